@@ -1,0 +1,218 @@
+//! Joint limits: position limits (hard) and optional velocity limits, and the per-step velocity
+//! interval they allow.
+//!
+//! For a step of duration `Δt` from `q`, joint `i` may move at a velocity in
+//! `[max((q_min,i − q_i)/Δt, −v_max,i), min((q_max,i − q_i)/Δt, v_max,i)]`, rounded so that
+//! `q_i + q̇_i Δt` lands inside `[q_min,i, q_max,i]` in floating point too. Position limits are
+//! hard: if `q_i` starts outside its range by more than one step at `v_max,i` can recover, the
+//! interval collapses onto the velocity that lands on the nearest limit (position wins over
+//! velocity).
+
+use super::SolverError;
+use super::stack::check_len;
+
+/// Position limits (rad or m) and velocity limits (rad/s or m/s) per joint.
+#[derive(Debug, Clone, PartialEq)]
+pub struct JointBounds {
+    lower: Vec<f64>,
+    upper: Vec<f64>,
+    velocity: Vec<f64>,
+}
+
+impl JointBounds {
+    /// Position limits only (velocity unbounded). `lower[i] ≤ upper[i]`; infinite limits are allowed
+    /// (`f64::NEG_INFINITY`/`f64::INFINITY`), NaN is not.
+    pub fn new(lower: &[f64], upper: &[f64]) -> Result<Self, SolverError> {
+        Self::with_velocity(lower, upper, &vec![f64::INFINITY; lower.len()])
+    }
+
+    /// Position and velocity limits. `velocity[i] ≥ 0` is the largest `|q̇_i|`.
+    pub fn with_velocity(
+        lower: &[f64],
+        upper: &[f64],
+        velocity: &[f64],
+    ) -> Result<Self, SolverError> {
+        check_len("upper limits", lower.len(), upper.len())?;
+        check_len("velocity limits", lower.len(), velocity.len())?;
+        for (joint, ((&lo, &hi), &v)) in lower.iter().zip(upper).zip(velocity).enumerate() {
+            if lo.is_nan()
+                || hi.is_nan()
+                || lo > hi
+                || lo == f64::INFINITY
+                || hi == f64::NEG_INFINITY
+            {
+                return Err(SolverError::InvertedLimits {
+                    joint,
+                    lower: lo,
+                    upper: hi,
+                });
+            }
+            if v.is_nan() || v < 0.0 {
+                return Err(SolverError::InvalidParameter {
+                    name: "velocity limit",
+                    value: v,
+                    reason: "must be >= 0 (infinity for none)",
+                });
+            }
+        }
+        Ok(Self {
+            lower: lower.to_vec(),
+            upper: upper.to_vec(),
+            velocity: velocity.to_vec(),
+        })
+    }
+
+    /// No limits at all on `dof` joints.
+    pub fn unbounded(dof: usize) -> Self {
+        Self {
+            lower: vec![f64::NEG_INFINITY; dof],
+            upper: vec![f64::INFINITY; dof],
+            velocity: vec![f64::INFINITY; dof],
+        }
+    }
+
+    /// Number of joints.
+    pub fn dof(&self) -> usize {
+        self.lower.len()
+    }
+
+    /// Lower position limits.
+    pub fn lower(&self) -> &[f64] {
+        &self.lower
+    }
+
+    /// Upper position limits.
+    pub fn upper(&self) -> &[f64] {
+        &self.upper
+    }
+
+    /// Velocity limits (`|q̇_i| ≤ velocity[i]`).
+    pub fn velocity(&self) -> &[f64] {
+        &self.velocity
+    }
+
+    /// Scales every velocity limit by `fraction` (e.g. 0.1 to run at 10 % of the rated speed).
+    pub fn scale_velocity(&mut self, fraction: f64) -> Result<(), SolverError> {
+        if !(fraction.is_finite() && fraction >= 0.0) {
+            return Err(SolverError::InvalidParameter {
+                name: "velocity fraction",
+                value: fraction,
+                reason: "must be finite and >= 0",
+            });
+        }
+        self.velocity.iter_mut().for_each(|v| *v *= fraction);
+        Ok(())
+    }
+
+    /// Clamps `q` into the position limits in place.
+    pub fn clamp_position(&self, q: &mut [f64]) {
+        for ((qi, &lo), &hi) in q.iter_mut().zip(&self.lower).zip(&self.upper) {
+            *qi = qi.clamp(lo, hi);
+        }
+    }
+
+    /// Writes the velocity interval `[lo_i, hi_i]` that one step of `dt` from `q` allows.
+    pub(crate) fn step_interval(&self, q: &[f64], dt: f64, lo: &mut [f64], hi: &mut [f64]) {
+        for i in 0..q.len() {
+            let (qi, v) = (q[i], self.velocity[i]);
+            let from_lower = landing_velocity(qi, self.lower[i], dt);
+            let from_upper = landing_velocity(qi, self.upper[i], dt);
+            let (mut l, mut h) = (from_lower.max(-v), from_upper.min(v));
+            if l > h {
+                // Outside the range and too far to come back at the velocity limit: land on the
+                // nearest position limit.
+                let land = if qi > self.upper[i] {
+                    from_upper
+                } else {
+                    from_lower
+                };
+                (l, h) = (land, land);
+            }
+            lo[i] = l;
+            hi[i] = h;
+        }
+    }
+}
+
+/// The velocity that takes `q` to `limit` in `dt`, rounded toward the inside so that
+/// `q + v·dt` does not cross `limit` in floating point. Infinite limits give infinite velocities.
+fn landing_velocity(q: f64, limit: f64, dt: f64) -> f64 {
+    if limit.is_infinite() {
+        return limit;
+    }
+    let mut v = (limit - q) / dt;
+    // `limit - q` and the division each round; correct the landing point by its own error.
+    for _ in 0..4 {
+        let overshoot = (q + v * dt) - limit;
+        let outside = if limit >= q {
+            overshoot > 0.0
+        } else {
+            overshoot < 0.0
+        };
+        if !outside {
+            return v;
+        }
+        v -= overshoot / dt;
+        v = if limit >= q {
+            v.next_down()
+        } else {
+            v.next_up()
+        };
+    }
+    v
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn inverted_limits_name_the_joint() {
+        let err = JointBounds::new(&[0.0, 1.0], &[1.0, 0.0]).unwrap_err();
+        assert_eq!(
+            err,
+            SolverError::InvertedLimits {
+                joint: 1,
+                lower: 1.0,
+                upper: 0.0
+            }
+        );
+    }
+
+    #[test]
+    fn step_interval_combines_position_and_velocity_limits() {
+        let b = JointBounds::with_velocity(&[-1.0, -1.0], &[1.0, 1.0], &[0.5, 10.0]).unwrap();
+        let (mut lo, mut hi) = ([0.0; 2], [0.0; 2]);
+        b.step_interval(&[0.9, 0.9], 0.1, &mut lo, &mut hi);
+        // Joint 0: velocity-limited both ways. Joint 1: (1 − 0.9)/0.1 = 1 up, 10 down (velocity).
+        assert_eq!((lo[0], hi[0]), (-0.5, 0.5));
+        assert!((hi[1] - 1.0).abs() < 1e-12 && lo[1] == -10.0);
+    }
+
+    #[test]
+    fn landing_is_inside_in_floating_point() {
+        for &(q, limit, dt) in &[
+            (0.1, 0.3, 0.01),
+            (-2.08567, 2.08567, 0.007),
+            (1.0, -0.7, 3.0),
+        ] {
+            let v = landing_velocity(q, limit, dt);
+            let landed = q + v * dt;
+            if limit >= q {
+                assert!(landed <= limit);
+            } else {
+                assert!(landed >= limit);
+            }
+            assert!((landed - limit).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn start_outside_range_lands_on_limit_despite_velocity_limit() {
+        let b = JointBounds::with_velocity(&[-1.0], &[1.0], &[0.1]).unwrap();
+        let (mut lo, mut hi) = ([0.0], [0.0]);
+        b.step_interval(&[2.0], 0.1, &mut lo, &mut hi);
+        assert_eq!(lo, hi);
+        assert!(2.0 + hi[0] * 0.1 <= 1.0);
+    }
+}

@@ -1,0 +1,441 @@
+//! The prioritized solve (eq. 4–6) with the clamping loop.
+//!
+//! # Method
+//!
+//! The textbook recursion is `q̇_j = q̇_{j−1} + (J_j P^a_{j−1})⁺ (ẋ_j − J_j q̇_{j−1})` with
+//! `P^a_j = I − (J^a_j)⁺ J^a_j`. Instead of forming `n × n` projectors we carry an orthonormal basis
+//! `Z_j` of the null space of levels `1..j`, so that `P^a_j = Z_j Z_jᵀ` and
+//! `(J_j P^a_{j−1})⁺ = Z_{j−1} (J_j Z_{j−1})⁺` (valid because `Z_{j−1}` has orthonormal columns).
+//!
+//! * `Z_0` selects the joints that are not clamped; clamped joints move at their fixed velocity,
+//!   whose effect `J_j q̇_clamped` is moved to the right-hand side of every level.
+//! * Level `j`: `A_j = J_j Z_{j−1}` (`m_j × r_{j−1}`). A Householder QR with column pivoting of
+//!   `A_jᵀ = Q_j [R_j; 0] Πᵀ`, truncated where the remaining row norm falls to
+//!   [`Settings::rank_tolerance`], gives the rank `k_j`. The level's minimum-norm (damped)
+//!   least-squares step is `Z_{j−1} Q_j[:, ..k_j] w_j` with
+//!   `w_j = argmin ‖R_jᵀ w − Πᵀ b_j‖² + μ_j² ‖w‖²`, and the next basis is
+//!   `Z_j = Z_{j−1} Q_j[:, k_j..]`.
+//! * `Z_j` is never formed: it is the product of the stored reflectors, applied to each new task row
+//!   (`Z_{j−1}ᵀ J_jᵀ`), to the gradient (`Z_Nᵀ g`), and once, back, to assemble `q̇`.
+//! * Damping: when the smallest kept pivot `σ` of a level is below
+//!   [`Settings::damping_threshold`] `ε`, `μ² = μ_max² (1 − (σ/ε)²)` (Nakamura–Hanafusa style,
+//!   continuous in `σ`); otherwise `μ = 0` and the level is solved exactly.
+//!
+//! Lower levels act only in `Z_j`, so they cannot disturb a higher level: its residual is the same
+//! with or without them (strict priority), up to rounding and the truncated directions whose
+//! singular values are below the rank tolerance.
+//!
+//! The gradient term is added as `Z_N Z_Nᵀ Σ κ_k ∇f_k` (eq. 6).
+//!
+//! The clamping loop (Baerlocher & Boulic 2004): after a solve, every free joint whose velocity
+//! leaves the interval allowed for this step (position limits over `Δt`, and velocity limits) is
+//! fixed at the violated bound and removed from `Z_0`; the stack is solved again, until no free joint
+//! violates its interval. Each pass clamps at least one joint, so at most `n + 1` passes run, and the
+//! result never violates a limit.
+
+use super::SolverError;
+use super::bounds::JointBounds;
+use super::householder::{
+    apply_reflector, dot, norm, qr_col_pivoting, qr_with_rhs, solve_upper, solve_upper_transposed,
+};
+use super::report::SolveReport;
+use super::stack::{StackShape, TaskStack, check_finite_slice, check_len};
+
+/// Numerical settings of the solve. All are absolute, in the units of the task rows (e.g. m/rad
+/// for position tasks); the defaults suit Jacobians whose entries are of order 0.01–1.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Settings {
+    /// Directions of a projected level whose remaining norm (≈ singular value) is at or below this
+    /// are treated as null: they are neither used by the level nor removed from the space left to
+    /// lower levels. Default `1e-9`.
+    pub rank_tolerance: f64,
+    /// A level whose smallest kept singular value estimate `σ` is below this is damped. Default
+    /// `1e-3`. Set to 0 to disable damping (pure truncation).
+    pub damping_threshold: f64,
+    /// Largest damping factor `μ_max`, reached as `σ → 0`. Default `1e-2`.
+    pub max_damping: f64,
+    /// A level is reported feasible when `‖J_j q̇ − ẋ_j‖ ≤ feasibility_tolerance · (1 + ‖ẋ_j‖)`.
+    /// Default `1e-8`.
+    pub feasibility_tolerance: f64,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Self {
+            rank_tolerance: 1e-9,
+            damping_threshold: 1e-3,
+            max_damping: 1e-2,
+            feasibility_tolerance: 1e-8,
+        }
+    }
+}
+
+impl Settings {
+    fn validate(&self) -> Result<(), SolverError> {
+        let check = |name, value: f64, positive: bool| {
+            let ok = value.is_finite() && if positive { value > 0.0 } else { value >= 0.0 };
+            if ok {
+                Ok(())
+            } else {
+                Err(SolverError::InvalidParameter {
+                    name,
+                    value,
+                    reason: if positive {
+                        "must be finite and > 0"
+                    } else {
+                        "must be finite and >= 0"
+                    },
+                })
+            }
+        };
+        check("rank_tolerance", self.rank_tolerance, true)?;
+        check("damping_threshold", self.damping_threshold, false)?;
+        check("max_damping", self.max_damping, false)?;
+        check("feasibility_tolerance", self.feasibility_tolerance, false)
+    }
+}
+
+/// Per-level factorization data, in the stacked workspace buffers.
+#[derive(Debug, Clone, Copy, Default)]
+struct LevelFactor {
+    /// Dimension of the space the level was solved in, `r_{j−1}`.
+    dim: usize,
+    /// Rank used, `k_j`.
+    rank: usize,
+}
+
+/// A prioritized task-stack solver: the stack, its workspace, and the last result.
+///
+/// Everything is allocated in [`Solver::new`]; [`Solver::solve`] allocates nothing.
+#[derive(Debug, Clone)]
+pub struct Solver {
+    stack: TaskStack,
+    settings: Settings,
+    // Workspace, sized for (n, level rows).
+    factors: Vec<LevelFactor>,
+    /// `A_jᵀ` per level, column-major with leading dimension `r_{j−1}`, at offset `n · start_j`;
+    /// after factorization, `R_j` and the reflectors.
+    qr: Vec<f64>,
+    tau: Vec<f64>,
+    perm: Vec<usize>,
+    /// Right-hand side `b_j` per row, then `w_j` per level (at the level's start).
+    rhs: Vec<f64>,
+    coeff: Vec<f64>,
+    /// Damped least-squares scratch: `(2 m_max) × m_max` and `2 m_max`.
+    ls_matrix: Vec<f64>,
+    ls_rhs: Vec<f64>,
+    /// Vector in reduced coordinates (length n).
+    coords: Vec<f64>,
+    free: Vec<usize>,
+    clamped: Vec<bool>,
+    fixed_velocity: Vec<f64>,
+    step_lo: Vec<f64>,
+    step_hi: Vec<f64>,
+    velocity: Vec<f64>,
+    report: SolveReport,
+}
+
+impl Solver {
+    /// A solver for stacks of this shape, with default [`Settings`].
+    pub fn new(shape: &StackShape) -> Result<Self, SolverError> {
+        Self::with_settings(shape, Settings::default())
+    }
+
+    /// A solver for stacks of this shape with the given settings.
+    pub fn with_settings(shape: &StackShape, settings: Settings) -> Result<Self, SolverError> {
+        settings.validate()?;
+        let stack = TaskStack::new(shape)?;
+        let n = stack.dof();
+        let total = stack.total_rows();
+        let levels = stack.level_count();
+        let m_max = shape.level_rows().max().unwrap_or(0);
+        Ok(Self {
+            factors: vec![LevelFactor::default(); levels],
+            qr: vec![0.0; n * total],
+            tau: vec![0.0; total],
+            perm: vec![0; total],
+            rhs: vec![0.0; total],
+            coeff: vec![0.0; total],
+            ls_matrix: vec![0.0; 2 * m_max * m_max],
+            ls_rhs: vec![0.0; 2 * m_max],
+            coords: vec![0.0; n],
+            free: Vec::with_capacity(n),
+            clamped: vec![false; n],
+            fixed_velocity: vec![0.0; n],
+            step_lo: vec![0.0; n],
+            step_hi: vec![0.0; n],
+            velocity: vec![0.0; n],
+            report: SolveReport::with_capacity(levels, n),
+            stack,
+            settings,
+        })
+    }
+
+    /// The task stack (read).
+    pub fn stack(&self) -> &TaskStack {
+        &self.stack
+    }
+
+    /// The task stack, to fill Jacobians, desired velocities and the gradient term.
+    pub fn stack_mut(&mut self) -> &mut TaskStack {
+        &mut self.stack
+    }
+
+    /// The numerical settings.
+    pub fn settings(&self) -> &Settings {
+        &self.settings
+    }
+
+    /// Replaces the numerical settings.
+    pub fn set_settings(&mut self, settings: Settings) -> Result<(), SolverError> {
+        settings.validate()?;
+        self.settings = settings;
+        Ok(())
+    }
+
+    /// The joint velocity `q̇` of the last successful solve (rad/s or m/s).
+    pub fn velocity(&self) -> &[f64] {
+        &self.velocity
+    }
+
+    /// The report of the last successful solve.
+    pub fn report(&self) -> &SolveReport {
+        &self.report
+    }
+
+    /// Solves the stack for `q̇` at configuration `q` with the clamping loop: `q + q̇ Δt` stays within
+    /// the position limits and `|q̇|` within the velocity limits of `bounds` (see
+    /// [`JointBounds`] for a `q` that starts outside its limits).
+    ///
+    /// `q` (rad or m) is only used for the bounds; Jacobians, targets and the gradient term are the
+    /// ones in [`Solver::stack_mut`]. `dt` is the step duration in seconds (> 0).
+    pub fn solve(
+        &mut self,
+        q: &[f64],
+        bounds: &JointBounds,
+        dt: f64,
+    ) -> Result<&SolveReport, SolverError> {
+        let n = self.stack.dof();
+        check_len("q", n, q.len())?;
+        check_len("joint bounds", n, bounds.dof())?;
+        check_finite_slice("q", q)?;
+        if !(dt.is_finite() && dt > 0.0) {
+            return Err(SolverError::InvalidParameter {
+                name: "dt",
+                value: dt,
+                reason: "the time step must be finite and > 0 s",
+            });
+        }
+        self.stack.check_finite()?;
+        bounds.step_interval(q, dt, &mut self.step_lo, &mut self.step_hi);
+        self.clamped.fill(false);
+        self.fixed_velocity.fill(0.0);
+        self.report.clamped.clear();
+        self.report.clamping_iterations = 0;
+        loop {
+            self.report.clamping_iterations += 1;
+            self.prioritized_pass();
+            let mut clamped_any = false;
+            for &i in &self.free {
+                let v = self.velocity[i];
+                let bound = if v < self.step_lo[i] {
+                    self.step_lo[i]
+                } else if v > self.step_hi[i] {
+                    self.step_hi[i]
+                } else {
+                    continue;
+                };
+                self.clamped[i] = true;
+                self.fixed_velocity[i] = bound;
+                self.report.clamped.push(i);
+                clamped_any = true;
+            }
+            if !clamped_any {
+                break;
+            }
+        }
+        self.finish_report();
+        Ok(&self.report)
+    }
+
+    /// Solves the stack without any joint limit (no clamping loop).
+    pub fn solve_unbounded(&mut self) -> Result<&SolveReport, SolverError> {
+        self.stack.check_finite()?;
+        self.clamped.fill(false);
+        self.fixed_velocity.fill(0.0);
+        self.report.clamped.clear();
+        self.report.clamping_iterations = 1;
+        self.prioritized_pass();
+        self.finish_report();
+        Ok(&self.report)
+    }
+
+    /// One prioritized solve over the joints not clamped; writes `self.velocity`.
+    fn prioritized_pass(&mut self) {
+        let n = self.stack.dof();
+        self.free.clear();
+        self.free.extend((0..n).filter(|&i| !self.clamped[i]));
+        let mut dim = self.free.len();
+        for j in 0..self.stack.level_count() {
+            self.project_level_rows(j, dim);
+            let rank = self.factor_and_solve_level(j, dim);
+            self.factors[j] = LevelFactor { dim, rank };
+            dim -= rank;
+        }
+        self.assemble_velocity();
+    }
+
+    /// Writes `A_jᵀ = Z_{j−1}ᵀ J_jᵀ` into level j's QR buffer and the right-hand side
+    /// `b_j = ẋ_j − J_j q̇_{j−1}` into `rhs`.
+    fn project_level_rows(&mut self, j: usize, dim: usize) {
+        let n = self.stack.dof();
+        let start = self.stack.level_start(j);
+        let rows = self.stack.level_start(j + 1) - start;
+        let (head, tail) = self.qr.split_at_mut(n * start);
+        for t in 0..rows {
+            let row = self.stack.row(start + t);
+            let mut b = self.stack.stacked_target()[start + t] - dot(row, &self.fixed_velocity);
+            for (c, &i) in self.coords.iter_mut().zip(&self.free) {
+                *c = row[i];
+            }
+            let mut offset = 0;
+            for (i, f) in self.factors[..j].iter().enumerate() {
+                let level_start = self.stack.level_start(i);
+                let factor = &head[n * level_start..];
+                let cur = &mut self.coords[offset..offset + f.dim];
+                for l in 0..f.rank {
+                    apply_reflector(
+                        &factor[l * f.dim + l..(l + 1) * f.dim],
+                        self.tau[level_start + l],
+                        &mut cur[l..],
+                    );
+                }
+                b -= dot(
+                    &cur[..f.rank],
+                    &self.coeff[level_start..level_start + f.rank],
+                );
+                offset += f.rank;
+            }
+            tail[t * dim..(t + 1) * dim].copy_from_slice(&self.coords[offset..offset + dim]);
+            self.rhs[start + t] = b;
+        }
+    }
+
+    /// Factorizes level j's projected rows and stores its least-squares coefficients `w_j`.
+    /// Returns the rank used.
+    fn factor_and_solve_level(&mut self, j: usize, dim: usize) -> usize {
+        let n = self.stack.dof();
+        let start = self.stack.level_start(j);
+        let rows = self.stack.level_start(j + 1) - start;
+        let a = &mut self.qr[n * start..n * start + dim * rows];
+        let tau = &mut self.tau[start..start + rows];
+        let perm = &mut self.perm[start..start + rows];
+        let rank = qr_col_pivoting(a, dim, rows, self.settings.rank_tolerance, tau, perm);
+        let w = &mut self.coeff[start..start + rows];
+        w.fill(0.0);
+        let mut damping = 0.0;
+        if rank > 0 {
+            let sigma = a[(rank - 1) * dim + rank - 1].abs();
+            let eps = self.settings.damping_threshold;
+            if sigma < eps {
+                let ratio = sigma / eps;
+                damping = self.settings.max_damping * (1.0 - ratio * ratio).sqrt();
+            }
+            let c = &mut self.ls_rhs[..rows + rank];
+            for (ck, &p) in c.iter_mut().zip(perm.iter()) {
+                *ck = self.rhs[start + p];
+            }
+            if rank == rows && damping == 0.0 {
+                solve_upper_transposed(a, dim, rank, c);
+            } else {
+                // min ‖[Rᵀ; μ I] w − [c; 0]‖ by a QR of the stacked matrix.
+                let aug_rows = rows + if damping > 0.0 { rank } else { 0 };
+                let m = &mut self.ls_matrix[..aug_rows * rank];
+                m.fill(0.0);
+                for l in 0..rank {
+                    // Rᵀ is lower-trapezoidal; below R's diagonal `a` holds reflectors.
+                    for t in l..rows {
+                        m[l * aug_rows + t] = a[t * dim + l];
+                    }
+                    if damping > 0.0 {
+                        m[l * aug_rows + rows + l] = damping;
+                    }
+                }
+                c[rows..aug_rows].fill(0.0);
+                qr_with_rhs(m, aug_rows, rank, &mut c[..aug_rows]);
+                solve_upper(m, aug_rows, rank, c);
+            }
+            w[..rank].copy_from_slice(&c[..rank]);
+        }
+        self.report.levels[j].rank = rank;
+        self.report.levels[j].rows = rows;
+        self.report.levels[j].damping = damping;
+        rank
+    }
+
+    /// `q̇ = q̇_clamped + Z_0 (Σ_j Z-chain [w_j] + Z_N Z_Nᵀ g)`, folding the levels back from the
+    /// deepest.
+    fn assemble_velocity(&mut self) {
+        let n = self.stack.dof();
+        let levels = self.stack.level_count();
+        // Z_Nᵀ g: the gradient through every level's reflectors.
+        let gradient = self.stack.gradient();
+        for (c, &i) in self.coords.iter_mut().zip(&self.free) {
+            *c = gradient[i];
+        }
+        let mut offset = 0;
+        for j in 0..levels {
+            let f = self.factors[j];
+            let start = self.stack.level_start(j);
+            let factor = &self.qr[n * start..];
+            let cur = &mut self.coords[offset..offset + f.dim];
+            for l in 0..f.rank {
+                apply_reflector(
+                    &factor[l * f.dim + l..(l + 1) * f.dim],
+                    self.tau[start + l],
+                    &mut cur[l..],
+                );
+            }
+            offset += f.rank;
+        }
+        // Fold back: at level j the vector is [w_j; (deeper part)] in r_{j−1} coordinates.
+        for j in (0..levels).rev() {
+            let f = self.factors[j];
+            let start = self.stack.level_start(j);
+            offset -= f.rank;
+            let factor = &self.qr[n * start..];
+            let cur = &mut self.coords[offset..offset + f.dim];
+            cur[..f.rank].copy_from_slice(&self.coeff[start..start + f.rank]);
+            for l in (0..f.rank).rev() {
+                apply_reflector(
+                    &factor[l * f.dim + l..(l + 1) * f.dim],
+                    self.tau[start + l],
+                    &mut cur[l..],
+                );
+            }
+        }
+        self.velocity.copy_from_slice(&self.fixed_velocity);
+        for (&c, &i) in self.coords.iter().zip(&self.free) {
+            self.velocity[i] = c;
+        }
+    }
+
+    /// Residuals and feasibility of every level for the final velocity.
+    fn finish_report(&mut self) {
+        for j in 0..self.stack.level_count() {
+            let start = self.stack.level_start(j);
+            let end = self.stack.level_start(j + 1);
+            let targets = &self.stack.stacked_target()[start..end];
+            // Reuse the least-squares scratch for the residual vector.
+            let r = &mut self.ls_rhs[..end - start];
+            for (t, (ri, &x)) in r.iter_mut().zip(targets).enumerate() {
+                *ri = dot(self.stack.row(start + t), &self.velocity) - x;
+            }
+            let residual = norm(r);
+            let level = &mut self.report.levels[j];
+            level.residual = residual;
+            level.feasible =
+                residual <= self.settings.feasibility_tolerance * (1.0 + norm(targets));
+        }
+    }
+}

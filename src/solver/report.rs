@@ -1,0 +1,58 @@
+//! What a solve achieved, level by level: the answer to "why did it fail".
+
+/// Outcome of one equality level.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct LevelReport {
+    /// Rows of the level, `m_j`.
+    pub rows: usize,
+    /// Rank of the level inside the null space left by the levels above it (and by the clamped
+    /// joints): how many independent directions it could use. `rank < rows` means some rows are
+    /// redundant or conflict with higher levels.
+    pub rank: usize,
+    /// `‖J_j q̇ − ẋ_j‖` for the final `q̇` (task velocity units, e.g. m/s).
+    pub residual: f64,
+    /// Whether the residual is within the feasibility tolerance (see
+    /// [`Settings::feasibility_tolerance`](super::Settings::feasibility_tolerance)). An infeasible
+    /// level got its least-squares best inside the null space of the levels above it.
+    pub feasible: bool,
+    /// The damping factor `μ` used for this level (0 when it was well conditioned).
+    pub damping: f64,
+}
+
+/// Outcome of a solve, including the clamping loop.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SolveReport {
+    pub(crate) levels: Vec<LevelReport>,
+    pub(crate) clamped: Vec<usize>,
+    pub(crate) clamping_iterations: usize,
+}
+
+impl SolveReport {
+    pub(crate) fn with_capacity(levels: usize, dof: usize) -> Self {
+        Self {
+            levels: vec![LevelReport::default(); levels],
+            clamped: Vec::with_capacity(dof),
+            clamping_iterations: 0,
+        }
+    }
+
+    /// Per-level outcomes, highest priority first.
+    pub fn levels(&self) -> &[LevelReport] {
+        &self.levels
+    }
+
+    /// Joints fixed at a bound by the clamping loop (indices, in the order they were clamped).
+    pub fn clamped_joints(&self) -> &[usize] {
+        &self.clamped
+    }
+
+    /// Number of prioritized solves the clamping loop ran (1 when no joint had to be clamped).
+    pub fn clamping_iterations(&self) -> usize {
+        self.clamping_iterations
+    }
+
+    /// Index of the first level that is not feasible, if any: the highest level that gave way.
+    pub fn first_infeasible_level(&self) -> Option<usize> {
+        self.levels.iter().position(|l| !l.feasible)
+    }
+}
