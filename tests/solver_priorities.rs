@@ -34,6 +34,7 @@ fn unbounded_velocity(problem: &Problem, with_gradient: bool) -> (Vec<f64>, Vec<
     let residuals = solver
         .solve_unbounded()
         .unwrap()
+        .report
         .levels()
         .iter()
         .map(|l| l.residual)

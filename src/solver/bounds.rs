@@ -6,7 +6,10 @@
 //! `q_i + q̇_i Δt` lands inside `[q_min,i, q_max,i]` in floating point too. Position limits are
 //! hard: if `q_i` starts outside its range by more than one step at `v_max,i` can recover, the
 //! interval collapses onto the velocity that lands on the nearest limit (position wins over
-//! velocity).
+//! velocity). One case cannot be exact: a zero-width range (`q_min,i = q_max,i`) with `q_i` outside
+//! it, where no floating-point velocity may land exactly on the single admissible value; there the
+//! landing is within a few ulps, and [`JointBounds::clamp_position`] (used by the position-level
+//! driver after integrating) removes the rest.
 
 use super::SolverError;
 use super::stack::check_len;
@@ -104,6 +107,16 @@ impl JointBounds {
         Ok(())
     }
 
+    /// Copies `other` (same number of joints) into `self`, with every velocity limit capped at
+    /// `cap`. Allocation-free.
+    pub(crate) fn copy_with_velocity_cap(&mut self, other: &JointBounds, cap: f64) {
+        self.lower.copy_from_slice(&other.lower);
+        self.upper.copy_from_slice(&other.upper);
+        for (v, &o) in self.velocity.iter_mut().zip(&other.velocity) {
+            *v = o.min(cap);
+        }
+    }
+
     /// Clamps `q` into the position limits in place.
     pub fn clamp_position(&self, q: &mut [f64]) {
         for ((qi, &lo), &hi) in q.iter_mut().zip(&self.lower).zip(&self.upper) {
@@ -115,17 +128,18 @@ impl JointBounds {
     pub(crate) fn step_interval(&self, q: &[f64], dt: f64, lo: &mut [f64], hi: &mut [f64]) {
         for i in 0..q.len() {
             let (qi, v) = (q[i], self.velocity[i]);
-            let from_lower = landing_velocity(qi, self.lower[i], dt);
-            let from_upper = landing_velocity(qi, self.upper[i], dt);
+            let from_lower = landing_velocity(qi, self.lower[i], dt, Side::Lower);
+            let from_upper = landing_velocity(qi, self.upper[i], dt, Side::Upper);
             let (mut l, mut h) = (from_lower.max(-v), from_upper.min(v));
             if l > h {
                 // Outside the range and too far to come back at the velocity limit: land on the
                 // nearest position limit.
-                let land = if qi > self.upper[i] {
+                let guess = if qi > self.upper[i] {
                     from_upper
                 } else {
                     from_lower
                 };
+                let land = inside_landing(qi, guess, dt, self.lower[i], self.upper[i]);
                 (l, h) = (land, land);
             }
             lo[i] = l;
@@ -134,32 +148,58 @@ impl JointBounds {
     }
 }
 
-/// The velocity that takes `q` to `limit` in `dt`, rounded toward the inside so that
+#[derive(Clone, Copy, PartialEq)]
+enum Side {
+    Lower,
+    Upper,
+}
+
+/// The velocity that takes `q` to `limit` in `dt`, rounded toward the inside of the range so that
 /// `q + v·dt` does not cross `limit` in floating point. Infinite limits give infinite velocities.
-fn landing_velocity(q: f64, limit: f64, dt: f64) -> f64 {
+fn landing_velocity(q: f64, limit: f64, dt: f64, side: Side) -> f64 {
     if limit.is_infinite() {
         return limit;
     }
-    let mut v = (limit - q) / dt;
-    // `limit - q` and the division each round; correct the landing point by its own error.
-    for _ in 0..4 {
-        let overshoot = (q + v * dt) - limit;
-        let outside = if limit >= q {
-            overshoot > 0.0
-        } else {
-            overshoot < 0.0
+    let crosses = |v: f64| {
+        let landed = q + v * dt;
+        match side {
+            Side::Upper => landed > limit,
+            Side::Lower => landed < limit,
+        }
+    };
+    // `limit - q` and the division each round: aim a little further inside, doubling the margin
+    // until the landing point is on the right side.
+    let ulp = (limit.next_up() - limit).max(f64::MIN_POSITIVE);
+    let mut margin = 0.0;
+    loop {
+        let target = match side {
+            Side::Upper => limit - margin,
+            Side::Lower => limit + margin,
         };
-        if !outside {
+        let v = (target - q) / dt;
+        if !crosses(v) || margin > 1e6 * ulp {
             return v;
         }
-        v -= overshoot / dt;
-        v = if limit >= q {
-            v.next_down()
-        } else {
-            v.next_up()
-        };
+        margin = (2.0 * margin).max(ulp);
     }
-    v
+}
+
+/// A velocity near `guess` that lands `q` inside `[lower, upper]` after `dt` in floating point
+/// (needed when the range has zero width and `q` is outside it, where the rounded landing
+/// velocities of the two limits straddle the only admissible point).
+fn inside_landing(q: f64, guess: f64, dt: f64, lower: f64, upper: f64) -> f64 {
+    let inside = |v: f64| (lower..=upper).contains(&(q + v * dt));
+    let (mut up, mut down) = (guess, guess);
+    for _ in 0..64 {
+        if inside(up) {
+            return up;
+        }
+        if inside(down) {
+            return down;
+        }
+        (up, down) = (up.next_up(), down.next_down());
+    }
+    guess
 }
 
 #[cfg(test)]
@@ -191,17 +231,19 @@ mod tests {
 
     #[test]
     fn landing_is_inside_in_floating_point() {
-        for &(q, limit, dt) in &[
-            (0.1, 0.3, 0.01),
-            (-2.08567, 2.08567, 0.007),
-            (1.0, -0.7, 3.0),
-        ] {
-            let v = landing_velocity(q, limit, dt);
+        let cases = [
+            (0.1, 0.3, 0.01, Side::Upper),
+            (-2.08567, 2.08567, 0.007, Side::Upper),
+            (1.0, -0.7, 3.0, Side::Lower),
+            (1.3, 0.9, 0.01, Side::Upper),
+            (-1.3, -0.9, 0.01, Side::Lower),
+        ];
+        for (q, limit, dt, side) in cases {
+            let v = landing_velocity(q, limit, dt, side);
             let landed = q + v * dt;
-            if limit >= q {
-                assert!(landed <= limit);
-            } else {
-                assert!(landed >= limit);
+            match side {
+                Side::Upper => assert!(landed <= limit),
+                Side::Lower => assert!(landed >= limit),
             }
             assert!((landed - limit).abs() < 1e-12);
         }

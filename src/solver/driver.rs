@@ -1,7 +1,8 @@
 //! Position-level IK: iterate the velocity solve until position targets are reached.
 //!
 //! Each iteration asks a [`TaskModel`] for the task errors `e_j = x*_j − x_j(q)` and Jacobians at
-//! the current `q`, sets `ẋ_j = K e_j`, solves the stack (with the clamping loop, so every iterate
+//! the current `q`, sets `ẋ_j = K e_j` (each task's error first clipped to a largest norm, so that
+//! a far target is approached in steps the linearization can be trusted over), solves the stack (with the clamping loop, so every iterate
 //! is within the joint limits) and integrates `q ← q + q̇ Δt`. With `K Δt = 1` (the default) an
 //! iteration is a Gauss–Newton step. It stops when every task's error norm is within tolerance,
 //! when no task error changed by more than the stall tolerance in the last iteration, or at the
@@ -38,6 +39,15 @@ pub struct DriverSettings {
     pub stall_tolerance: f64,
     /// Largest number of solves. Default 50.
     pub max_iterations: usize,
+    /// Largest error norm a task may ask for in one iteration (task units, e.g. m); a larger
+    /// error is scaled down to this, keeping its direction. Default 0.05.
+    pub max_task_error: f64,
+    /// Largest change of any joint in one iteration (rad or m): a velocity limit of
+    /// `max_joint_step / dt` added to the joint bounds, so the clamping loop fixes a joint that
+    /// would step further and lets the others take over its share of the tasks (a box trust
+    /// region). Guards against the overshoot of Gauss–Newton steps near singular configurations.
+    /// Default 0.2.
+    pub max_joint_step: f64,
 }
 
 impl Default for DriverSettings {
@@ -48,6 +58,8 @@ impl Default for DriverSettings {
             tolerance: 1e-4,
             stall_tolerance: 1e-7,
             max_iterations: 50,
+            max_task_error: 0.05,
+            max_joint_step: 0.2,
         }
     }
 }
@@ -87,6 +99,8 @@ pub struct PositionDriver {
     /// First stacked row of every task, plus the total at the end.
     task_start: Vec<usize>,
     previous: Vec<f64>,
+    /// The caller's bounds with the per-iteration step limit as a velocity cap.
+    step_bounds: JointBounds,
     report: DriverReport,
 }
 
@@ -98,14 +112,17 @@ impl PositionDriver {
             ("dt", settings.dt),
             ("tolerance", settings.tolerance),
             ("stall_tolerance", settings.stall_tolerance),
+            ("max_task_error", settings.max_task_error),
+            ("max_joint_step", settings.max_joint_step),
         ] {
-            if !(value.is_finite() && value >= 0.0)
-                || (value == 0.0 && matches!(name, "gain" | "dt"))
-            {
+            let unbounded_ok = matches!(name, "max_task_error" | "max_joint_step");
+            let positive = matches!(name, "gain" | "dt") || unbounded_ok;
+            let finite = value.is_finite() || unbounded_ok;
+            if value.is_nan() || !finite || value < 0.0 || (positive && value == 0.0) {
                 return Err(SolverError::InvalidParameter {
                     name,
                     value,
-                    reason: "must be finite and >= 0 (gain and dt > 0)",
+                    reason: "must be >= 0 and finite (gain, dt and the step limits > 0; the step limits may be infinite)",
                 });
             }
         }
@@ -120,6 +137,7 @@ impl PositionDriver {
             settings,
             task_start,
             previous: vec![0.0; tasks],
+            step_bounds: JointBounds::unbounded(solver.stack().dof()),
             report: DriverReport {
                 iterations: 0,
                 stop: StopReason::Converged,
@@ -143,6 +161,9 @@ impl PositionDriver {
         bounds: &JointBounds,
     ) -> Result<&DriverReport, M::Error> {
         check_len("q", solver.stack().dof(), q.len())?;
+        check_len("joint bounds", self.step_bounds.dof(), bounds.dof())?;
+        self.step_bounds
+            .copy_with_velocity_cap(bounds, self.settings.max_joint_step / self.settings.dt);
         check_len(
             "task rows",
             self.task_start[self.task_start.len() - 1],
@@ -169,25 +190,43 @@ impl PositionDriver {
                 break StopReason::IterationLimit;
             }
             self.previous.copy_from_slice(errors);
-            let stack = solver.stack_mut();
-            for level in 0..stack.level_count() {
-                stack
-                    .level_mut(level)
-                    .target_mut()
-                    .iter_mut()
-                    .for_each(|e| *e *= s.gain);
-            }
-            solver.solve(q, bounds, s.dt)?;
+            self.set_velocities(solver.stack_mut());
+            solver.solve(q, &self.step_bounds, s.dt)?;
             for (qi, v) in q.iter_mut().zip(solver.velocity()) {
                 *qi += v * s.dt;
             }
-            // The step interval already lands inside; this only removes a last-ulp excursion.
+            // The step interval already lands inside; this removes a last-ulp excursion (possible
+            // only for a zero-width range entered from outside).
             bounds.clamp_position(q);
             iterations += 1;
         };
         self.report.iterations = iterations;
         self.report.stop = stop;
         Ok(&self.report)
+    }
+
+    /// `ẋ = K e`, with each task's error clipped to `max_task_error`.
+    fn set_velocities(&self, stack: &mut TaskStack) {
+        let (gain, limit) = (self.settings.gain, self.settings.max_task_error);
+        let errors = &self.report.task_errors;
+        let mut level = 0;
+        for t in 0..errors.len() {
+            let (start, end) = (self.task_start[t], self.task_start[t + 1]);
+            while start >= stack.level_start(level + 1) {
+                level += 1;
+            }
+            let scale = gain
+                * if errors[t] > limit {
+                    limit / errors[t]
+                } else {
+                    1.0
+                };
+            let offset = stack.level_start(level);
+            let mut l = stack.level_mut(level);
+            for e in &mut l.target_mut()[start - offset..end - offset] {
+                *e *= scale;
+            }
+        }
     }
 
     fn measure_errors(&mut self, stack: &TaskStack) {

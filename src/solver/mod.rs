@@ -33,10 +33,10 @@
 //! let q = [0.0; 3];
 //! let limits = JointLimitAvoidance::new(&bounds);
 //! solver.stack_mut().add_gradient(-0.1, &limits, &q).unwrap();
-//! let report = solver.solve(&q, &bounds, 0.1).unwrap();
+//! let solution = solver.solve(&q, &bounds, 0.1).unwrap();
+//! let (v, report) = (solution.velocity, solution.report);
 //! // Joint 0 may move 0.05 rad in 0.1 s: it is clamped at 0.5 rad/s, level 1 still holds.
 //! assert_eq!(report.clamped_joints(), &[0]);
-//! let v = solver.velocity();
 //! assert!((v[0] - 0.5).abs() < 1e-12 && (v[0] + v[1] + v[2] - 1.0).abs() < 1e-12);
 //! assert!(report.levels()[0].feasible && !report.levels()[1].feasible);
 //! ```
@@ -54,5 +54,5 @@ pub use bounds::JointBounds;
 pub use error::SolverError;
 pub use gradient::{GradientFunction, JointLimitAvoidance, JointTracking};
 pub use prioritized::{Settings, Solver};
-pub use report::{LevelReport, SolveReport};
+pub use report::{LevelReport, Solution, SolveReport};
 pub use stack::{LevelMut, LevelSpec, StackShape, TaskSpec, TaskStack};

@@ -27,18 +27,20 @@
 //!
 //! The gradient term is added as `Z_N Z_Nᵀ Σ κ_k ∇f_k` (eq. 6).
 //!
-//! The clamping loop (Baerlocher & Boulic 2004): after a solve, every free joint whose velocity
-//! leaves the interval allowed for this step (position limits over `Δt`, and velocity limits) is
-//! fixed at the violated bound and removed from `Z_0`; the stack is solved again, until no free joint
-//! violates its interval. Each pass clamps at least one joint, so at most `n + 1` passes run, and the
-//! result never violates a limit.
+//! The clamping loop (Baerlocher & Boulic 2004): after a solve, the free joint whose velocity
+//! leaves the interval allowed for this step (position limits over `Δt`, and velocity limits) by
+//! the most is fixed at the violated bound and removed from `Z_0`; the stack is solved again, until
+//! no free joint violates its interval. (The paper clamps every violator at once; one at a time, like
+//! an active-set method, keeps joints free that a near-singular first solution would have pinned.)
+//! Each pass clamps one joint, so at most `n + 1` passes run, and the result never violates a
+//! limit.
 
 use super::SolverError;
 use super::bounds::JointBounds;
 use super::householder::{
     apply_reflector, dot, norm, qr_col_pivoting, qr_with_rhs, solve_upper, solve_upper_transposed,
 };
-use super::report::SolveReport;
+use super::report::{Solution, SolveReport};
 use super::stack::{StackShape, TaskStack, check_finite_slice, check_len};
 
 /// Numerical settings of the solve. All are absolute, in the units of the task rows (e.g. m/rad
@@ -50,9 +52,9 @@ pub struct Settings {
     /// lower levels. Default `1e-9`.
     pub rank_tolerance: f64,
     /// A level whose smallest kept singular value estimate `σ` is below this is damped. Default
-    /// `1e-3`. Set to 0 to disable damping (pure truncation).
+    /// `2e-2`. Set to 0 to disable damping (pure truncation).
     pub damping_threshold: f64,
-    /// Largest damping factor `μ_max`, reached as `σ → 0`. Default `1e-2`.
+    /// Largest damping factor `μ_max`, reached as `σ → 0`. Default `2e-2`.
     pub max_damping: f64,
     /// A level is reported feasible when `‖J_j q̇ − ẋ_j‖ ≤ feasibility_tolerance · (1 + ‖ẋ_j‖)`.
     /// Default `1e-8`.
@@ -63,8 +65,8 @@ impl Default for Settings {
     fn default() -> Self {
         Self {
             rank_tolerance: 1e-9,
-            damping_threshold: 1e-3,
-            max_damping: 1e-2,
+            damping_threshold: 2e-2,
+            max_damping: 2e-2,
             feasibility_tolerance: 1e-8,
         }
     }
@@ -214,7 +216,7 @@ impl Solver {
         q: &[f64],
         bounds: &JointBounds,
         dt: f64,
-    ) -> Result<&SolveReport, SolverError> {
+    ) -> Result<Solution<'_>, SolverError> {
         let n = self.stack.dof();
         check_len("q", n, q.len())?;
         check_len("joint bounds", n, bounds.dof())?;
@@ -235,31 +237,36 @@ impl Solver {
         loop {
             self.report.clamping_iterations += 1;
             self.prioritized_pass();
-            let mut clamped_any = false;
+            // Clamp the worst violator only, then solve again: clamping every violator at once
+            // lets a near-singular raw solution decide the fate of joints it would not need.
+            let mut worst: Option<(usize, f64, f64)> = None;
             for &i in &self.free {
                 let v = self.velocity[i];
-                let bound = if v < self.step_lo[i] {
-                    self.step_lo[i]
+                let (bound, excess) = if v < self.step_lo[i] {
+                    (self.step_lo[i], self.step_lo[i] - v)
                 } else if v > self.step_hi[i] {
-                    self.step_hi[i]
+                    (self.step_hi[i], v - self.step_hi[i])
                 } else {
                     continue;
                 };
-                self.clamped[i] = true;
-                self.fixed_velocity[i] = bound;
-                self.report.clamped.push(i);
-                clamped_any = true;
+                if worst.is_none_or(|(_, _, e)| excess > e) {
+                    worst = Some((i, bound, excess));
+                }
             }
-            if !clamped_any {
-                break;
-            }
+            let Some((i, bound, _)) = worst else { break };
+            self.clamped[i] = true;
+            self.fixed_velocity[i] = bound;
+            self.report.clamped.push(i);
         }
         self.finish_report();
-        Ok(&self.report)
+        Ok(Solution {
+            velocity: &self.velocity,
+            report: &self.report,
+        })
     }
 
     /// Solves the stack without any joint limit (no clamping loop).
-    pub fn solve_unbounded(&mut self) -> Result<&SolveReport, SolverError> {
+    pub fn solve_unbounded(&mut self) -> Result<Solution<'_>, SolverError> {
         self.stack.check_finite()?;
         self.clamped.fill(false);
         self.fixed_velocity.fill(0.0);
@@ -267,7 +274,10 @@ impl Solver {
         self.report.clamping_iterations = 1;
         self.prioritized_pass();
         self.finish_report();
-        Ok(&self.report)
+        Ok(Solution {
+            velocity: &self.velocity,
+            report: &self.report,
+        })
     }
 
     /// One prioritized solve over the joints not clamped; writes `self.velocity`.

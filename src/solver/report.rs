@@ -56,3 +56,12 @@ impl SolveReport {
         self.levels.iter().position(|l| !l.feasible)
     }
 }
+
+/// The result of a solve: the joint velocity and the report, borrowed from the solver.
+#[derive(Debug, Clone, Copy)]
+pub struct Solution<'a> {
+    /// Joint velocity `q̇` (rad/s or m/s), one entry per joint.
+    pub velocity: &'a [f64],
+    /// What each level achieved, and the clamping loop's work.
+    pub report: &'a SolveReport,
+}

@@ -1,0 +1,127 @@
+//! A warmed-up solve allocates nothing on the heap: a counting global allocator in its own test
+//! binary (so no other test's allocations interfere) counts allocations during the solves.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use taskstack::solver::driver::{DriverSettings, PositionDriver, TaskModel};
+use taskstack::solver::{
+    JointBounds, JointLimitAvoidance, JointTracking, Solver, SolverError, StackShape, TaskStack,
+};
+
+struct Counting;
+
+static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+
+// SAFETY: forwards to the system allocator; only counts.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+const N: usize = 23;
+
+/// A deterministic pseudo-random entry in [-1, 1).
+fn entry(i: usize, j: usize, salt: usize) -> f64 {
+    let x = ((i * 7919 + j * 104_729 + salt * 1_299_709) % 2003) as f64;
+    x / 1001.5 - 1.0
+}
+
+fn fill(solver: &mut Solver, salt: usize) {
+    let stack = solver.stack_mut();
+    for level in 0..stack.level_count() {
+        let mut l = stack.level_mut(level);
+        let rows = l.rows();
+        let mut jac = l.jacobian_mut();
+        for i in 0..rows {
+            for j in 0..N {
+                jac[(i, j)] = entry(i + 10 * level, j, salt);
+            }
+        }
+        for (i, t) in l.target_mut().iter_mut().enumerate() {
+            *t = 5.0 * entry(i, level, salt + 1);
+        }
+    }
+}
+
+/// A linear "model" x = A q, for the driver.
+struct Linear;
+
+impl TaskModel for Linear {
+    type Error = SolverError;
+    fn evaluate(&mut self, q: &[f64], stack: &mut TaskStack) -> Result<(), SolverError> {
+        for level in 0..stack.level_count() {
+            let mut l = stack.level_mut(level);
+            let rows = l.rows();
+            for i in 0..rows {
+                let row: [f64; N] = std::array::from_fn(|j| entry(i + 10 * level, j, 3));
+                let x: f64 = row.iter().zip(q).map(|(a, b)| a * b).sum();
+                l.set_row(i, &row, 0.2 * (i as f64) - x)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+#[test]
+fn warmed_up_solves_do_not_allocate() {
+    // The paper's RS stack shape: CoM (2 rows), then hands + free ankle (9 rows).
+    let shape = StackShape::new(N)
+        .with_level("balance", &[("com_xy", 2)])
+        .with_level("tracking", &[("l_hand", 3), ("r_hand", 3), ("l_ankle", 3)]);
+    let mut solver = Solver::new(&shape).unwrap();
+    let lower = [-0.3; N];
+    let upper = [0.3; N];
+    let bounds = JointBounds::with_velocity(&lower, &upper, &[2.0; N]).unwrap();
+    let limits = JointLimitAvoidance::new(&bounds);
+    let mut tracking = JointTracking::new(&[0.1; N]).unwrap();
+    let reference = [0.05; N];
+    let q = [0.25; N];
+    let mut driver = PositionDriver::new(&solver, DriverSettings::default()).unwrap();
+    let mut model = Linear;
+    let mut q_driver = [0.0; N];
+
+    // Warm-up.
+    fill(&mut solver, 0);
+    solver.solve(&q, &bounds, 0.01).unwrap();
+
+    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    let mut clamped = 0;
+    for salt in 0..50 {
+        fill(&mut solver, salt);
+        let stack = solver.stack_mut();
+        stack.clear_gradient();
+        stack.add_gradient(-0.10, &limits, &q).unwrap();
+        tracking.set_reference(&reference).unwrap();
+        stack.add_gradient(-0.02, &tracking, &q).unwrap();
+        clamped += solver
+            .solve(&q, &bounds, 0.01)
+            .unwrap()
+            .report
+            .clamped_joints()
+            .len();
+        solver.solve_unbounded().unwrap();
+    }
+    driver
+        .run(&mut solver, &mut model, &mut q_driver, &bounds)
+        .unwrap();
+    let after = ALLOCATIONS.load(Ordering::SeqCst);
+    assert!(clamped > 0, "the clamping loop was exercised");
+    assert_eq!(
+        after - before,
+        0,
+        "heap allocations during warmed-up solves"
+    );
+}
