@@ -1,0 +1,125 @@
+//! Prioritized solve on the paper's stack shapes (n = 23): RS (CoM 2 rows, then hands + free
+//! ankle 9 rows, two gradient tasks) and DS (2 rows, then 11 rows), with and without an active
+//! clamp, against a naive nalgebra implementation of eq. 4–6 (explicit n × n projectors, SVD
+//! pseudo-inverses) measured in the same run.
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use nalgebra::{DMatrix, DVector};
+use std::hint::black_box;
+use taskstack::solver::{JointBounds, JointLimitAvoidance, JointTracking, Solver, StackShape};
+
+const N: usize = 23;
+
+/// Deterministic pseudo-random entries in [-0.3, 0.3): the scale of NAO Jacobians (m/rad).
+fn entry(i: usize, j: usize, salt: usize) -> f64 {
+    let mut z = (i as u64) << 32 ^ (j as u64) << 8 ^ salt as u64;
+    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^= z >> 31;
+    0.6 * ((z >> 11) as f64 / (1u64 << 53) as f64) - 0.3
+}
+
+struct Case {
+    name: &'static str,
+    levels: Vec<(DMatrix<f64>, DVector<f64>)>,
+}
+
+impl Case {
+    fn new(name: &'static str, rows: &[usize]) -> Self {
+        let levels = rows
+            .iter()
+            .enumerate()
+            .map(|(l, &m)| {
+                let jac = DMatrix::from_fn(m, N, |i, j| entry(i, j, 17 * l + 1));
+                let target = DVector::from_fn(m, |i, _| 0.05 * entry(i, 99, l));
+                (jac, target)
+            })
+            .collect();
+        Self { name, levels }
+    }
+
+    fn shape(&self) -> StackShape {
+        let rows: Vec<usize> = self.levels.iter().map(|l| l.0.nrows()).collect();
+        StackShape::from_level_rows(N, &rows)
+    }
+
+    fn fill(&self, solver: &mut Solver, q: &[f64], limits: &JointLimitAvoidance, tracking: &JointTracking) {
+        let stack = solver.stack_mut();
+        for (l, (jac, target)) in self.levels.iter().enumerate() {
+            let mut level = stack.level_mut(l);
+            let mut view = level.jacobian_mut();
+            for i in 0..jac.nrows() {
+                for j in 0..N {
+                    view[(i, j)] = jac[(i, j)];
+                }
+            }
+            level.target_mut().copy_from_slice(target.as_slice());
+        }
+        stack.clear_gradient();
+        stack.add_gradient(-0.10, limits, q).unwrap();
+        stack.add_gradient(-0.02, tracking, q).unwrap();
+    }
+}
+
+/// The textbook recursion with explicit projectors and nalgebra SVD pseudo-inverses.
+fn naive(levels: &[(DMatrix<f64>, DVector<f64>)], gradient: &DVector<f64>) -> DVector<f64> {
+    let mut qdot = DVector::zeros(N);
+    let mut projector = DMatrix::<f64>::identity(N, N);
+    let mut augmented = DMatrix::zeros(0, N);
+    for (jac, target) in levels {
+        let a = jac * &projector;
+        let pinv = a.svd(true, true).pseudo_inverse(1e-9).unwrap();
+        qdot += pinv * (target - jac * &qdot);
+        let rows = augmented.nrows();
+        augmented = augmented.insert_rows(rows, jac.nrows(), 0.0);
+        augmented.rows_mut(rows, jac.nrows()).copy_from(jac);
+        let pinv_a = augmented.clone().svd(true, true).pseudo_inverse(1e-9).unwrap();
+        projector = DMatrix::identity(N, N) - pinv_a * &augmented;
+    }
+    qdot + projector * gradient
+}
+
+fn bench(c: &mut Criterion) {
+    let lower = vec![-2.0; N];
+    let upper = vec![2.0; N];
+    let free_bounds = JointBounds::new(&lower, &upper).unwrap();
+    let q_mid = vec![0.1; N];
+    // A tight velocity limit on a few joints makes the clamping loop run.
+    let mut velocity = vec![f64::INFINITY; N];
+    for v in velocity.iter_mut().step_by(5) {
+        *v = 0.01;
+    }
+    let clamp_bounds = JointBounds::with_velocity(&lower, &upper, &velocity).unwrap();
+    let limits = JointLimitAvoidance::new(&free_bounds);
+    let tracking = JointTracking::new(&vec![0.2; N]).unwrap();
+    let dt = 0.01;
+
+    for case in [Case::new("RS", &[2, 9]), Case::new("DS", &[2, 11])] {
+        let mut solver = Solver::new(&case.shape()).unwrap();
+        case.fill(&mut solver, &q_mid, &limits, &tracking);
+        let clamped = solver.solve(&q_mid, &clamp_bounds, dt).unwrap().report.clamped_joints().len();
+        assert!(clamped > 0 && solver.solve(&q_mid, &free_bounds, dt).unwrap().report.clamped_joints().is_empty());
+        let mut group = c.benchmark_group(format!("solve_{}", case.name));
+        group.bench_function("taskstack_no_clamp", |b| {
+            b.iter(|| {
+                case.fill(&mut solver, black_box(&q_mid), &limits, &tracking);
+                black_box(solver.solve(&q_mid, &free_bounds, dt).unwrap().velocity[0])
+            })
+        });
+        group.bench_function(format!("taskstack_clamp_{clamped}_joints"), |b| {
+            b.iter(|| {
+                case.fill(&mut solver, black_box(&q_mid), &limits, &tracking);
+                black_box(solver.solve(&q_mid, &clamp_bounds, dt).unwrap().velocity[0])
+            })
+        });
+        let gradient = DVector::from_column_slice(solver.stack().gradient());
+        group.bench_function("naive_nalgebra_no_clamp", |b| {
+            b.iter(|| black_box(naive(black_box(&case.levels), &gradient)[0]))
+        });
+        group.finish();
+    }
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
