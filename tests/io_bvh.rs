@@ -395,6 +395,17 @@ fn non_numeric_values_are_reported_with_their_channel() {
     assert!(matches!(error_of(&text), BvhError::Number { line: 8, .. }));
     let text = TWO_JOINTS.replace("Frame Time: 0.5", "Frame Time: -0.5");
     assert!(matches!(error_of(&text), BvhError::Number { line: 18, .. }));
+    // Frame 1 at 1 × 1e308 s is finite, a frame 2 would not be: the time is checked too.
+    let text = TWO_JOINTS
+        .replace("Frame Time: 0.5", "Frame Time: 1e308")
+        .replace("Frames: 2", "Frames: 3")
+        + "0 0 0 0 0 0 0 0 0\n";
+    let mut frames = BvhReader::new(Cursor::new(text), "test.bvh", custom_config()).unwrap();
+    assert!(frames.next().unwrap().is_ok() && frames.next().unwrap().is_ok());
+    assert!(matches!(
+        frames.next(),
+        Some(Err(BvhError::Number { line: 21, .. }))
+    ));
 }
 
 /// A header may claim any number of frames: nothing is allocated from it, and the file simply

@@ -548,13 +548,28 @@ impl<R: BufRead> BvhReader<R> {
             self.done = true;
             return Ok(false);
         }
-        let result = self.read_values().and_then(|()| self.forward_kinematics());
+        // Frame counts in real files are far below 2^53, so the conversion is exact.
+        let time = self.frames_read as f64 * self.frame_time;
+        let result = self
+            .read_values()
+            .and_then(|()| self.forward_kinematics())
+            .and_then(|()| {
+                if time.is_finite() {
+                    Ok(())
+                } else {
+                    Err(BvhError::Number {
+                        origin: self.origin.clone(),
+                        line: self.line_no,
+                        field: "frame time × frame index".to_owned(),
+                        text: time.to_string(),
+                    })
+                }
+            });
         if result.is_err() {
             self.done = true;
         }
         result?;
-        // Frame counts in real files are far below 2^53, so the conversion is exact.
-        out.clear(self.frames_read as f64 * self.frame_time);
+        out.clear(time);
         for joint in HumanJoint::ALL {
             out.set(joint, self.map[joint.index()].map(|j| self.positions[j]));
         }

@@ -256,7 +256,14 @@ impl<R: BufRead> KinectReader<R> {
             });
         }
         let first = self.first_timestamp.unwrap_or(timestamp);
-        out.clear((timestamp - first) * 1e-7);
+        let time = (timestamp - first) * 1e-7;
+        if !time.is_finite() {
+            return Err(self.value_error(
+                Some((0, fields_text(line, 0))),
+                "timestamp (too far from the first)".to_owned(),
+            ));
+        }
+        out.clear(time);
         for (name, human) in KINECT_JOINTS {
             let x = self.number(fields.next(), || format!("{name} X"))?;
             let y = self.number(fields.next(), || format!("{name} Y"))?;
@@ -303,6 +310,11 @@ impl<R: BufRead> KinectReader<R> {
             text: text.to_owned(),
         }
     }
+}
+
+/// The text of field `index` (0-based) of `line`.
+fn fields_text(line: &str, index: usize) -> &str {
+    line.split(',').nth(index).unwrap_or("").trim()
 }
 
 impl<R: BufRead> Iterator for KinectReader<R> {
