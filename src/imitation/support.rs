@@ -21,8 +21,9 @@
 //! # Ground
 //!
 //! Floors are not level (the CMU walks rise 7–10 cm over 4 m) and Kinect heights are relative to
-//! a possibly tilted sensor, so the ground is learnt from the data. While a foot is in support its
-//! sole point is recorded (at most every [`SupportConfig::ground_sample_interval`] s, in a ring
+//! a possibly tilted sensor, so the ground is learnt from the data. While a foot is in support
+//! and also meets the going-into-support condition (a confident contact), its sole point is
+//! recorded (at most every [`SupportConfig::ground_sample_interval`] s, in a ring
 //! of [`GROUND_SAMPLES`]). The ground under a point `q` is the height at `q` of the plane
 //! `z = a + b·(x − q_x) + c·(y − q_y)` fitted by weighted least squares to the samples, with
 //! Gaussian weights `w_i = exp(−d_i² / 2σ²) + ε` on the horizontal distance `d_i` to `q`
@@ -206,14 +207,16 @@ pub enum SupportError {
     Config(&'static str, &'static str),
 }
 
-/// What the detector measured for one foot in the last frame.
+/// What the detector measured for one foot in the last frame. Values are always finite.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FootStatus {
     /// Whether the foot is in support.
     pub in_support: bool,
-    /// Height of the sole point above the local ground, metres (`None`: foot joints missing).
+    /// Height of the sole point above the local ground, metres (`None`: foot joints missing, or
+    /// no finite ground estimate).
     pub height: Option<f64>,
-    /// Horizontal speed, m/s (`None`: foot joints missing or no earlier sample yet).
+    /// Horizontal speed, m/s (`None`: foot joints missing or no earlier sample yet); saturates
+    /// at `f64::MAX` for absurd input.
     pub speed: Option<f64>,
 }
 
@@ -370,7 +373,9 @@ impl SupportDetector {
     fn update_foot(&mut self, side: Side, frame: &HumanFrame, now: f64, first: bool) {
         let config = self.config;
         let sole = sole_point(frame, side);
-        let height = sole.and_then(|p| Some(p.z - self.fit_ground(p.xy())?));
+        let height = sole
+            .and_then(|p| Some(p.z - self.fit_ground(p.xy())?))
+            .filter(|h| h.is_finite());
         let foot = &mut self.feet[side.index()];
         let ankle = frame.get(side.ankle()).map(|p| p.xy());
         let toe = frame.get(side.toe()).map(|p| p.xy());
@@ -380,7 +385,8 @@ impl SupportDetector {
                 let point = point?;
                 let speed = windowed_speed(history, now, point, config.speed_window);
                 history.push((now, point));
-                speed
+                // Absurd coordinates can overflow the difference; that foot is moving.
+                speed.map(|v| if v.is_finite() { v } else { f64::MAX })
             })
             .min_by(f64::total_cmp);
         foot.status.height = height;
@@ -408,7 +414,11 @@ impl SupportDetector {
             }
         }
         foot.status.in_support = foot.in_support;
+        // Only confident contacts teach the ground: a foot kept in support by hysteresis while
+        // hovering between the on and off heights would otherwise raise the ground under itself.
         if foot.in_support
+            && h < config.height_on
+            && v < config.speed_on
             && now - foot.last_sample >= config.ground_sample_interval
             && let Some(p) = sole
         {
@@ -445,7 +455,7 @@ impl SupportDetector {
             .map(|c| c.solve(&rhs)[0])
             .filter(|h| h.is_finite())
             .unwrap_or(weighted_mean);
-        Some(height)
+        height.is_finite().then_some(height)
     }
 }
 
