@@ -254,3 +254,48 @@ impl HumanFrame {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_joint_reaches_mid_hip_through_its_antecedents() {
+        for joint in HumanJoint::ALL {
+            let mut current = joint;
+            let mut steps = 0;
+            while let Some(parent) = current.antecedent() {
+                current = parent;
+                steps += 1;
+                assert!(steps < HumanJoint::COUNT, "cycle from {joint:?}");
+            }
+            assert_eq!(current, HumanJoint::MidHip);
+        }
+    }
+
+    #[test]
+    fn indices_names_and_mirrors_are_consistent() {
+        for (k, joint) in HumanJoint::ALL.into_iter().enumerate() {
+            assert_eq!(joint.index(), k);
+            assert_eq!(HumanJoint::from_name(joint.name()), Some(joint));
+            assert_eq!(joint.mirror().mirror(), joint);
+            // A limb's antecedent mirrors with it (the tree is left/right symmetric).
+            assert_eq!(
+                joint.mirror().antecedent(),
+                joint.antecedent().map(HumanJoint::mirror)
+            );
+        }
+    }
+
+    #[test]
+    fn non_finite_positions_are_stored_as_missing() {
+        let mut frame = HumanFrame::new(0.0);
+        frame.set(HumanJoint::Head, Some(Vector3::new(0.0, f64::NAN, 1.0)));
+        assert_eq!(frame.get(HumanJoint::Head), None);
+        frame.set(HumanJoint::Neck, Some(Vector3::new(0.0, 0.0, 1.5)));
+        frame.set(HumanJoint::Head, Some(Vector3::new(0.0, 0.0, 1.7)));
+        let segment = frame.segment(HumanJoint::Head).unwrap();
+        assert!((segment - Vector3::new(0.0, 0.0, 0.2)).norm() < 1e-12);
+        assert_eq!(frame.segment(HumanJoint::MidHip), None);
+    }
+}
