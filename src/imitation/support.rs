@@ -125,8 +125,10 @@ pub struct SupportConfig {
 impl SupportConfig {
     /// Defaults for optical motion capture (CMU, 120 Hz, millimetre noise). Tuned on the CMU
     /// clips: a planted foot's sole point stays within ~2 cm of the learnt ground and moves under
-    /// 0.2 m/s over 50 ms, a swinging foot moves at 1.5–3.5 m/s and a lifted foot is 0.1–0.4 m up:
-    /// on below 5 cm and 0.35 m/s, off above 8 cm or 0.7 m/s, 50 ms window, 30 ms dwell.
+    /// 0.2 m/s over 50 ms, a swinging foot moves at 1.5–3.5 m/s and a lifted foot is 0.1–0.4 m
+    /// up, while a landing foot still slides at 0.3–0.5 m/s as it rolls flat (hence an on speed
+    /// above that, or the walks show airborne gaps at each landing): on below 5 cm and 0.6 m/s,
+    /// off above 8 cm or 1.0 m/s, 50 ms window, 30 ms dwell.
     pub const fn optical() -> Self {
         SupportConfig {
             height_on: 0.05,
