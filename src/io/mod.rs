@@ -1,0 +1,34 @@
+//! Readers of human motion (DESIGN §1, layer `io`): BVH motion capture ([`bvh`]) and Microsoft
+//! Kinect v2 skeleton CSV ([`kinect`]). Both stream: a reader parses its header once and then
+//! yields one [`crate::imitation::human::HumanFrame`] at a time, so a live source and a file feed
+//! the same pipeline. Both cap what a file may ask for (line length, joint count) so that hostile
+//! input is refused with a typed error instead of exhausting memory.
+
+pub mod bvh;
+pub mod kinect;
+
+use std::io::{self, BufRead, Read};
+
+/// Reads one line (without its `\n` / `\r\n`) into `buf`, reading at most `max_bytes` bytes.
+/// Returns `Ok(None)` at end of input and `Ok(Some(true))` if the line was longer than
+/// `max_bytes` (the rest of it is left unread). Invalid UTF-8 is an `InvalidData` error.
+fn read_line_capped<R: BufRead>(
+    reader: &mut R,
+    buf: &mut String,
+    max_bytes: usize,
+) -> io::Result<Option<bool>> {
+    buf.clear();
+    let limit = u64::try_from(max_bytes).unwrap_or(u64::MAX);
+    let n = reader.by_ref().take(limit).read_line(buf)?;
+    if n == 0 {
+        return Ok(None);
+    }
+    let complete = buf.ends_with('\n');
+    if complete {
+        buf.pop();
+        if buf.ends_with('\r') {
+            buf.pop();
+        }
+    }
+    Ok(Some(!complete && n >= max_bytes))
+}
