@@ -44,7 +44,13 @@ impl Case {
         StackShape::from_level_rows(N, &rows)
     }
 
-    fn fill(&self, solver: &mut Solver, q: &[f64], limits: &JointLimitAvoidance, tracking: &JointTracking) {
+    fn fill(
+        &self,
+        solver: &mut Solver,
+        q: &[f64],
+        limits: &JointLimitAvoidance,
+        tracking: &JointTracking,
+    ) {
         let stack = solver.stack_mut();
         for (l, (jac, target)) in self.levels.iter().enumerate() {
             let mut level = stack.level_mut(l);
@@ -74,7 +80,11 @@ fn naive(levels: &[(DMatrix<f64>, DVector<f64>)], gradient: &DVector<f64>) -> DV
         let rows = augmented.nrows();
         augmented = augmented.insert_rows(rows, jac.nrows(), 0.0);
         augmented.rows_mut(rows, jac.nrows()).copy_from(jac);
-        let pinv_a = augmented.clone().svd(true, true).pseudo_inverse(1e-9).unwrap();
+        let pinv_a = augmented
+            .clone()
+            .svd(true, true)
+            .pseudo_inverse(1e-9)
+            .unwrap();
         projector = DMatrix::identity(N, N) - pinv_a * &augmented;
     }
     qdot + projector * gradient
@@ -98,8 +108,21 @@ fn bench(c: &mut Criterion) {
     for case in [Case::new("RS", &[2, 9]), Case::new("DS", &[2, 11])] {
         let mut solver = Solver::new(&case.shape()).unwrap();
         case.fill(&mut solver, &q_mid, &limits, &tracking);
-        let clamped = solver.solve(&q_mid, &clamp_bounds, dt).unwrap().report.clamped_joints().len();
-        assert!(clamped > 0 && solver.solve(&q_mid, &free_bounds, dt).unwrap().report.clamped_joints().is_empty());
+        let clamped = solver
+            .solve(&q_mid, &clamp_bounds, dt)
+            .unwrap()
+            .report
+            .clamped_joints()
+            .len();
+        assert!(
+            clamped > 0
+                && solver
+                    .solve(&q_mid, &free_bounds, dt)
+                    .unwrap()
+                    .report
+                    .clamped_joints()
+                    .is_empty()
+        );
         let mut group = c.benchmark_group(format!("solve_{}", case.name));
         group.bench_function("taskstack_no_clamp", |b| {
             b.iter(|| {

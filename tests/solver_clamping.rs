@@ -1,9 +1,9 @@
 //! Property tests of the clamping loop: limits always hold; nothing changes when none binds.
 
-mod common;
+mod solver_common;
 
-use common::{LevelKind, Problem, Rng, random_bounds, random_problem};
 use proptest::prelude::*;
+use solver_common::{LevelKind, Problem, Rng, random_bounds, random_problem};
 use taskstack::solver::JointBounds;
 
 const KINDS: [LevelKind; 4] = [

@@ -1,11 +1,11 @@
 //! Property tests of the prioritized solve: strict priorities, agreement with the textbook
 //! recursion, gradient tasks in the null space, finite output.
 
-mod common;
+mod solver_common;
 
-use common::{LevelKind, Problem, Rng, random_problem, textbook, well_conditioned};
 use nalgebra::DVector;
 use proptest::prelude::*;
+use solver_common::{LevelKind, Problem, Rng, random_problem, textbook, well_conditioned};
 use taskstack::solver::{Settings, Solver};
 
 const KINDS: [LevelKind; 4] = [
@@ -58,7 +58,7 @@ proptest! {
         let mut changed = problem.clone();
         for j in 1..changed.levels.len() {
             let m = changed.levels[j].jacobian.nrows();
-            changed.levels[j] = common::random_level(&mut rng, problem.n, m, LevelKind::Full, &[]);
+            changed.levels[j] = solver_common::random_level(&mut rng, problem.n, m, LevelKind::Full, &[]);
         }
         changed.gradient = rng.vector(problem.n, 10.0);
         let (_, other) = unbounded_velocity(&changed, true);
@@ -83,7 +83,7 @@ proptest! {
             kinds.push(KINDS[rng.below(4)]);
         }
         let problem = random_problem(&mut rng, n, &rows, &kinds);
-        let sv = common::singular_values(&problem.levels[0].jacobian);
+        let sv = solver_common::singular_values(&problem.levels[0].jacobian);
         prop_assume!(sv.iter().cloned().fold(f64::INFINITY, f64::min) > 0.05);
         let (qdot, _) = unbounded_velocity(&problem, true);
         let target_norm = problem.levels[0].target.norm();
