@@ -3,4 +3,5 @@
 #![deny(missing_docs)]
 
 pub mod model;
+pub mod robots;
 pub mod solver;

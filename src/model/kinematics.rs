@@ -1,7 +1,7 @@
 //! Forward kinematics, Jacobians and centre of mass (formulas in the [module docs](super)).
 
 use faer::MatMut;
-use nalgebra::{Matrix3, Rotation3, Translation3, Unit, Vector3};
+use nalgebra::{IsometryMatrix3, Matrix3, Rotation3, Translation3, Unit, Vector3};
 
 use super::{FrameId, JointKind, Model, ModelData, ModelError};
 
@@ -89,6 +89,19 @@ impl Model {
             return Err(ModelError::NoMass);
         }
         Ok(data.mass_moments[0] / self.total_mass)
+    }
+
+    /// World placement of the named frame `frame`, given the world placement of the model's base:
+    /// `ʷT_f = ʷT_base · ᵇᵃˢᵉT_f(q)` (metres, radians; from the last forward kinematics).
+    pub fn placement_in_world(
+        &self,
+        data: &ModelData,
+        world_t_base: &IsometryMatrix3<f64>,
+        frame: FrameId,
+    ) -> Result<IsometryMatrix3<f64>, ModelError> {
+        self.check_computed(data)?;
+        self.check_frame(frame)?;
+        Ok(world_t_base * data.frame_placements[frame.0])
     }
 
     /// Position in the base frame (metres) of the point at `offset` (metres, in the frame's axes)
