@@ -43,7 +43,12 @@ fn kinematics(c: &mut Criterion) {
                 .unwrap();
             for (k, id) in ids.iter().enumerate() {
                 model
-                    .point_jacobian(&data, *id, &zero, j.as_mut().submatrix_mut(2 + 3 * k, 0, 3, n))
+                    .point_jacobian(
+                        &data,
+                        *id,
+                        &zero,
+                        j.as_mut().submatrix_mut(2 + 3 * k, 0, 3, n),
+                    )
                     .unwrap();
             }
             black_box(model.com(&data).unwrap())

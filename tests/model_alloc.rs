@@ -46,12 +46,31 @@ fn kinematics_do_not_allocate_after_new_data() {
     for step in 0..100 {
         q[step % 23] += 0.01;
         model.forward_kinematics(&mut data, &q).unwrap();
-        model.com_jacobian_rows(&data, 2, j.as_mut().submatrix_mut(0, 0, 2, 23)).unwrap();
+        model
+            .com_jacobian_rows(&data, 2, j.as_mut().submatrix_mut(0, 0, 2, 23))
+            .unwrap();
         for (k, id) in ids[..3].iter().enumerate() {
-            model.point_jacobian(&data, *id, &zero, j.as_mut().submatrix_mut(2 + 3 * k, 0, 3, 23)).unwrap();
+            model
+                .point_jacobian(
+                    &data,
+                    *id,
+                    &zero,
+                    j.as_mut().submatrix_mut(2 + 3 * k, 0, 3, 23),
+                )
+                .unwrap();
         }
-        model.point_jacobian_row(&data, ids[3], &zero, 2, j.as_mut().submatrix_mut(11, 0, 1, 23)).unwrap();
-        model.orientation_jacobian(&data, ids[0], j.as_mut().submatrix_mut(12, 0, 3, 23)).unwrap();
+        model
+            .point_jacobian_row(
+                &data,
+                ids[3],
+                &zero,
+                2,
+                j.as_mut().submatrix_mut(11, 0, 1, 23),
+            )
+            .unwrap();
+        model
+            .orientation_jacobian(&data, ids[0], j.as_mut().submatrix_mut(12, 0, 3, 23))
+            .unwrap();
         checksum += model.com(&data).unwrap().x + j[(5, 3)];
     }
     let after = ALLOCATIONS.load(Ordering::SeqCst);

@@ -90,9 +90,15 @@ fn tree_structure_mimic_prismatic_fixed() {
     assert!((link4.mass - 0.35).abs() < 1e-15);
     // m4 = −0.5·j1 + 0.1; m6 = 2·j3 − 0.2.
     let m4 = model.joints().iter().find(|j| j.name == "m4").unwrap();
-    assert_eq!((m4.variable, m4.multiplier, m4.offset), (Some(0), -0.5, 0.1));
+    assert_eq!(
+        (m4.variable, m4.multiplier, m4.offset),
+        (Some(0), -0.5, 0.1)
+    );
     let m6 = model.joints().iter().find(|j| j.name == "m6").unwrap();
-    assert_eq!((m6.variable, m6.multiplier, m6.offset), (Some(2), 2.0, -0.2));
+    assert_eq!(
+        (m6.variable, m6.multiplier, m6.offset),
+        (Some(2), 2.0, -0.2)
+    );
     // The continuous joint has no limits.
     assert_eq!(model.variables()[3].lower, f64::NEG_INFINITY);
     // Re-rooted at `tool`: the path joints are reversed (multiplier and offset negated).
@@ -126,7 +132,9 @@ fn planar_arm_matches_hand_calculation() {
     // Jacobian of the tip, column 3: z × (tip − joint 3) = 0.1·(−s123, c123, 0).
     let mut j = Mat::<f64>::zeros(3, 3);
     let id = model.frame_id("tip").unwrap();
-    model.point_jacobian(&data, id, &Vector3::zeros(), j.as_mut()).unwrap();
+    model
+        .point_jacobian(&data, id, &Vector3::zeros(), j.as_mut())
+        .unwrap();
     assert!((j[(0, 2)] + 0.1 * a123.sin()).abs() < 1e-15);
     assert!((j[(1, 2)] - 0.1 * a123.cos()).abs() < 1e-15);
 }
@@ -144,7 +152,10 @@ fn algorithm_errors_are_typed() {
     );
     assert!(matches!(
         model.forward_kinematics(&mut data, &[0.0; 22]),
-        Err(ModelError::WrongQLength { expected: 23, got: 22 })
+        Err(ModelError::WrongQLength {
+            expected: 23,
+            got: 22
+        })
     ));
     let mut q = [0.0; 23];
     q[4] = f64::NAN;
@@ -156,16 +167,35 @@ fn algorithm_errors_are_typed() {
     let mut wrong = Mat::<f64>::zeros(3, 22);
     assert!(matches!(
         model.point_jacobian(&data, hand, &zero, wrong.as_mut()),
-        Err(ModelError::OutputShape { expected_rows: 3, expected_cols: 23, rows: 3, cols: 22 })
+        Err(ModelError::OutputShape {
+            expected_rows: 3,
+            expected_cols: 23,
+            rows: 3,
+            cols: 22
+        })
     ));
     assert!(matches!(
         model.com_jacobian_rows(&data, 2, j.as_mut()),
-        Err(ModelError::OutputShape { expected_rows: 2, .. })
+        Err(ModelError::OutputShape {
+            expected_rows: 2,
+            ..
+        })
     ));
-    assert_eq!(model.frame_id("l_foot_typo"), Err(ModelError::UnknownFrame("l_foot_typo".into())));
-    assert_eq!(model.variable_index("RHipYawPitch"), Err(ModelError::UnknownVariable("RHipYawPitch".into())));
+    assert_eq!(
+        model.frame_id("l_foot_typo"),
+        Err(ModelError::UnknownFrame("l_foot_typo".into()))
+    );
+    assert_eq!(
+        model.variable_index("RHipYawPitch"),
+        Err(ModelError::UnknownVariable("RHipYawPitch".into()))
+    );
     assert!(matches!(
-        model.point_jacobian(&data, hand, &Vector3::new(f64::INFINITY, 0.0, 0.0), j.as_mut()),
+        model.point_jacobian(
+            &data,
+            hand,
+            &Vector3::new(f64::INFINITY, 0.0, 0.0),
+            j.as_mut()
+        ),
         Err(ModelError::NonFiniteOffset(_))
     ));
     let other = Model::from_dh_str(PLANAR, "planar3r.toml").unwrap();

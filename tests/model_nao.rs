@@ -58,11 +58,27 @@ fn compare(a: &Model, b: &Model, q: &[f64]) -> (f64, f64, f64) {
 
 fn pairs() -> Vec<(&'static str, Model, Model)> {
     vec![
-        ("r_sole", nao::rfoot(), nao::from_urdf_str(URDF, Some("r_sole")).unwrap()),
-        ("l_sole", nao::lfoot(), nao::from_urdf_str(URDF, Some("l_sole")).unwrap()),
-        ("torso", nao::torso(), nao::from_urdf_str(URDF, Some("torso")).unwrap()),
+        (
+            "r_sole",
+            nao::rfoot(),
+            nao::from_urdf_str(URDF, Some("r_sole")).unwrap(),
+        ),
+        (
+            "l_sole",
+            nao::lfoot(),
+            nao::from_urdf_str(URDF, Some("l_sole")).unwrap(),
+        ),
+        (
+            "torso",
+            nao::torso(),
+            nao::from_urdf_str(URDF, Some("torso")).unwrap(),
+        ),
         // The URDF's own root is `base_link`, coincident with `torso` (fixed joint, identity).
-        ("urdf root", nao::torso(), nao::from_urdf_str(URDF, None).unwrap()),
+        (
+            "urdf root",
+            nao::torso(),
+            nao::from_urdf_str(URDF, None).unwrap(),
+        ),
     ]
 }
 
@@ -74,10 +90,17 @@ fn variables_frames_and_mass_follow_the_contract() {
             assert_eq!(names, nao::VARIABLES);
             assert_eq!(model.frames().len(), nao::FRAMES.len());
             // Sum of all URDF <mass> values (python over nao.urdf: 5.305402000100008).
-            assert!((model.total_mass() - 5.3054020001).abs() < 1e-12, "{}", model.total_mass());
+            assert!(
+                (model.total_mass() - 5.3054020001).abs() < 1e-12,
+                "{}",
+                model.total_mass()
+            );
         }
         for (vd, vu) in dh.variables().iter().zip(urdf.variables()) {
-            assert_eq!((vd.lower, vd.upper, vd.velocity), (vu.lower, vu.upper, vu.velocity));
+            assert_eq!(
+                (vd.lower, vd.upper, vd.velocity),
+                (vu.lower, vu.upper, vu.velocity)
+            );
         }
     }
 }
@@ -87,7 +110,10 @@ fn dh_and_urdf_agree_at_stand_init_and_zero() {
     for (root, dh, urdf) in pairs() {
         for q in [stand_init(&dh), vec![0.0; 23]] {
             let (pos, rot, com) = compare(&dh, &urdf, &q);
-            assert!(pos < TOL && rot < TOL && com < TOL, "{root}: {pos:e} m, {rot:e} rad, com {com:e} m");
+            assert!(
+                pos < TOL && rot < TOL && com < TOL,
+                "{root}: {pos:e} m, {rot:e} rad, com {com:e} m"
+            );
         }
     }
 }
@@ -154,7 +180,11 @@ fn hand_checkable_positions_at_zero_in_the_right_sole_frame() {
     let model = nao::rfoot();
     let mut data = model.new_data();
     model.forward_kinematics(&mut data, &[0.0; 23]).unwrap();
-    let at = |name: &str| data.frame_placement(model.frame_id(name).unwrap()).translation.vector;
+    let at = |name: &str| {
+        data.frame_placement(model.frame_id(name).unwrap())
+            .translation
+            .vector
+    };
     // Torso: HipOffsetY sideways; FootHeight + TibiaLength + ThighLength + HipOffsetZ up
     // = 0.04511 + 0.1029 + 0.100 + 0.085 = 0.33301.
     let torso = Vector3::new(0.0, 0.05, 0.33301);
@@ -183,7 +213,11 @@ fn hand_checkable_positions_at_zero_in_the_right_sole_frame() {
         ("r_hand", Vector3::new(0.2187, -0.063, 0.4207)),
     ];
     for (name, want) in expected {
-        assert!((at(name) - want).norm() < 1e-12, "{name}: {} vs {want}", at(name));
+        assert!(
+            (at(name) - want).norm() < 1e-12,
+            "{name}: {} vs {want}",
+            at(name)
+        );
     }
     // Every frame is axis-aligned at q = 0.
     for p in data.frame_placements() {

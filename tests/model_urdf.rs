@@ -31,7 +31,13 @@ fn unknown_root_link() {
 fn unknown_mimic_target() {
     let text = TREE.replace(r#"<mimic joint="j1""#, r#"<mimic joint="j9""#);
     let err = load(&text).unwrap_err();
-    assert_eq!(err, UrdfError::UnknownMimicTarget { joint: "m4".into(), target: "j9".into() });
+    assert_eq!(
+        err,
+        UrdfError::UnknownMimicTarget {
+            joint: "m4".into(),
+            target: "j9".into()
+        }
+    );
     assert!(err.to_string().contains("m4") && err.to_string().contains("j9"));
 }
 
@@ -40,7 +46,10 @@ fn mimic_of_a_fixed_joint() {
     let text = TREE.replace(r#"<mimic joint="j1""#, r#"<mimic joint="tool_fixed""#);
     assert_eq!(
         load(&text).unwrap_err(),
-        UrdfError::BadMimicTarget { joint: "m4".into(), target: "tool_fixed".into() }
+        UrdfError::BadMimicTarget {
+            joint: "m4".into(),
+            target: "tool_fixed".into()
+        }
     );
 }
 
@@ -69,18 +78,33 @@ fn locking_a_joint_locks_its_mimics() {
 
 #[test]
 fn non_finite_number() {
-    let text = TREE.replace(r#"<origin xyz="0.2 0.05 0" rpy="0 0 0.5"/>"#, r#"<origin xyz="0.2 nan 0" rpy="0 0 0.5"/>"#);
+    let text = TREE.replace(
+        r#"<origin xyz="0.2 0.05 0" rpy="0 0 0.5"/>"#,
+        r#"<origin xyz="0.2 nan 0" rpy="0 0 0.5"/>"#,
+    );
     let err = load(&text).unwrap_err();
-    assert!(matches!(err, UrdfError::NonFinite { ref place, value } if place == "joint `j3` origin" && value.is_nan()), "{err}");
+    assert!(
+        matches!(err, UrdfError::NonFinite { ref place, value } if place == "joint `j3` origin" && value.is_nan()),
+        "{err}"
+    );
     let text = TREE.replace(r#"<mass value="0.3"/>"#, r#"<mass value="inf"/>"#);
     let err = load(&text).unwrap_err();
-    assert!(matches!(err, UrdfError::NonFinite { ref place, .. } if place == "link `link2` mass"), "{err}");
+    assert!(
+        matches!(err, UrdfError::NonFinite { ref place, .. } if place == "link `link2` mass"),
+        "{err}"
+    );
 }
 
 #[test]
 fn negative_mass() {
     let text = TREE.replace(r#"<mass value="0.3"/>"#, r#"<mass value="-0.3"/>"#);
-    assert_eq!(load(&text).unwrap_err(), UrdfError::NegativeMass { link: "link2".into(), mass: -0.3 });
+    assert_eq!(
+        load(&text).unwrap_err(),
+        UrdfError::NegativeMass {
+            link: "link2".into(),
+            mass: -0.3
+        }
+    );
 }
 
 #[test]
@@ -88,26 +112,56 @@ fn malformed_xml_and_missing_field() {
     let err = load("<robot name=\"x\"><link name=\"a\"></robot>").unwrap_err();
     assert!(matches!(err, UrdfError::Xml(_)), "{err}");
     // A joint without <parent>.
-    let text = TREE.replace(r#"<parent link="link1"/><child link="link2"/>"#, r#"<child link="link2"/>"#);
+    let text = TREE.replace(
+        r#"<parent link="link1"/><child link="link2"/>"#,
+        r#"<child link="link2"/>"#,
+    );
     assert!(matches!(load(&text).unwrap_err(), UrdfError::Xml(_)));
 }
 
 #[test]
 fn unknown_link_two_parents_and_loops() {
     let text = TREE.replace(r#"<parent link="link3"/>"#, r#"<parent link="link9"/>"#);
-    assert_eq!(load(&text).unwrap_err(), UrdfError::UnknownJointLink { joint: "m4".into(), link: "link9".into() });
+    assert_eq!(
+        load(&text).unwrap_err(),
+        UrdfError::UnknownJointLink {
+            joint: "m4".into(),
+            link: "link9".into()
+        }
+    );
     let text = TREE.replace(r#"<child link="hand2"/>"#, r#"<child link="link2"/>"#);
     assert_eq!(
         load(&text).unwrap_err(),
-        UrdfError::TwoParents { link: "link2".into(), first: "slide".into(), second: "m6".into() }
+        UrdfError::TwoParents {
+            link: "link2".into(),
+            first: "slide".into(),
+            second: "m6".into()
+        }
     );
     // Re-parenting (hand2 under link4, arm2 under hand2) still gives a tree; `tool` is folded.
-    let text = TREE.replace(r#"<parent link="arm2"/><child link="hand2"/>"#, r#"<parent link="link4"/><child link="hand2"/>"#)
-        .replace(r#"<parent link="base"/><child link="arm2"/>"#, r#"<parent link="hand2"/><child link="arm2"/>"#);
+    let text = TREE
+        .replace(
+            r#"<parent link="arm2"/><child link="hand2"/>"#,
+            r#"<parent link="link4"/><child link="hand2"/>"#,
+        )
+        .replace(
+            r#"<parent link="base"/><child link="arm2"/>"#,
+            r#"<parent link="hand2"/><child link="arm2"/>"#,
+        );
     let model = load(&text).unwrap();
     assert_eq!(model.links().len(), 8 - 1);
-    let looped = TREE.replace(r#"<parent link="base"/><child link="link1"/>"#, r#"<parent link="link4"/><child link="link1"/>"#);
-    let err = Model::from_urdf_str(&looped, &UrdfOptions { root_link: Some("base".into()), ..UrdfOptions::default() }).unwrap_err();
+    let looped = TREE.replace(
+        r#"<parent link="base"/><child link="link1"/>"#,
+        r#"<parent link="link4"/><child link="link1"/>"#,
+    );
+    let err = Model::from_urdf_str(
+        &looped,
+        &UrdfOptions {
+            root_link: Some("base".into()),
+            ..UrdfOptions::default()
+        },
+    )
+    .unwrap_err();
     assert!(matches!(err, UrdfError::NotATree(_)), "{err}");
 }
 
@@ -119,12 +173,36 @@ fn variable_order_and_frames() {
     };
     let model = load_with(order(&["j5", "j3", "slide", "j1"])).unwrap();
     assert_eq!(model.variables()[0].name, "j5");
-    assert_eq!(load_with(order(&["j5", "j3", "slide", "m4"])).unwrap_err(), UrdfError::UnknownVariable("m4".into()));
-    assert_eq!(load_with(order(&["j5", "j3", "slide"])).unwrap_err(), UrdfError::MissingVariable("j1".into()));
-    let frame = |name: &str, link: &str| UrdfFrame { name: name.into(), link: link.into(), placement: IsometryMatrix3::identity() };
-    let err = load_with(UrdfOptions { frames: vec![frame("tip", "link7")], ..UrdfOptions::default() }).unwrap_err();
-    assert_eq!(err, UrdfError::UnknownFrameLink { frame: "tip".into(), link: "link7".into() });
-    let err = load_with(UrdfOptions { frames: vec![frame("tool", "link4")], ..UrdfOptions::default() }).unwrap_err();
+    assert_eq!(
+        load_with(order(&["j5", "j3", "slide", "m4"])).unwrap_err(),
+        UrdfError::UnknownVariable("m4".into())
+    );
+    assert_eq!(
+        load_with(order(&["j5", "j3", "slide"])).unwrap_err(),
+        UrdfError::MissingVariable("j1".into())
+    );
+    let frame = |name: &str, link: &str| UrdfFrame {
+        name: name.into(),
+        link: link.into(),
+        placement: IsometryMatrix3::identity(),
+    };
+    let err = load_with(UrdfOptions {
+        frames: vec![frame("tip", "link7")],
+        ..UrdfOptions::default()
+    })
+    .unwrap_err();
+    assert_eq!(
+        err,
+        UrdfError::UnknownFrameLink {
+            frame: "tip".into(),
+            link: "link7".into()
+        }
+    );
+    let err = load_with(UrdfOptions {
+        frames: vec![frame("tool", "link4")],
+        ..UrdfOptions::default()
+    })
+    .unwrap_err();
     assert_eq!(err, UrdfError::DuplicateFrame("tool".into()));
 }
 

@@ -183,7 +183,15 @@ impl Loader<'_> {
             place: "document".into(),
             table: doc,
         };
-        top.allow(&["format", "name", "units", "base", "variables", "joints", "frames"])?;
+        top.allow(&[
+            "format",
+            "name",
+            "units",
+            "base",
+            "variables",
+            "joints",
+            "frames",
+        ])?;
         let format = top.string("format")?;
         if format != DH_FORMAT {
             return Err(top.err("format", DhProblem::WrongFormat(format.to_owned())));

@@ -168,7 +168,10 @@ impl TreeSpec {
 
 fn first_duplicate<'a>(names: impl Iterator<Item = &'a str>) -> Option<usize> {
     let mut seen = std::collections::HashSet::new();
-    names.enumerate().find(|(_, n)| !seen.insert(*n)).map(|(i, _)| i)
+    names
+        .enumerate()
+        .find(|(_, n)| !seen.insert(*n))
+        .map(|(i, _)| i)
 }
 
 impl Model {

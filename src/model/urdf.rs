@@ -310,7 +310,10 @@ fn build(robot: &urdf_rs::Robot, options: &UrdfOptions) -> Result<Model, UrdfErr
                 mass: inertial.mass.value,
             });
         }
-        finite(|| format!("link `{name}` inertial origin"), &inertial.origin.xyz.0)?;
+        finite(
+            || format!("link `{name}` inertial origin"),
+            &inertial.origin.xyz.0,
+        )?;
     }
     let mut joint_index: HashMap<&str, usize> = HashMap::new();
     let mut parent_joint: Vec<Option<usize>> = vec![None; robot.links.len()];
@@ -526,7 +529,10 @@ fn resolve_drives(
     for j in 0..n {
         resolve(j, robot, checked, joint_index, &locked, &mut drives, 0)?;
     }
-    Ok(drives.into_iter().map(|d| d.unwrap_or(Drive::Locked(0.0))).collect())
+    Ok(drives
+        .into_iter()
+        .map(|d| d.unwrap_or(Drive::Locked(0.0)))
+        .collect())
 }
 
 /// Resolves joint `j`'s drive, following mimic targets (`depth` guards against mimic loops).
@@ -611,7 +617,9 @@ fn number_variables(
                 order.push(j);
             }
             if let Some(&missing) = free.iter().find(|j| !order.contains(j)) {
-                return Err(UrdfError::MissingVariable(robot.joints[missing].name.clone()));
+                return Err(UrdfError::MissingVariable(
+                    robot.joints[missing].name.clone(),
+                ));
             }
             order
         }

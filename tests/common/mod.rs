@@ -16,8 +16,16 @@ pub fn q_from_unit(model: &Model, u: &[f64]) -> Vec<f64> {
         .iter()
         .zip(u)
         .map(|(v, &t)| {
-            let lo = if v.lower.is_finite() { v.lower } else { -std::f64::consts::PI };
-            let hi = if v.upper.is_finite() { v.upper } else { std::f64::consts::PI };
+            let lo = if v.lower.is_finite() {
+                v.lower
+            } else {
+                -std::f64::consts::PI
+            };
+            let hi = if v.upper.is_finite() {
+                v.upper
+            } else {
+                std::f64::consts::PI
+            };
             lo + t * (hi - lo)
         })
         .collect()
@@ -40,7 +48,12 @@ fn com(model: &Model, q: &[f64]) -> Vector3<f64> {
 }
 
 /// Central difference of `f` along variable `k`.
-fn diff<T>(q: &[f64], k: usize, f: impl Fn(&[f64]) -> T, d: impl Fn(&T, &T) -> Vector3<f64>) -> Vector3<f64> {
+fn diff<T>(
+    q: &[f64],
+    k: usize,
+    f: impl Fn(&[f64]) -> T,
+    d: impl Fn(&T, &T) -> Vector3<f64>,
+) -> Vector3<f64> {
     let (mut qp, mut qm) = (q.to_vec(), q.to_vec());
     qp[k] += H;
     qm[k] -= H;
@@ -49,7 +62,12 @@ fn diff<T>(q: &[f64], k: usize, f: impl Fn(&[f64]) -> T, d: impl Fn(&T, &T) -> V
 
 /// Largest difference between every analytic Jacobian of `frame` (position of the point at
 /// `offset`, its z row, orientation) and central differences of forward kinematics at `q`.
-pub fn frame_jacobian_error(model: &Model, q: &[f64], frame: FrameId, offset: &Vector3<f64>) -> f64 {
+pub fn frame_jacobian_error(
+    model: &Model,
+    q: &[f64],
+    frame: FrameId,
+    offset: &Vector3<f64>,
+) -> f64 {
     let n = model.nv();
     let mut data = model.new_data();
     fk(model, &mut data, q);
@@ -57,17 +75,31 @@ pub fn frame_jacobian_error(model: &Model, q: &[f64], frame: FrameId, offset: &V
     let mut jr = Mat::<f64>::zeros(3, n);
     // A row-major 1×n view through a strided buffer: the model must write through indexing.
     let mut zrow = Mat::<f64>::zeros(4, n);
-    model.point_jacobian(&data, frame, offset, jp.as_mut()).unwrap();
-    model.orientation_jacobian(&data, frame, jr.as_mut()).unwrap();
     model
-        .point_jacobian_row(&data, frame, offset, 2, zrow.as_mut().submatrix_mut(2, 0, 1, n))
+        .point_jacobian(&data, frame, offset, jp.as_mut())
+        .unwrap();
+    model
+        .orientation_jacobian(&data, frame, jr.as_mut())
+        .unwrap();
+    model
+        .point_jacobian_row(
+            &data,
+            frame,
+            offset,
+            2,
+            zrow.as_mut().submatrix_mut(2, 0, 1, n),
+        )
         .unwrap();
     let mut worst: f64 = 0.0;
     for k in 0..n {
         let dp = diff(
             q,
             k,
-            |q| placement(model, q, frame).transform_point(&(*offset).into()).coords,
+            |q| {
+                placement(model, q, frame)
+                    .transform_point(&(*offset).into())
+                    .coords
+            },
             |a, b| a - b,
         );
         let dr = diff(
@@ -82,7 +114,10 @@ pub fn frame_jacobian_error(model: &Model, q: &[f64], frame: FrameId, offset: &V
         }
         worst = worst.max((zrow[(2, k)] - dp[2]).abs());
         // Rows of the buffer outside the view must stay untouched.
-        worst = worst.max(zrow[(0, k)].abs()).max(zrow[(1, k)].abs()).max(zrow[(3, k)].abs());
+        worst = worst
+            .max(zrow[(0, k)].abs())
+            .max(zrow[(1, k)].abs())
+            .max(zrow[(3, k)].abs());
     }
     worst
 }
@@ -104,7 +139,9 @@ pub fn com_jacobian_error(model: &Model, q: &[f64]) -> f64 {
         for r in 0..3 {
             worst = worst.max((j[(r, k)] - d[r]).abs());
         }
-        worst = worst.max((buf[k] - d[0]).abs()).max((buf[n + k] - d[1]).abs());
+        worst = worst
+            .max((buf[k] - d[0]).abs())
+            .max((buf[n + k] - d[1]).abs());
     }
     worst
 }
@@ -113,7 +150,11 @@ pub fn com_jacobian_error(model: &Model, q: &[f64]) -> f64 {
 /// the trace would lose half the digits near the identity).
 pub fn small_rotation_vector(r: &nalgebra::Rotation3<f64>) -> Vector3<f64> {
     let m = r.matrix();
-    Vector3::new(m[(2, 1)] - m[(1, 2)], m[(0, 2)] - m[(2, 0)], m[(1, 0)] - m[(0, 1)]) * 0.5
+    Vector3::new(
+        m[(2, 1)] - m[(1, 2)],
+        m[(0, 2)] - m[(2, 0)],
+        m[(1, 0)] - m[(0, 1)],
+    ) * 0.5
 }
 
 /// Orientation difference (rad, small angles) between two rotations.
