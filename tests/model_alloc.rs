@@ -6,6 +6,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use faer::Mat;
 use nalgebra::Vector3;
+use taskstack::model::Axis;
 use taskstack::robots::nao;
 
 struct Counting;
@@ -64,7 +65,7 @@ fn kinematics_do_not_allocate_after_new_data() {
                 &data,
                 ids[3],
                 &zero,
-                2,
+                Axis::Z,
                 j.as_mut().submatrix_mut(11, 0, 1, 23),
             )
             .unwrap();

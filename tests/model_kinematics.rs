@@ -212,3 +212,32 @@ fn tree_without_mass() -> Model {
         <limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>"#;
     Model::from_urdf_str(urdf, &UrdfOptions::default()).unwrap()
 }
+
+#[test]
+fn model_is_shareable_between_threads() {
+    fn shareable<T: Send + Sync>(_: &T) -> bool {
+        true
+    }
+    let model = nao::rfoot();
+    assert!(shareable(&model) && shareable(&model.new_data()));
+    // And actually used from two threads at once.
+    let heights: Vec<f64> = std::thread::scope(|s| {
+        let handles: Vec<_> = [0.0, 0.5]
+            .map(|knee| {
+                let model = &model;
+                s.spawn(move || {
+                    let mut data = model.new_data();
+                    let mut q = vec![0.0; 23];
+                    q[model.variable_index("RKneePitch").unwrap()] = knee;
+                    model.forward_kinematics(&mut data, &q).unwrap();
+                    data.frame_placement(model.frame_id("torso").unwrap())
+                        .translation
+                        .z
+                })
+            })
+            .into();
+        handles.into_iter().map(|h| h.join().unwrap()).collect()
+    });
+    // A bent knee lowers the torso.
+    assert!((heights[0] - 0.33301).abs() < 1e-12 && heights[1] < heights[0]);
+}

@@ -3,7 +3,7 @@
 use faer::MatMut;
 use nalgebra::{IsometryMatrix3, Matrix3, Rotation3, Translation3, Unit, Vector3};
 
-use super::{FrameId, JointKind, Model, ModelData, ModelError};
+use super::{Axis, FrameId, JointKind, Model, ModelData, ModelError};
 
 /// Rotation by `angle` (radians) about the unit `axis` (Rodrigues' formula, no normalisation).
 pub(super) fn rotation_about(axis: &Unit<Vector3<f64>>, angle: f64) -> Rotation3<f64> {
@@ -143,26 +143,23 @@ impl Model {
         Ok(())
     }
 
-    /// One row (`axis` 0 = x, 1 = y, 2 = z of the base frame) of [`Model::point_jacobian`],
+    /// One row (`axis` of the base frame) of [`Model::point_jacobian`],
     /// written into the 1×n view `out` (e.g. the height rate of a toe or heel).
     pub fn point_jacobian_row(
         &self,
         data: &ModelData,
         frame: FrameId,
         offset: &Vector3<f64>,
-        axis: usize,
+        axis: Axis,
         mut out: MatMut<'_, f64>,
     ) -> Result<(), ModelError> {
-        if axis > 2 {
-            return Err(ModelError::BadAxis(axis));
-        }
         let x = self.point_position(data, frame, offset)?;
         self.check_shape(&out, 1)?;
         out.fill(0.0);
         let link = self.frames[frame.0].link;
         for &i in &self.chain[self.chain_start[link]..self.chain_start[link + 1]] {
             let (k, column) = self.point_column(data, i, &x);
-            out[(0, k)] += column[axis];
+            out[(0, k)] += column[axis as usize];
         }
         Ok(())
     }
@@ -207,7 +204,7 @@ impl Model {
         mut out: MatMut<'_, f64>,
     ) -> Result<(), ModelError> {
         if rows == 0 || rows > 3 {
-            return Err(ModelError::BadAxis(rows));
+            return Err(ModelError::BadRowCount(rows));
         }
         self.check_computed(data)?;
         if self.total_mass <= 0.0 {

@@ -127,6 +127,17 @@ pub struct Frame {
     pub placement: IsometryMatrix3<f64>,
 }
 
+/// A Cartesian axis of the base frame (x forward, y left, z up).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Axis {
+    /// x (forward).
+    X = 0,
+    /// y (left).
+    Y = 1,
+    /// z (up).
+    Z = 2,
+}
+
 /// Index of a named frame in a [`Model`] (look it up once with [`Model::frame_id`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct FrameId(usize);
@@ -171,9 +182,9 @@ pub enum ModelError {
     /// A point offset (or other geometric input) is not finite.
     #[error("the point offset is not finite: {0:?}")]
     NonFiniteOffset([f64; 3]),
-    /// A Cartesian axis index other than 0 (x), 1 (y), 2 (z).
-    #[error("axis index {0} is not 0 (x), 1 (y) or 2 (z)")]
-    BadAxis(usize),
+    /// A number of CoM Jacobian rows other than 1, 2 or 3.
+    #[error("{0} CoM Jacobian rows asked (1: x, 2: x and y, 3: x, y and z)")]
+    BadRowCount(usize),
     /// The output matrix view has the wrong shape.
     #[error("output matrix is {rows}×{cols}, expected {expected_rows}×{expected_cols}")]
     OutputShape {
@@ -195,9 +206,6 @@ pub enum ModelError {
     /// The model has zero total mass, so its centre of mass is undefined.
     #[error("the model has zero total mass: its centre of mass is undefined")]
     NoMass,
-    /// The tree given to the builder is inconsistent (duplicate names, unknown antecedent, cycle, …).
-    #[error("invalid tree: {0}")]
-    Tree(String),
 }
 
 /// An immutable kinematic tree (see the [module docs](self) for the maths).

@@ -489,21 +489,22 @@ fn build(robot: &urdf_rs::Robot, options: &UrdfOptions) -> Result<Model, UrdfErr
         joints,
         frames,
     };
+    // Links, joints and variables were checked above and the walk only emits a tree, so in
+    // practice only duplicate frame names reach this point; every issue still maps to its name.
     spec.clone().build().map_err(|issue| match issue {
         TreeIssue::DuplicateFrame(i) => UrdfError::DuplicateFrame(spec.frames[i].name.clone()),
-        // Links, joints and variables were checked above and the walk builds a tree, so other
-        // issues can only name a duplicate the checks above would have caught.
-        TreeIssue::DuplicateJoint(i)
-        | TreeIssue::DuplicateLink(i)
-        | TreeIssue::UnknownAntecedent(i)
-        | TreeIssue::Cycle(i) => UrdfError::DuplicateJoint(spec.joints[i].name.clone()),
-        TreeIssue::DuplicateVariable(i) | TreeIssue::UnusedVariable(i) => {
-            UrdfError::UnknownVariable(spec.variables[i].name.clone())
-        }
         TreeIssue::UnknownFrameLink(i) => UrdfError::UnknownFrameLink {
             frame: spec.frames[i].name.clone(),
             link: spec.frames[i].link.clone(),
         },
+        TreeIssue::DuplicateJoint(i) => UrdfError::DuplicateJoint(spec.joints[i].name.clone()),
+        TreeIssue::DuplicateLink(i) => UrdfError::DuplicateLink(spec.joints[i].link.name.clone()),
+        TreeIssue::UnknownAntecedent(i) | TreeIssue::Cycle(i) => {
+            UrdfError::NotATree(spec.joints[i].link.name.clone())
+        }
+        TreeIssue::DuplicateVariable(i) | TreeIssue::UnusedVariable(i) => {
+            UrdfError::UnknownVariable(spec.variables[i].name.clone())
+        }
     })
 }
 

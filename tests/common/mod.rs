@@ -4,7 +4,7 @@
 
 use faer::Mat;
 use nalgebra::{IsometryMatrix3, Vector3};
-use taskstack::model::{FrameId, Model, ModelData};
+use taskstack::model::{Axis, FrameId, Model, ModelData};
 
 /// Step of the central differences (error O(h²) ≈ 1e-12 on these arm lengths).
 pub const H: f64 = 1e-6;
@@ -86,7 +86,7 @@ pub fn frame_jacobian_error(
             &data,
             frame,
             offset,
-            2,
+            Axis::Z,
             zrow.as_mut().submatrix_mut(2, 0, 1, n),
         )
         .unwrap();
