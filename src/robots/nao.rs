@@ -11,6 +11,25 @@
 //! current support sole `a` and `ᵃT_b(q)` the placement of the other sole in the current model,
 //! the new base is `ʷT_b = ʷT_a · ᵃT_b(q)`; every frame's world placement is then the same in both
 //! models for the same `q`.
+//!
+//! ```
+//! use faer::Mat;
+//! use nalgebra::Vector3;
+//! use taskstack::robots::nao;
+//!
+//! let model = nao::rfoot(); // base frame: the right sole
+//! let mut data = model.new_data(); // reuse it: no allocation from here on
+//! let q = vec![0.0; model.nv()]; // nao::VARIABLES order, radians
+//! model.forward_kinematics(&mut data, &q)?;
+//! let hand = model.frame_id("l_hand")?;
+//! // At q = 0 the hand is 0.4207 m above the sole (torso 0.33301 + shoulder 0.100 − hand 0.01231).
+//! assert!((data.frame_placement(hand).translation.z - 0.4207).abs() < 1e-12);
+//! let mut jacobian = Mat::<f64>::zeros(3, model.nv());
+//! model.point_jacobian(&data, hand, &Vector3::zeros(), jacobian.as_mut())?;
+//! let com = model.com(&data)?;
+//! assert!(com.z > 0.2 && com.z < 0.35);
+//! # Ok::<(), taskstack::model::ModelError>(())
+//! ```
 
 use std::path::Path;
 
