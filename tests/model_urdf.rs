@@ -221,3 +221,43 @@ fn nao_urdf_locks_hands_and_fingers_and_reads_from_a_file() {
     let err = nao::from_urdf_file("tests/data/missing.urdf", None).unwrap_err();
     assert!(matches!(err, UrdfError::Io { ref path, .. } if path == "tests/data/missing.urdf"));
 }
+
+#[test]
+fn fixed_links_fold_mass_com_and_inertia() {
+    // Two 1 kg bodies 1 m apart along x, each with inertia diag(0.1, 0.2, 0.3) about its CoM; the
+    // second is turned 90° about z, so in the first's axes its inertia is diag(0.2, 0.1, 0.3).
+    // Merged: 2 kg at (0.5, 0, 0); each body is 0.5 m from it along x, adding
+    // m (|d|² 1 − d dᵀ) = diag(0, 0.25, 0.25) each: I = diag(0.3, 0.8, 1.1).
+    let urdf = r#"<robot name="pair">
+        <link name="a"><inertial><mass value="1"/>
+            <inertia ixx="0.1" ixy="0" ixz="0" iyy="0.2" iyz="0" izz="0.3"/></inertial></link>
+        <link name="b"><inertial><mass value="1"/>
+            <inertia ixx="0.1" ixy="0" ixz="0" iyy="0.2" iyz="0" izz="0.3"/></inertial></link>
+        <joint name="weld" type="fixed"><parent link="a"/><child link="b"/>
+            <origin xyz="1 0 0" rpy="0 0 1.5707963267948966"/></joint></robot>"#;
+    let model = load(urdf).unwrap();
+    assert_eq!(model.links().len(), 1);
+    let link = &model.links()[0];
+    assert_eq!(link.mass, 2.0);
+    assert!((link.com - nalgebra::Vector3::new(0.5, 0.0, 0.0)).norm() < 1e-15);
+    let expected = nalgebra::Matrix3::from_diagonal(&nalgebra::Vector3::new(0.3, 0.8, 1.1));
+    assert!(
+        (link.inertia.unwrap() - expected).amax() < 1e-15,
+        "{}",
+        link.inertia.unwrap()
+    );
+    // Rooted at `b` (x_b = y_a, y_b = −x_a): a's origin, −1 m along x_a, is +1 m along y_b, so the
+    // CoM is at (0, 0.5, 0) in b.
+    let at_b = Model::from_urdf_str(
+        urdf,
+        &UrdfOptions {
+            root_link: Some("b".into()),
+            ..UrdfOptions::default()
+        },
+    )
+    .unwrap();
+    assert!((at_b.links()[0].com - nalgebra::Vector3::new(0.0, 0.5, 0.0)).norm() < 1e-15);
+    // In b's axes the same sums give diag(0.1 + 0.2 + 0.5, 0.2 + 0.1, 0.3 + 0.3 + 0.5).
+    let expected = nalgebra::Matrix3::from_diagonal(&nalgebra::Vector3::new(0.8, 0.3, 1.1));
+    assert!((at_b.links()[0].inertia.unwrap() - expected).amax() < 1e-15);
+}

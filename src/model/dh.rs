@@ -217,6 +217,7 @@ impl Loader<'_> {
             name: base_row.string("link")?.to_owned(),
             mass: base_row.mass("mass")?,
             com: base_row.vec3("com")?,
+            inertia: None,
         };
 
         let variable_rows = top.rows("variables")?;
@@ -367,6 +368,7 @@ impl Loader<'_> {
                 name: row.string("link")?.to_owned(),
                 mass: row.mass("mass")?,
                 com: row.vec3("com")?,
+                inertia: None,
             },
             placement,
             axis: Vector3::z_axis(),

@@ -52,7 +52,7 @@ mod kinematics;
 mod tree;
 pub mod urdf;
 
-use nalgebra::{IsometryMatrix3, Unit, Vector3};
+use nalgebra::{IsometryMatrix3, Matrix3, Unit, Vector3};
 use thiserror::Error;
 
 pub use dh::DhError;
@@ -101,6 +101,9 @@ pub struct Link {
     pub mass: f64,
     /// Centre of mass in the link frame (metres).
     pub com: Vector3<f64>,
+    /// Rotational inertia about the centre of mass, in link-frame axes (kg·m²), including
+    /// everything rigidly attached; `None` when the source has none (DH tables).
+    pub inertia: Option<Matrix3<f64>>,
 }
 
 /// An IK variable (an entry of `q`) and its limits.

@@ -12,7 +12,8 @@
 //!
 //! Fixed joints, and the joints locked at a given value, are folded: their child link becomes a
 //! named frame of the moving body it is attached to (when [`UrdfOptions::link_frames`] is on), and
-//! its mass joins that body's mass and CoM (`m = Σ m_k`, `c = Σ m_k c_k / m`). A `<mimic>` joint
+//! its mass joins that body's mass, CoM and inertia (`m = Σ m_k`, `c = Σ m_k c_k / m`, parallel-axis
+//! theorem about `c`). A `<mimic>` joint
 //! `v = μ·v_t + o` of a free joint `t` becomes a joint driven by `t`'s variable; mimics of mimics
 //! compose; mimics of locked joints are locked too. Continuous joints are revolute joints with
 //! infinite limits. All lengths metres, angles radians, masses kilograms.
@@ -20,7 +21,7 @@
 use std::collections::HashMap;
 use std::path::Path;
 
-use nalgebra::{IsometryMatrix3, Rotation3, Translation3, Unit, Vector3};
+use nalgebra::{IsometryMatrix3, Matrix3, Rotation3, Translation3, Unit, Vector3};
 use thiserror::Error;
 use urdf_rs::JointType;
 
@@ -409,6 +410,7 @@ fn build(robot: &urdf_rs::Robot, options: &UrdfOptions) -> Result<Model, UrdfErr
                             name: robot.links[v].name.clone(),
                             mass: 0.0,
                             com: Vector3::zeros(),
+                            inertia: None,
                         },
                         placement: if forward { body_t_u * origin } else { body_t_u },
                         axis: *axis,
@@ -435,23 +437,47 @@ fn build(robot: &urdf_rs::Robot, options: &UrdfOptions) -> Result<Model, UrdfErr
         placed_links.push(placed.ok_or_else(|| UrdfError::NotATree(link.name.clone()))?);
     }
 
-    // Masses folded into bodies: m = Σ m_k, c = Σ m_k c_k / m (body frame).
+    // Masses folded into bodies: m = Σ m_k, c = Σ m_k c_k / m (body frame), and the inertia about
+    // c by the parallel-axis theorem: I = Σ R_k I_k R_kᵀ + m_k (|d_k|² 1 − d_k d_kᵀ), d_k = c_k − c.
     let mut mass = vec![0.0; bodies.len()];
     let mut moment = vec![Vector3::zeros(); bodies.len()];
+    let mut com_of_link = Vec::with_capacity(robot.links.len());
     for (link, &(body, body_t_link)) in robot.links.iter().zip(&placed_links) {
         let m = link.inertial.mass.value;
-        let c = Vector3::from(link.inertial.origin.xyz.0);
+        let c = body_t_link.transform_point(&Vector3::from(link.inertial.origin.xyz.0).into());
         mass[body] += m;
-        moment[body] += body_t_link.transform_point(&c.into()).coords * m;
+        moment[body] += c.coords * m;
+        com_of_link.push(c.coords);
+    }
+    let com: Vec<Vector3<f64>> = (0..bodies.len())
+        .map(|b| {
+            if mass[b] > 0.0 {
+                moment[b] / mass[b]
+            } else {
+                Vector3::zeros()
+            }
+        })
+        .collect();
+    let mut inertia = vec![Matrix3::zeros(); bodies.len()];
+    for ((link, &(body, body_t_link)), c) in robot.links.iter().zip(&placed_links).zip(&com_of_link)
+    {
+        let i = &link.inertial.inertia;
+        let own = Matrix3::new(
+            i.ixx, i.ixy, i.ixz, //
+            i.ixy, i.iyy, i.iyz, //
+            i.ixz, i.iyz, i.izz,
+        );
+        let r = body_t_link.rotation * pose(&link.inertial.origin).rotation;
+        let d = c - com[body];
+        inertia[body] += r.matrix() * own * r.matrix().transpose()
+            + (Matrix3::identity() * d.norm_squared() - d * d.transpose())
+                * link.inertial.mass.value;
     }
     let body_link = |b: usize| Link {
         name: robot.links[bodies[b]].name.clone(),
         mass: mass[b],
-        com: if mass[b] > 0.0 {
-            moment[b] / mass[b]
-        } else {
-            Vector3::zeros()
-        },
+        com: com[b],
+        inertia: Some(inertia[b]),
     };
     for (k, joint) in joints.iter_mut().enumerate() {
         joint.link = body_link(k + 1);
