@@ -57,7 +57,17 @@ impl Model {
                 JointKind::Fixed => frame,
                 JointKind::Revolute => {
                     let mut p = frame;
-                    p.rotation *= rotation_about(&joint.axis, value);
+                    if joint.axis.x == 0.0 && joint.axis.y == 0.0 {
+                        // About ±z (every DH joint): R·Rz(θ) only mixes the first two columns,
+                        // a third of the general product.
+                        let (s, c) = (value * joint.axis.z).sin_cos();
+                        let m = p.rotation.matrix_mut_unchecked();
+                        let (x, y) = (m.column(0).into_owned(), m.column(1).into_owned());
+                        m.set_column(0, &(x * c + y * s));
+                        m.set_column(1, &(y * c - x * s));
+                    } else {
+                        p.rotation *= rotation_about(&joint.axis, value);
+                    }
                     p
                 }
                 JointKind::Prismatic => {
