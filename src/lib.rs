@@ -4,4 +4,6 @@
 
 pub mod imitation;
 pub mod io;
+pub mod model;
+pub mod robots;
 pub mod solver;

@@ -1,0 +1,3 @@
+//! Built-in robots: models built from data files shipped with the crate.
+
+pub mod nao;

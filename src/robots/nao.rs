@@ -1,0 +1,204 @@
+//! The NAO H25 V5 humanoid: 23 IK variables (NAOqi names), named frames, the models rooted at the
+//! right sole ([`rfoot`]), the left sole ([`lfoot`]) and the torso ([`torso`]) from the hand-written
+//! modified-DH tables in `robots/nao_dh/` (embedded at compile time), the same robot from its URDF
+//! ([`from_urdf_str`]) for cross-checks, and the change of support foot ([`switch_support`]).
+//!
+//! Frames: x forward, y left, z up; at q = 0 every named frame is axis-aligned with the base.
+//! `RHipYawPitch` is not a variable: both HipYawPitch joints are driven by `LHipYawPitch` (one
+//! motor). The hands (`LHand`, `RHand`) and their finger mimics are locked at 0.
+//!
+//! Changing support keeps the world placement continuous: with `ʷT_a` the world placement of the
+//! current support sole `a` and `ᵃT_b(q)` the placement of the other sole in the current model,
+//! the new base is `ʷT_b = ʷT_a · ᵃT_b(q)`; every frame's world placement is then the same in both
+//! models for the same `q`.
+//!
+//! ```
+//! use faer::Mat;
+//! use nalgebra::Vector3;
+//! use taskstack::robots::nao;
+//!
+//! let model = nao::rfoot(); // base frame: the right sole
+//! let mut data = model.new_data(); // reuse it: no allocation from here on
+//! let q = vec![0.0; model.nv()]; // nao::VARIABLES order, radians
+//! model.forward_kinematics(&mut data, &q)?;
+//! let hand = model.frame_id("l_hand")?;
+//! // At q = 0 the hand is 0.4207 m above the sole (torso 0.33301 + shoulder 0.100 − hand 0.01231).
+//! assert!((data.frame_placement(hand).translation.z - 0.4207).abs() < 1e-12);
+//! let mut jacobian = Mat::<f64>::zeros(3, model.nv());
+//! model.point_jacobian(&data, hand, &Vector3::zeros(), jacobian.as_mut())?;
+//! let com = model.com(&data)?;
+//! assert!(com.z > 0.2 && com.z < 0.35);
+//! # Ok::<(), taskstack::model::ModelError>(())
+//! ```
+
+use std::path::Path;
+
+use nalgebra::{IsometryMatrix3, Translation3};
+
+use crate::model::{Model, ModelData, ModelError, UrdfError, UrdfFrame, UrdfOptions};
+
+/// The 23 IK variables (NAOqi joint names) in the order of `q` of every NAO model.
+pub const VARIABLES: [&str; 23] = [
+    "HeadYaw",
+    "HeadPitch",
+    "LShoulderPitch",
+    "LShoulderRoll",
+    "LElbowYaw",
+    "LElbowRoll",
+    "LWristYaw",
+    "LHipYawPitch",
+    "LHipRoll",
+    "LHipPitch",
+    "LKneePitch",
+    "LAnklePitch",
+    "LAnkleRoll",
+    "RHipRoll",
+    "RHipPitch",
+    "RKneePitch",
+    "RAnklePitch",
+    "RAnkleRoll",
+    "RShoulderPitch",
+    "RShoulderRoll",
+    "RElbowYaw",
+    "RElbowRoll",
+    "RWristYaw",
+];
+
+/// Named frames of every NAO model, each with the URDF link it is fixed to and its offset in that
+/// link's frame (metres; the orientation is the link's). Hands: NAOqi's HandOffsetX 0.05775 and
+/// HandOffsetZ 0.01231 (both hands); soles 0.04511 m (FootHeight) under the ankles; toes/heels
+/// ± 0.05 m along the foot's x; gaze (0.05871, 0, 0.06364) from the head.
+pub const FRAMES: [(&str, &str, [f64; 3]); 23] = [
+    ("torso", "torso", [0.0, 0.0, 0.0]),
+    ("head", "Head", [0.0, 0.0, 0.0]),
+    ("gaze", "Head", [0.05871, 0.0, 0.06364]),
+    ("l_shoulder", "LShoulder", [0.0, 0.0, 0.0]),
+    ("l_elbow", "LElbow", [0.0, 0.0, 0.0]),
+    ("l_wrist", "l_wrist", [0.0, 0.0, 0.0]),
+    ("l_hand", "l_wrist", [0.05775, 0.0, -0.01231]),
+    ("r_shoulder", "RShoulder", [0.0, 0.0, 0.0]),
+    ("r_elbow", "RElbow", [0.0, 0.0, 0.0]),
+    ("r_wrist", "r_wrist", [0.0, 0.0, 0.0]),
+    ("r_hand", "r_wrist", [0.05775, 0.0, -0.01231]),
+    ("l_hip", "LHip", [0.0, 0.0, 0.0]),
+    ("l_knee", "LTibia", [0.0, 0.0, 0.0]),
+    ("l_ankle", "l_ankle", [0.0, 0.0, 0.0]),
+    ("l_sole", "l_sole", [0.0, 0.0, 0.0]),
+    ("l_toe", "l_sole", [0.05, 0.0, 0.0]),
+    ("l_heel", "l_sole", [-0.05, 0.0, 0.0]),
+    ("r_hip", "RHip", [0.0, 0.0, 0.0]),
+    ("r_knee", "RTibia", [0.0, 0.0, 0.0]),
+    ("r_ankle", "r_ankle", [0.0, 0.0, 0.0]),
+    ("r_sole", "r_sole", [0.0, 0.0, 0.0]),
+    ("r_toe", "r_sole", [0.05, 0.0, 0.0]),
+    ("r_heel", "r_sole", [-0.05, 0.0, 0.0]),
+];
+
+/// URDF joints that are not IK variables, locked at 0 (their finger mimics follow).
+pub const LOCKED_JOINTS: [&str; 2] = ["LHand", "RHand"];
+
+/// DH table of the NAO rooted at the right sole (`robots/nao_dh/nao_rfoot.toml`).
+pub const RFOOT_DH: &str = include_str!("../../robots/nao_dh/nao_rfoot.toml");
+/// DH table of the NAO rooted at the left sole (`robots/nao_dh/nao_lfoot.toml`).
+pub const LFOOT_DH: &str = include_str!("../../robots/nao_dh/nao_lfoot.toml");
+/// DH table of the NAO rooted at the torso (`robots/nao_dh/nao_torso.toml`).
+pub const TORSO_DH: &str = include_str!("../../robots/nao_dh/nao_torso.toml");
+
+/// A support foot.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Foot {
+    /// The right foot (model [`rfoot`], base frame `r_sole`).
+    Right,
+    /// The left foot (model [`lfoot`], base frame `l_sole`).
+    Left,
+}
+
+impl Foot {
+    /// Name of this foot's sole frame (`r_sole` or `l_sole`).
+    pub fn sole(self) -> &'static str {
+        match self {
+            Foot::Right => "r_sole",
+            Foot::Left => "l_sole",
+        }
+    }
+
+    /// The other foot.
+    pub fn other(self) -> Foot {
+        match self {
+            Foot::Right => Foot::Left,
+            Foot::Left => Foot::Right,
+        }
+    }
+
+    /// The DH model rooted at this foot's sole.
+    pub fn model(self) -> Model {
+        match self {
+            Foot::Right => rfoot(),
+            Foot::Left => lfoot(),
+        }
+    }
+}
+
+fn embedded(text: &str, origin: &str) -> Model {
+    // The embedded tables are part of the crate and loaded by the tests; failing here is a build
+    // defect, not bad user input.
+    Model::from_dh_str(text, origin).unwrap_or_else(|e| panic!("embedded NAO table: {e}"))
+}
+
+/// The NAO rooted at the right sole (base frame = `r_sole`), from the embedded DH table.
+pub fn rfoot() -> Model {
+    embedded(RFOOT_DH, "robots/nao_dh/nao_rfoot.toml")
+}
+
+/// The NAO rooted at the left sole (base frame = `l_sole`), from the embedded DH table.
+pub fn lfoot() -> Model {
+    embedded(LFOOT_DH, "robots/nao_dh/nao_lfoot.toml")
+}
+
+/// The NAO rooted at the torso (base frame = URDF `torso`), from the embedded DH table.
+pub fn torso() -> Model {
+    embedded(TORSO_DH, "robots/nao_dh/nao_torso.toml")
+}
+
+/// URDF loading options for the NAO: base at `root_link` (`None`: the URDF's root), hands locked at
+/// 0, variables in [`VARIABLES`] order, exactly the named frames of [`FRAMES`].
+pub fn urdf_options(root_link: Option<&str>) -> UrdfOptions {
+    UrdfOptions {
+        root_link: root_link.map(str::to_owned),
+        locked_joints: LOCKED_JOINTS.iter().map(|j| (j.to_string(), 0.0)).collect(),
+        variable_order: Some(VARIABLES.iter().map(|v| v.to_string()).collect()),
+        frames: FRAMES
+            .iter()
+            .map(|&(name, link, [x, y, z])| UrdfFrame {
+                name: name.to_owned(),
+                link: link.to_owned(),
+                placement: IsometryMatrix3::from(Translation3::new(x, y, z)),
+            })
+            .collect(),
+        link_frames: false,
+    }
+}
+
+/// The NAO from URDF text (e.g. `nao.urdf` of NAO H25 V5), rooted at the URDF link `root_link`
+/// (`"r_sole"`, `"l_sole"`, `"torso"`; `None`: the URDF's root), with the NAO named frames.
+pub fn from_urdf_str(text: &str, root_link: Option<&str>) -> Result<Model, UrdfError> {
+    Model::from_urdf_str(text, &urdf_options(root_link))
+}
+
+/// [`from_urdf_str`] on a file.
+pub fn from_urdf_file(path: impl AsRef<Path>, root_link: Option<&str>) -> Result<Model, UrdfError> {
+    Model::from_urdf_file(path, &urdf_options(root_link))
+}
+
+/// Change of support: the world placement of the sole of `new_support`, given a model and its
+/// forward kinematics at the current `q` and the world placement `world_t_base` of that model's
+/// base (the current support sole). Use it as the new model's base placement: `ʷT_b = ʷT_a · ᵃT_b(q)`.
+pub fn switch_support(
+    model: &Model,
+    data: &ModelData,
+    world_t_base: &IsometryMatrix3<f64>,
+    new_support: Foot,
+) -> Result<IsometryMatrix3<f64>, ModelError> {
+    let sole = model.frame_id(new_support.sole())?;
+    model.placement_in_world(data, world_t_base, sole)
+}
