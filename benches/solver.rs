@@ -102,7 +102,7 @@ fn bench(c: &mut Criterion) {
     }
     let clamp_bounds = JointBounds::with_velocity(&lower, &upper, &velocity).unwrap();
     let limits = JointLimitAvoidance::new(&free_bounds);
-    let tracking = JointTracking::new(&vec![0.2; N]).unwrap();
+    let tracking = JointTracking::new(&[0.2; N]).unwrap();
     let dt = 0.01;
 
     for case in [Case::new("RS", &[2, 9]), Case::new("DS", &[2, 11])] {

@@ -49,7 +49,11 @@ fn main() -> ExitCode {
     }
 }
 
-fn run(path: &str, frames: Option<usize>, repeats: usize) -> Result<(), Box<dyn std::error::Error>> {
+fn run(
+    path: &str,
+    frames: Option<usize>,
+    repeats: usize,
+) -> Result<(), Box<dyn std::error::Error>> {
     let problem = Problem::from_json(&std::fs::read_to_string(path)?)?;
     let count = frames.unwrap_or(problem.frames).min(problem.frames);
     let names = problem.task_names();
@@ -89,7 +93,11 @@ fn run(path: &str, frames: Option<usize>, repeats: usize) -> Result<(), Box<dyn 
         }
     }
     let (median, p99, max) = percentiles(&mut times);
-    let top_level_worst = worst.iter().zip(&levels).filter(|(_, l)| **l == 0).fold(0.0_f64, |m, (w, _)| m.max(*w));
+    let top_level_worst = worst
+        .iter()
+        .zip(&levels)
+        .filter(|(_, l)| **l == 0)
+        .fold(0.0_f64, |m, (w, _)| m.max(*w));
     let out = json!({
         "problem": problem.label,
         "joint_order": problem.joint_order,

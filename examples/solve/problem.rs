@@ -65,7 +65,10 @@ fn floats(v: &Value, what: &str) -> Result<Vec<f64>, Error> {
     v.as_array()
         .ok_or_else(|| format!("{what}: expected an array"))?
         .iter()
-        .map(|x| x.as_f64().ok_or_else(|| format!("{what}: expected numbers").into()))
+        .map(|x| {
+            x.as_f64()
+                .ok_or_else(|| format!("{what}: expected numbers").into())
+        })
         .collect()
 }
 
@@ -73,7 +76,11 @@ fn strings(v: &Value, what: &str) -> Result<Vec<String>, Error> {
     v.as_array()
         .ok_or_else(|| format!("{what}: expected an array"))?
         .iter()
-        .map(|x| x.as_str().map(str::to_owned).ok_or_else(|| format!("{what}: expected strings").into()))
+        .map(|x| {
+            x.as_str()
+                .map(str::to_owned)
+                .ok_or_else(|| format!("{what}: expected strings").into())
+        })
         .collect()
 }
 
@@ -100,7 +107,11 @@ impl Problem {
         let index_of = |name: &str| joint_order.iter().position(|j| j == name);
         let mut order_to_variable = Vec::new();
         for name in &joint_order {
-            let variable = if name == "RHipYawPitch" { "LHipYawPitch" } else { name };
+            let variable = if name == "RHipYawPitch" {
+                "LHipYawPitch"
+            } else {
+                name
+            };
             order_to_variable.push(model.variable_index(variable)?);
         }
         let lower = floats(&doc["joint_limits"]["lower"], "joint_limits.lower")?;
@@ -118,14 +129,21 @@ impl Problem {
         let bounds = JointBounds::new(&to_model(&lower)?, &to_model(&upper)?)?;
         let q_init = to_model(&floats(&doc["q_init"], "q_init")?)?;
         let q_ref = to_model(&floats(&doc["q_ref"], "q_ref")?)?;
-        let frames = doc["frames"]["count"].as_u64().ok_or("frames.count missing")? as usize;
+        let frames = doc["frames"]["count"]
+            .as_u64()
+            .ok_or("frames.count missing")? as usize;
 
         let points = &doc["points"];
         let point = |name: &str| -> Result<(FrameId, Vector3<f64>), Error> {
             let p = &points[name];
-            let link = p["link"].as_str().ok_or_else(|| format!("point {name}: no link"))?;
+            let link = p["link"]
+                .as_str()
+                .ok_or_else(|| format!("point {name}: no link"))?;
             let offset = floats(&p["offset"], "point offset")?;
-            Ok((model.frame_id(link)?, Vector3::new(offset[0], offset[1], offset[2])))
+            Ok((
+                model.frame_id(link)?,
+                Vector3::new(offset[0], offset[1], offset[2]),
+            ))
         };
         let per_frame = |name: &str| -> Result<Vec<[f64; 3]>, Error> {
             doc["frames"]["targets"][name]
@@ -142,7 +160,11 @@ impl Problem {
         let mut tasks = Vec::new();
         let mut level_names = Vec::new();
         let mut shape = StackShape::new(model.nv());
-        let mut level_defs: Vec<&Value> = doc["tasks"].as_array().ok_or("tasks missing")?.iter().collect();
+        let mut level_defs: Vec<&Value> = doc["tasks"]
+            .as_array()
+            .ok_or("tasks missing")?
+            .iter()
+            .collect();
         level_defs.sort_by_key(|t| t["priority"].as_u64().unwrap_or(u64::MAX));
         for def in level_defs {
             let name = def["name"].as_str().unwrap_or("level").to_owned();
@@ -163,7 +185,10 @@ impl Problem {
                 Some("points") if def["rows"].is_array() => {
                     for row in def["rows"].as_array().into_iter().flatten() {
                         let p = row["point"].as_str().ok_or("row without point")?;
-                        let axes = strings(&row["axes"], "axes")?.iter().map(|a| axis(a)).collect::<Result<_, _>>()?;
+                        let axes = strings(&row["axes"], "axes")?
+                            .iter()
+                            .map(|a| axis(a))
+                            .collect::<Result<_, _>>()?;
                         level_tasks.push(Task {
                             name: p.to_owned(),
                             point: Some(point(p)?),
@@ -175,8 +200,10 @@ impl Problem {
                     }
                 }
                 Some("points") => {
-                    let axes: Vec<Axis> =
-                        strings(&def["axes"], "axes")?.iter().map(|a| axis(a)).collect::<Result<_, _>>()?;
+                    let axes: Vec<Axis> = strings(&def["axes"], "axes")?
+                        .iter()
+                        .map(|a| axis(a))
+                        .collect::<Result<_, _>>()?;
                     for p in strings(&def["points"], "points")? {
                         level_tasks.push(Task {
                             name: p.clone(),
@@ -197,7 +224,10 @@ impl Problem {
                 t.row = row;
                 row += t.axes.len();
             }
-            let specs: Vec<(&str, usize)> = level_tasks.iter().map(|t| (t.name.as_str(), t.axes.len())).collect();
+            let specs: Vec<(&str, usize)> = level_tasks
+                .iter()
+                .map(|t| (t.name.as_str(), t.axes.len()))
+                .collect();
             shape = shape.with_level(&name, &specs);
             level_names.push(name);
             tasks.extend(level_tasks);
@@ -287,7 +317,9 @@ impl<'p> Runner<'p> {
             posture: &self.posture,
             frame,
         };
-        let report = self.driver.run(&mut self.solver, &mut model, q, &self.problem.bounds)?;
+        let report = self
+            .driver
+            .run(&mut self.solver, &mut model, q, &self.problem.bounds)?;
         let micros = start.elapsed().as_secs_f64() * 1e6;
         Ok(FrameResult {
             iterations: report.iterations,
@@ -351,7 +383,13 @@ impl TaskModel for FrameModel<'_> {
                     } else {
                         let mut jac = jac;
                         for (r, &a) in task.axes.iter().enumerate() {
-                            model.point_jacobian_row(self.data, *frame, offset, a, jac.as_mut().subrows_mut(r, 1))?;
+                            model.point_jacobian_row(
+                                self.data,
+                                *frame,
+                                offset,
+                                a,
+                                jac.as_mut().subrows_mut(r, 1),
+                            )?;
                         }
                     }
                     let p = model.point_position(self.data, *frame, offset)?;
@@ -388,5 +426,9 @@ pub fn percentiles(values: &mut [f64]) -> (f64, f64, f64) {
 
 /// Per-task statistics in a JSON object keyed by task name.
 pub fn per_task(names: &[&str], values: impl Fn(usize) -> f64) -> BTreeMap<String, f64> {
-    names.iter().enumerate().map(|(i, n)| (n.to_string(), values(i))).collect()
+    names
+        .iter()
+        .enumerate()
+        .map(|(i, n)| (n.to_string(), values(i)))
+        .collect()
 }

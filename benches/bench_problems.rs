@@ -1,0 +1,45 @@
+//! The whole `solve` frame on the NAO benchmark problems (`../shared/bench/problem_*.json`):
+//! targets set + all driver iterations + stop test, warm-started from the previous frame, cycling
+//! through the file's frames. Same code as the `solve` example.
+
+#[path = "../examples/solve/problem.rs"]
+#[allow(dead_code)] // the example uses more of it than the bench
+mod problem;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use problem::{Problem, Runner};
+use std::hint::black_box;
+
+fn bench(c: &mut Criterion) {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/bench");
+    for name in [
+        "problem_rs",
+        "problem_ds",
+        "problem_rs_stress",
+        "problem_ds_stress",
+    ] {
+        let path = dir.join(format!("{name}.json"));
+        let Ok(text) = std::fs::read_to_string(&path) else {
+            eprintln!("skipping {}: not found", path.display());
+            continue;
+        };
+        let problem = Problem::from_json(&text).expect("valid problem file");
+        let mut runner = Runner::new(&problem).expect("solver for the problem");
+        let mut q = problem.q_init.clone();
+        let mut frame = 0;
+        c.bench_function(&format!("solve_frame/{name}"), |b| {
+            b.iter(|| {
+                if frame == problem.frames {
+                    frame = 0;
+                    q.copy_from_slice(&problem.q_init);
+                }
+                let result = runner.solve_frame(frame, &mut q).expect("frame solves");
+                frame += 1;
+                black_box(result.iterations)
+            })
+        });
+    }
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
