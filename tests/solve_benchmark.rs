@@ -11,7 +11,8 @@ use problem::{Problem, Runner};
 use taskstack::solver::driver::StopReason;
 
 fn load(name: &str) -> Problem {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../shared/bench/{name}.json"));
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join(format!("../shared/bench/{name}.json"));
     let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     Problem::from_json(&text).expect("valid problem")
 }
@@ -39,8 +40,15 @@ fn main_problems_reach_tolerance_on_every_frame() {
     for name in ["problem_rs", "problem_ds"] {
         let problem = load(name);
         for (frame, (stop, errors)) in solve_all(&problem).iter().enumerate() {
-            assert_eq!(*stop, StopReason::Converged, "{name} frame {frame}: {errors:?}");
-            assert!(errors.iter().all(|e| *e <= 1e-4), "{name} frame {frame}: {errors:?}");
+            assert_eq!(
+                *stop,
+                StopReason::Converged,
+                "{name} frame {frame}: {errors:?}"
+            );
+            assert!(
+                errors.iter().all(|e| *e <= 1e-4),
+                "{name} frame {frame}: {errors:?}"
+            );
         }
     }
 }
