@@ -3,29 +3,8 @@
 mod solver_common;
 
 use proptest::prelude::*;
-use solver_common::{LevelKind, Problem, Rng, random_bounds, random_problem};
+use solver_common::{Rng, problems, random_bounds};
 use taskstack::solver::JointBounds;
-
-const KINDS: [LevelKind; 4] = [
-    LevelKind::Full,
-    LevelKind::LowRank,
-    LevelKind::ZeroRows,
-    LevelKind::Conflicting,
-];
-
-fn problems() -> impl Strategy<Value = (Problem, u64)> {
-    (
-        any::<u64>(),
-        1usize..=30,
-        prop::collection::vec((1usize..=8, 0usize..4), 1..=5),
-    )
-        .prop_map(|(seed, n, levels)| {
-            let rows: Vec<usize> = levels.iter().map(|l| l.0).collect();
-            let kinds: Vec<LevelKind> = levels.iter().map(|l| KINDS[l.1]).collect();
-            let mut rng = Rng::new(seed);
-            (random_problem(&mut rng, n, &rows, &kinds), rng.next_u64())
-        })
-}
 
 proptest! {
     #![proptest_config(ProptestConfig { cases: 512, ..ProptestConfig::default() })]

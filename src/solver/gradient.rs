@@ -21,33 +21,53 @@ pub trait GradientFunction {
     ) -> Result<(), SolverError>;
 }
 
+/// `f(q) = Σ w_i (q_i − c_i)²`: the shape of both built-in criteria.
+#[derive(Debug, Clone, PartialEq)]
+struct WeightedQuadratic {
+    center: Vec<f64>,
+    weight: Vec<f64>,
+}
+
+impl GradientFunction for WeightedQuadratic {
+    fn add_scaled_gradient(
+        &self,
+        q: &[f64],
+        scale: f64,
+        out: &mut [f64],
+    ) -> Result<(), SolverError> {
+        check_len("q", self.center.len(), q.len())?;
+        check_len("gradient output", self.center.len(), out.len())?;
+        check_finite_slice("q", q)?;
+        for (((o, &qi), &c), &w) in out.iter_mut().zip(q).zip(&self.center).zip(&self.weight) {
+            *o += scale * 2.0 * w * (qi - c);
+        }
+        Ok(())
+    }
+}
+
 /// Joint-limit avoidance (eq. 7): pushes each joint toward the middle of its range, with the
 /// squared distance normalized by the range. Joints with an unbounded or zero-width range do not
 /// contribute.
 #[derive(Debug, Clone, PartialEq)]
-pub struct JointLimitAvoidance {
-    middle: Vec<f64>,
-    /// `2 / (q_max − q_min)²`, or 0 where the range is infinite or empty.
-    weight: Vec<f64>,
-}
+pub struct JointLimitAvoidance(WeightedQuadratic);
 
 impl JointLimitAvoidance {
     /// The criterion for the position limits in `bounds`.
     pub fn new(bounds: &JointBounds) -> Self {
-        let (middle, weight) = bounds
+        let (center, weight) = bounds
             .lower()
             .iter()
             .zip(bounds.upper())
             .map(|(&lo, &hi)| {
                 let range = hi - lo;
                 if range.is_finite() && range > 0.0 {
-                    (0.5 * (lo + hi), 2.0 / (range * range))
+                    (0.5 * (lo + hi), 1.0 / (range * range))
                 } else {
                     (0.0, 0.0)
                 }
             })
             .unzip();
-        Self { middle, weight }
+        Self(WeightedQuadratic { center, weight })
     }
 }
 
@@ -58,23 +78,14 @@ impl GradientFunction for JointLimitAvoidance {
         scale: f64,
         out: &mut [f64],
     ) -> Result<(), SolverError> {
-        check_len("q", self.middle.len(), q.len())?;
-        check_len("gradient output", self.middle.len(), out.len())?;
-        check_finite_slice("q", q)?;
-        for (((o, &qi), &mid), &w) in out.iter_mut().zip(q).zip(&self.middle).zip(&self.weight) {
-            *o += scale * w * (qi - mid);
-        }
-        Ok(())
+        self.0.add_scaled_gradient(q, scale, out)
     }
 }
 
 /// Joint-space tracking (eq. 8): `f = Σ w_i (q_i − q^h_i)²`, pulling the joints toward a reference
 /// posture (the human's joint angles, in rad). A weight of 0 leaves a joint untracked.
 #[derive(Debug, Clone, PartialEq)]
-pub struct JointTracking {
-    reference: Vec<f64>,
-    weight: Vec<f64>,
-}
+pub struct JointTracking(WeightedQuadratic);
 
 impl JointTracking {
     /// Tracks `reference` with unit weight on every joint.
@@ -94,27 +105,27 @@ impl JointTracking {
                 reason: "weights must be >= 0",
             });
         }
-        Ok(Self {
-            reference: reference.to_vec(),
+        Ok(Self(WeightedQuadratic {
+            center: reference.to_vec(),
             weight: weight.to_vec(),
-        })
+        }))
     }
 
     /// Replaces the reference posture (same length), e.g. with the next frame's human angles.
     pub fn set_reference(&mut self, reference: &[f64]) -> Result<(), SolverError> {
         check_len(
             "joint tracking reference",
-            self.reference.len(),
+            self.0.center.len(),
             reference.len(),
         )?;
         check_finite_slice("joint tracking reference", reference)?;
-        self.reference.copy_from_slice(reference);
+        self.0.center.copy_from_slice(reference);
         Ok(())
     }
 
     /// The reference posture (rad).
     pub fn reference(&self) -> &[f64] {
-        &self.reference
+        &self.0.center
     }
 }
 
@@ -125,13 +136,7 @@ impl GradientFunction for JointTracking {
         scale: f64,
         out: &mut [f64],
     ) -> Result<(), SolverError> {
-        check_len("q", self.reference.len(), q.len())?;
-        check_len("gradient output", self.reference.len(), out.len())?;
-        check_finite_slice("q", q)?;
-        for (((o, &qi), &r), &w) in out.iter_mut().zip(q).zip(&self.reference).zip(&self.weight) {
-            *o += scale * 2.0 * w * (qi - r);
-        }
-        Ok(())
+        self.0.add_scaled_gradient(q, scale, out)
     }
 }
 

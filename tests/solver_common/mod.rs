@@ -3,6 +3,7 @@
 #![allow(dead_code)] // each test binary uses a different subset
 
 use nalgebra::{DMatrix, DVector};
+use proptest::prelude::*;
 use taskstack::solver::{JointBounds, Solver, StackShape};
 
 /// SplitMix64: a tiny deterministic generator, seeded by proptest.
@@ -266,4 +267,32 @@ pub fn random_bounds(rng: &mut Rng, n: usize) -> (JointBounds, Vec<f64>) {
         JointBounds::with_velocity(&lower, &upper, &velocity).unwrap(),
         q,
     )
+}
+
+const KINDS: [LevelKind; 4] = [
+    LevelKind::Full,
+    LevelKind::LowRank,
+    LevelKind::ZeroRows,
+    LevelKind::Conflicting,
+];
+
+/// A random level kind by index.
+pub fn kind(index: usize) -> LevelKind {
+    KINDS[index % KINDS.len()]
+}
+
+/// Random problems: n up to 30, 1–5 levels of 1–8 rows, of every kind; and a seed for more
+/// random numbers.
+pub fn problems() -> impl Strategy<Value = (Problem, u64)> {
+    (
+        any::<u64>(),
+        1usize..=30,
+        prop::collection::vec((1usize..=8, 0usize..4), 1..=5),
+    )
+        .prop_map(|(seed, n, levels)| {
+            let rows: Vec<usize> = levels.iter().map(|l| l.0).collect();
+            let kinds: Vec<LevelKind> = levels.iter().map(|l| kind(l.1)).collect();
+            let mut rng = Rng::new(seed);
+            (random_problem(&mut rng, n, &rows, &kinds), rng.next_u64())
+        })
 }
