@@ -8,3 +8,4 @@
 
 pub mod human;
 pub mod support;
+pub mod phase;
