@@ -7,5 +7,6 @@
 //! [`support::HumanSupport`] phases (Poubel §III.A).
 
 pub mod human;
-pub mod support;
 pub mod phase;
+pub mod support;
+pub mod tables;

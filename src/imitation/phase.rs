@@ -158,9 +158,9 @@ impl SupportPhase {
     pub const fn swing_foot(self) -> Option<Foot> {
         match self {
             SupportPhase::Double => None,
-            SupportPhase::Right | SupportPhase::DoubleToRight(_) | SupportPhase::RightToDouble(_) => {
-                Some(Foot::Left)
-            }
+            SupportPhase::Right
+            | SupportPhase::DoubleToRight(_)
+            | SupportPhase::RightToDouble(_) => Some(Foot::Left),
             SupportPhase::Left | SupportPhase::DoubleToLeft(_) | SupportPhase::LeftToDouble(_) => {
                 Some(Foot::Right)
             }
@@ -253,7 +253,10 @@ impl PhaseConfig {
     pub fn validate(&self) -> Result<(), PhaseError> {
         let positive = |v: f64| v.is_finite() && v > 0.0;
         if !positive(self.com_tolerance) {
-            return Err(PhaseError::Config("com_tolerance", "must be finite and > 0"));
+            return Err(PhaseError::Config(
+                "com_tolerance",
+                "must be finite and > 0",
+            ));
         }
         if !(self.lambda.is_finite() && self.lambda >= 0.0) {
             return Err(PhaseError::Config("lambda", "must be finite and ≥ 0"));
