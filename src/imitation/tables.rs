@@ -489,7 +489,7 @@ impl fmt::Display for PointCell<'_> {
         match target {
             PointTarget::Scaled(joint) => write!(f, "{coords} ← {}", joint.name()),
             PointTarget::Held { lift } if axes == Axes::Z => write!(f, "{coords} = {}", mm(lift)),
-            PointTarget::Held { lift } if lift == 0.0 => write!(f, "{coords} held"),
+            PointTarget::Held { lift: 0.0 } => write!(f, "{coords} held"),
             PointTarget::Held { lift } => write!(f, "{coords} held, lifted {}", mm(lift)),
         }
     }
