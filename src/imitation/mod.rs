@@ -4,7 +4,12 @@
 //! A motion source (a BVH file, a Kinect stream; see [`crate::io`]) yields one
 //! [`human::HumanFrame`] per time step: named joint positions in metres in a right-handed frame
 //! with z up. [`support::SupportDetector`] turns the stream of frames into a stream of
-//! [`support::HumanSupport`] phases (Poubel §III.A).
+//! [`support::HumanSupport`] phases (Poubel §III.A). [`phase::PhaseMachine`] turns those into the
+//! robot's [`phase::SupportPhase`] (DS, RS, LS and the two-step transitions of Table I), ending
+//! each transition step on measured conditions; [`tables::TaskTables`] says, per phase, which
+//! model root, equality levels and gradient tasks the IK solves (Table I as data).
 
 pub mod human;
+pub mod phase;
 pub mod support;
+pub mod tables;

@@ -1,0 +1,8 @@
+//! Prints the paper's task tables (Poubel Table I) as markdown; this is how
+//! `src/imitation/table1.md` is generated.
+
+use taskstack::imitation::tables::TaskTables;
+
+fn main() {
+    print!("{}", TaskTables::paper());
+}

@@ -1,0 +1,464 @@
+//! The robot's support phase (Poubel §III.B, Table I): double support (DS), right support (RS),
+//! left support (LS), and the two-step transitions between DS and a single support, driven by the
+//! human's support and ended by what the robot measurably achieved, never by timers.
+//!
+//! # Phases
+//!
+//! | Phase | Step | Model root | Ends when |
+//! |---|---|---|---|
+//! | DS | — | right sole | (continuous) |
+//! | RS | — | right sole | (continuous) |
+//! | LS | — | left sole | (continuous) |
+//! | DS → RS | CoM to RFoot | right sole | `e_c ≤ com_tolerance` |
+//! | DS → RS | Lift LFoot | right sole | `min(h_toe, h_heel) ≥ ρ − foot_height_tolerance` |
+//! | DS → LS | CoM to LFoot | right sole | `e_c ≤ com_tolerance` |
+//! | DS → LS | Lift RFoot | left sole | `min(h_toe, h_heel) ≥ ρ − foot_height_tolerance` |
+//! | RS → DS | Lower LFoot | right sole | `max(h_toe, h_heel) ≤ foot_height_tolerance` |
+//! | RS → DS | CoM to middle | right sole | `e_c ≤ com_tolerance` |
+//! | LS → DS | Lower RFoot | left sole | `max(h_toe, h_heel) ≤ foot_height_tolerance` |
+//! | LS → DS | CoM to middle | right sole | `e_c ≤ com_tolerance` |
+//!
+//! `e_c` is the horizontal distance (m) between the CoM ground projection and the current step's
+//! CoM goal; `h_toe`, `h_heel` are the heights (m) above the ground of the swing foot's toe and
+//! heel points ([`SupportPhase::swing_foot`]). A step whose condition is not met is repeated at
+//! the next update. A NaN measurement never meets a condition, so it never ends a step.
+//!
+//! # Transition graph
+//!
+//! The input is the human's support `h`; [`HumanSupport::Airborne`] is replaced by the last
+//! non-airborne human support (initially DS), so the robot keeps its support during a jump or a
+//! lost track. "done" is the current step's end condition. Every (phase, `h`) pair has exactly one
+//! successor (below for the right foot; the left foot is the mirror image):
+//!
+//! | From | `h` = DS | `h` = RS | `h` = LS |
+//! |---|---|---|---|
+//! | DS | DS | DS → RS: CoM to RFoot | DS → LS: CoM to LFoot |
+//! | RS | RS → DS: Lower LFoot | RS | RS → DS: Lower LFoot |
+//! | DS → RS: CoM to RFoot | DS (abort) | done ? Lift LFoot : stay | DS (abort) |
+//! | DS → RS: Lift LFoot | RS → DS: Lower LFoot | done ? RS : stay | RS → DS: Lower LFoot |
+//! | RS → DS: Lower LFoot | done ? CoM to middle : stay | DS → RS: Lift LFoot | done ? CoM to middle : stay |
+//! | RS → DS: CoM to middle | done ? DS : stay | DS → RS: CoM to RFoot | done ? DS : stay |
+//!
+//! Why these edges:
+//! * Aborting "CoM to RFoot" goes straight back to DS: both feet are still on the ground, so the
+//!   DS task table (CoM back to the middle) is safe from any CoM position between the feet.
+//! * A foot put back down while being lifted is lowered first ("Lower LFoot" then "CoM to
+//!   middle"), exactly as a regular landing; a foot lifted again while being lowered is lifted
+//!   again ("Lift LFoot"). Both steps keep the CoM at the same goal, so the switch is continuous.
+//! * "CoM to middle" interrupted by the human lifting the same foot again moves the CoM back to
+//!   the support foot ("CoM to RFoot") before any lift: the foot is on the ground there.
+//! * Walking (RS → LS) always goes through DS: the swing foot is landed and the CoM brought to the
+//!   middle before the other foot's take-off starts, so the CoM never has to cross a gap without
+//!   a foot under it.
+//!
+//! # Model root
+//!
+//! [`SupportPhase::model_root`] is the sole the paper roots the kinematic model at in each phase
+//! (§IV.B, Table I): the right sole in DS and whenever the right foot is on the ground, the left
+//! sole only while the right foot is in the air or being lowered ("Lift RFoot", LS, "Lower
+//! RFoot").
+
+use std::fmt;
+
+use super::support::HumanSupport;
+use crate::robots::nao::Foot;
+
+/// The steps of a take-off (DS to a single support), in order.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum TakeOff {
+    /// Move the CoM ground projection over the future support foot; both feet flat on the ground.
+    ComToFoot,
+    /// Lift the swing foot, parallel to the ground, to the height ρ.
+    LiftFoot,
+}
+
+/// The steps of a landing (a single support back to DS), in order.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Landing {
+    /// Lower the swing foot, parallel to the ground, until it is on the ground.
+    LowerFoot,
+    /// Move the CoM ground projection back to the middle between the ankles.
+    ComToMiddle,
+}
+
+/// The robot's support phase: a continuous support or one step of a transition (a row of
+/// Poubel's Table I).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum SupportPhase {
+    /// Double support (DS).
+    Double,
+    /// Right support (RS): the left foot is free.
+    Right,
+    /// Left support (LS): the right foot is free.
+    Left,
+    /// Transition DS → RS (the left foot takes off).
+    DoubleToRight(TakeOff),
+    /// Transition DS → LS (the right foot takes off).
+    DoubleToLeft(TakeOff),
+    /// Transition RS → DS (the left foot lands).
+    RightToDouble(Landing),
+    /// Transition LS → DS (the right foot lands).
+    LeftToDouble(Landing),
+}
+
+impl SupportPhase {
+    /// Number of phases (3 continuous supports + 8 transition steps).
+    pub const COUNT: usize = 11;
+
+    /// Every phase, in the row order of Table I.
+    pub const ALL: [SupportPhase; SupportPhase::COUNT] = [
+        SupportPhase::Right,
+        SupportPhase::Left,
+        SupportPhase::Double,
+        SupportPhase::DoubleToRight(TakeOff::ComToFoot),
+        SupportPhase::DoubleToRight(TakeOff::LiftFoot),
+        SupportPhase::DoubleToLeft(TakeOff::ComToFoot),
+        SupportPhase::DoubleToLeft(TakeOff::LiftFoot),
+        SupportPhase::RightToDouble(Landing::LowerFoot),
+        SupportPhase::RightToDouble(Landing::ComToMiddle),
+        SupportPhase::LeftToDouble(Landing::LowerFoot),
+        SupportPhase::LeftToDouble(Landing::ComToMiddle),
+    ];
+
+    /// Index of this phase in [`SupportPhase::ALL`].
+    pub const fn index(self) -> usize {
+        match self {
+            SupportPhase::Right => 0,
+            SupportPhase::Left => 1,
+            SupportPhase::Double => 2,
+            SupportPhase::DoubleToRight(TakeOff::ComToFoot) => 3,
+            SupportPhase::DoubleToRight(TakeOff::LiftFoot) => 4,
+            SupportPhase::DoubleToLeft(TakeOff::ComToFoot) => 5,
+            SupportPhase::DoubleToLeft(TakeOff::LiftFoot) => 6,
+            SupportPhase::RightToDouble(Landing::LowerFoot) => 7,
+            SupportPhase::RightToDouble(Landing::ComToMiddle) => 8,
+            SupportPhase::LeftToDouble(Landing::LowerFoot) => 9,
+            SupportPhase::LeftToDouble(Landing::ComToMiddle) => 10,
+        }
+    }
+
+    /// The sole the kinematic model is rooted at in this phase (the paper's choice, see the
+    /// module docs): `Foot::Left` in LS, "Lift RFoot" and "Lower RFoot", `Foot::Right` otherwise.
+    pub const fn model_root(self) -> Foot {
+        match self {
+            SupportPhase::Left
+            | SupportPhase::DoubleToLeft(TakeOff::LiftFoot)
+            | SupportPhase::LeftToDouble(Landing::LowerFoot) => Foot::Left,
+            SupportPhase::Double
+            | SupportPhase::Right
+            | SupportPhase::DoubleToRight(_)
+            | SupportPhase::DoubleToLeft(TakeOff::ComToFoot)
+            | SupportPhase::RightToDouble(_)
+            | SupportPhase::LeftToDouble(Landing::ComToMiddle) => Foot::Right,
+        }
+    }
+
+    /// The foot that leaves or reaches the ground in a transition (the left foot in DS ↔ RS, the
+    /// right foot in DS ↔ LS), or the free foot in a single support; `None` in DS.
+    pub const fn swing_foot(self) -> Option<Foot> {
+        match self {
+            SupportPhase::Double => None,
+            SupportPhase::Right
+            | SupportPhase::DoubleToRight(_)
+            | SupportPhase::RightToDouble(_) => Some(Foot::Left),
+            SupportPhase::Left | SupportPhase::DoubleToLeft(_) | SupportPhase::LeftToDouble(_) => {
+                Some(Foot::Right)
+            }
+        }
+    }
+
+    /// Whether this is one of the 8 transition steps (not DS, RS or LS).
+    pub const fn is_transition(self) -> bool {
+        !matches!(
+            self,
+            SupportPhase::Double | SupportPhase::Right | SupportPhase::Left
+        )
+    }
+
+    /// The "Support" column of Table I: `"DS"`, `"RS"`, `"LS"`, `"DS to RS"`, ….
+    pub const fn support_name(self) -> &'static str {
+        match self {
+            SupportPhase::Double => "DS",
+            SupportPhase::Right => "RS",
+            SupportPhase::Left => "LS",
+            SupportPhase::DoubleToRight(_) => "DS to RS",
+            SupportPhase::DoubleToLeft(_) => "DS to LS",
+            SupportPhase::RightToDouble(_) => "RS to DS",
+            SupportPhase::LeftToDouble(_) => "LS to DS",
+        }
+    }
+
+    /// The "Step" column of Table I (`"CoM to RFoot"`, `"Lift LFoot"`, …); `None` for DS, RS, LS.
+    pub const fn step_name(self) -> Option<&'static str> {
+        match self {
+            SupportPhase::Double | SupportPhase::Right | SupportPhase::Left => None,
+            SupportPhase::DoubleToRight(TakeOff::ComToFoot) => Some("CoM to RFoot"),
+            SupportPhase::DoubleToRight(TakeOff::LiftFoot) => Some("Lift LFoot"),
+            SupportPhase::DoubleToLeft(TakeOff::ComToFoot) => Some("CoM to LFoot"),
+            SupportPhase::DoubleToLeft(TakeOff::LiftFoot) => Some("Lift RFoot"),
+            SupportPhase::RightToDouble(Landing::LowerFoot) => Some("Lower LFoot"),
+            SupportPhase::LeftToDouble(Landing::LowerFoot) => Some("Lower RFoot"),
+            SupportPhase::RightToDouble(Landing::ComToMiddle)
+            | SupportPhase::LeftToDouble(Landing::ComToMiddle) => Some("CoM to middle"),
+        }
+    }
+}
+
+impl fmt::Display for SupportPhase {
+    /// `"DS"`, `"RS"`, `"LS"`, or e.g. `"DS to RS: CoM to RFoot"`.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.step_name() {
+            Some(step) => write!(f, "{}: {step}", self.support_name()),
+            None => f.write_str(self.support_name()),
+        }
+    }
+}
+
+/// Parameters of the phase machine and of the paper's task tables. Lengths in metres.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PhaseConfig {
+    /// A CoM step ends when the CoM ground projection is within this distance of its goal.
+    /// Default 5 mm: a third of λ, so at the end of "CoM to RFoot" the CoM is at least 10 mm in
+    /// front of the support ankle, inside a NAO sole (about 160 × 90 mm around a point 20 mm
+    /// ahead of the ankle) by more than 25 mm in every direction; and well above the millimetre
+    /// residual a converged solve leaves, so the step does end.
+    pub com_tolerance: f64,
+    /// Offset λ of the CoM goal from the support ankle toward the foot centre (x of the sole)
+    /// while a foot is lifted or lowered. Paper: 15 mm.
+    pub lambda: f64,
+    /// Height ρ of the swing sole (toe and heel points) above the ground at which a lift ends.
+    /// Paper: 30 mm.
+    pub rho: f64,
+    /// A lift ends when both sole points are within this of ρ; a lowering ends when both are
+    /// within this of the ground. Default 2 mm: what the IK reaches in a few steps, and small
+    /// against ρ so "lifted" and "on the ground" stay far apart.
+    pub foot_height_tolerance: f64,
+}
+
+impl Default for PhaseConfig {
+    /// The paper's λ = 15 mm and ρ = 30 mm, with a 5 mm CoM and a 2 mm foot height tolerance.
+    fn default() -> Self {
+        Self {
+            com_tolerance: 0.005,
+            lambda: 0.015,
+            rho: 0.030,
+            foot_height_tolerance: 0.002,
+        }
+    }
+}
+
+impl PhaseConfig {
+    /// Checks every field: tolerances finite and > 0, λ finite and ≥ 0, ρ finite and more than
+    /// twice the foot height tolerance (so a lifted foot is never also "on the ground").
+    pub fn validate(&self) -> Result<(), PhaseError> {
+        let positive = |v: f64| v.is_finite() && v > 0.0;
+        if !positive(self.com_tolerance) {
+            return Err(PhaseError::Config(
+                "com_tolerance",
+                "must be finite and > 0",
+            ));
+        }
+        if !(self.lambda.is_finite() && self.lambda >= 0.0) {
+            return Err(PhaseError::Config("lambda", "must be finite and ≥ 0"));
+        }
+        if !positive(self.foot_height_tolerance) {
+            return Err(PhaseError::Config(
+                "foot_height_tolerance",
+                "must be finite and > 0",
+            ));
+        }
+        if !(self.rho.is_finite() && self.rho > 2.0 * self.foot_height_tolerance) {
+            return Err(PhaseError::Config(
+                "rho",
+                "must be finite and > 2 × foot_height_tolerance",
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Errors of the phase machine.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum PhaseError {
+    /// A [`PhaseConfig`] field is out of range.
+    #[error("phase config: {0} {1}")]
+    Config(&'static str, &'static str),
+}
+
+/// What the robot achieved at the last solve, in the current phase (metres).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Measurements {
+    /// Horizontal distance between the CoM ground projection and the current phase's CoM goal.
+    pub com_error: f64,
+    /// Height above the ground of the swing foot's toe point ([`SupportPhase::swing_foot`]);
+    /// ignored in DS.
+    pub swing_toe_height: f64,
+    /// Height above the ground of the swing foot's heel point; ignored in DS.
+    pub swing_heel_height: f64,
+}
+
+/// The support phase state machine (see the module docs for the graph).
+///
+/// ```
+/// use taskstack::imitation::phase::{Measurements, PhaseConfig, PhaseMachine, SupportPhase, TakeOff};
+/// use taskstack::imitation::support::HumanSupport;
+///
+/// let mut machine = PhaseMachine::new(PhaseConfig::default())?;
+/// let far = Measurements { com_error: 0.04, swing_toe_height: 0.0, swing_heel_height: 0.0 };
+/// // The human lifts the left foot: the robot first moves its CoM over the right foot.
+/// assert_eq!(
+///     machine.update(HumanSupport::Right, &far),
+///     SupportPhase::DoubleToRight(TakeOff::ComToFoot)
+/// );
+/// # Ok::<(), taskstack::imitation::phase::PhaseError>(())
+/// ```
+#[derive(Clone, Debug)]
+pub struct PhaseMachine {
+    config: PhaseConfig,
+    phase: SupportPhase,
+    human: HumanSupport,
+}
+
+impl PhaseMachine {
+    /// A machine in DS (the human is assumed to start standing on both feet).
+    pub fn new(config: PhaseConfig) -> Result<Self, PhaseError> {
+        config.validate()?;
+        Ok(Self {
+            config,
+            phase: SupportPhase::Double,
+            human: HumanSupport::Double,
+        })
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &PhaseConfig {
+        &self.config
+    }
+
+    /// The current phase.
+    pub fn phase(&self) -> SupportPhase {
+        self.phase
+    }
+
+    /// The last non-airborne human support the machine was given (DS before any).
+    pub fn human_support(&self) -> HumanSupport {
+        self.human
+    }
+
+    /// Advances by one time step: `human` is the human's support in the new frame, `measured`
+    /// what the robot achieved at the last solve (in the current phase). Returns the new phase.
+    pub fn update(&mut self, human: HumanSupport, measured: &Measurements) -> SupportPhase {
+        if human != HumanSupport::Airborne {
+            self.human = human;
+        }
+        self.phase = next_phase(self.phase, self.human, measured, &self.config);
+        self.phase
+    }
+}
+
+/// Which foot the human stands on alone, if any (`None` for DS and airborne).
+fn human_single(human: HumanSupport) -> Option<Foot> {
+    match human {
+        HumanSupport::Right => Some(Foot::Right),
+        HumanSupport::Left => Some(Foot::Left),
+        HumanSupport::Double | HumanSupport::Airborne => None,
+    }
+}
+
+fn take_off(support: Foot, step: TakeOff) -> SupportPhase {
+    match support {
+        Foot::Right => SupportPhase::DoubleToRight(step),
+        Foot::Left => SupportPhase::DoubleToLeft(step),
+    }
+}
+
+fn landing(support: Foot, step: Landing) -> SupportPhase {
+    match support {
+        Foot::Right => SupportPhase::RightToDouble(step),
+        Foot::Left => SupportPhase::LeftToDouble(step),
+    }
+}
+
+fn single(support: Foot) -> SupportPhase {
+    match support {
+        Foot::Right => SupportPhase::Right,
+        Foot::Left => SupportPhase::Left,
+    }
+}
+
+/// End conditions of the current step, from the measurements. NaN never meets a condition.
+struct Done {
+    com: bool,
+    lifted: bool,
+    grounded: bool,
+}
+
+impl Done {
+    fn new(m: &Measurements, config: &PhaseConfig) -> Self {
+        let (toe, heel) = (m.swing_toe_height, m.swing_heel_height);
+        let lift_goal = config.rho - config.foot_height_tolerance;
+        Self {
+            com: m.com_error <= config.com_tolerance,
+            lifted: toe >= lift_goal && heel >= lift_goal,
+            grounded: toe <= config.foot_height_tolerance && heel <= config.foot_height_tolerance,
+        }
+    }
+}
+
+/// The transition function of the graph in the module docs. `human` is the last non-airborne
+/// human support (an airborne value would count as DS).
+fn next_phase(
+    phase: SupportPhase,
+    human: HumanSupport,
+    m: &Measurements,
+    config: &PhaseConfig,
+) -> SupportPhase {
+    let done = Done::new(m, config);
+    let wanted = human_single(human);
+    match phase {
+        SupportPhase::Double => match wanted {
+            Some(foot) => take_off(foot, TakeOff::ComToFoot),
+            None => SupportPhase::Double,
+        },
+        SupportPhase::Right => after_single(Foot::Right, wanted),
+        SupportPhase::Left => after_single(Foot::Left, wanted),
+        SupportPhase::DoubleToRight(step) => after_take_off(Foot::Right, step, wanted, &done),
+        SupportPhase::DoubleToLeft(step) => after_take_off(Foot::Left, step, wanted, &done),
+        SupportPhase::RightToDouble(step) => after_landing(Foot::Right, step, wanted, &done),
+        SupportPhase::LeftToDouble(step) => after_landing(Foot::Left, step, wanted, &done),
+    }
+}
+
+/// Successor of single support on `support`: stay while the human stands on that foot alone,
+/// otherwise land the free foot (also when the human switched straight to the other foot).
+fn after_single(support: Foot, wanted: Option<Foot>) -> SupportPhase {
+    if wanted == Some(support) {
+        single(support)
+    } else {
+        landing(support, Landing::LowerFoot)
+    }
+}
+
+/// Successor of a take-off step toward single support on `support`.
+fn after_take_off(support: Foot, step: TakeOff, wanted: Option<Foot>, done: &Done) -> SupportPhase {
+    let stays = wanted == Some(support);
+    match step {
+        TakeOff::ComToFoot if !stays => SupportPhase::Double,
+        TakeOff::ComToFoot if done.com => take_off(support, TakeOff::LiftFoot),
+        TakeOff::LiftFoot if !stays => landing(support, Landing::LowerFoot),
+        TakeOff::LiftFoot if done.lifted => single(support),
+        TakeOff::ComToFoot | TakeOff::LiftFoot => take_off(support, step),
+    }
+}
+
+/// Successor of a landing step from single support on `support`.
+fn after_landing(support: Foot, step: Landing, wanted: Option<Foot>, done: &Done) -> SupportPhase {
+    let lifts_again = wanted == Some(support);
+    match step {
+        Landing::LowerFoot if lifts_again => take_off(support, TakeOff::LiftFoot),
+        Landing::LowerFoot if done.grounded => landing(support, Landing::ComToMiddle),
+        Landing::ComToMiddle if lifts_again => take_off(support, TakeOff::ComToFoot),
+        Landing::ComToMiddle if done.com => SupportPhase::Double,
+        Landing::LowerFoot | Landing::ComToMiddle => landing(support, step),
+    }
+}

@@ -1,0 +1,617 @@
+//! Task tables (Poubel §II.B, §IV.B, Table I) as data: for each [`SupportPhase`], the model root,
+//! the equality levels in priority order (balance first, then Cartesian tracking), the gradient
+//! (optimization) tasks with their weights κ, and whether the clamping loop runs.
+//!
+//! # Task targets
+//!
+//! All coordinates are in the frame of the table's model root (the support sole: x forward, y
+//! left, z up, origin on the ground under the ankle), in metres.
+//!
+//! * [`Task::ComXY`] — the CoM ground projection `X'_c = (x_c, y_c)`, 2 rows, with the goal
+//!   ([`ComGoal`]) `[0, 0]` (under the support ankle, single support), `[λ, 0]` (λ toward the
+//!   support foot's centre, while a foot is lifted or lowered), `p_A.xy / 2` (midway to the other
+//!   ankle `A`, DS) or `p_A.xy + λ·x̂_A` (λ toward the other foot's centre along that sole's x
+//!   axis, CoM moving to the foot that is not the model root).
+//! * [`Task::Point`] — the selected coordinates ([`Axes`]) of a named robot frame, with the
+//!   target ([`PointTarget`]) either the scaled human joint, or the frame "held": its horizontal
+//!   position when the step began, at its rest height (its height when its foot is flat on the
+//!   ground: 0 for a sole point, 0.04511 m for a NAO ankle) plus a lift (0 on the ground, ρ lifted).
+//!
+//! Gradient tasks add `κ_k ∇f_k(q)` in the null space of the equality levels (eq. 6): joint
+//! limits `f_ℓ` (eq. 7, κ = −0.10) and human joint tracking `f_h` (eq. 8, κ = −0.02).
+//!
+//! # Paper choices and corrections
+//!
+//! The printed Table I has typos, corrected here: "Lift RFoot" and "Lower RFoot" (LFoot model)
+//! track the right foot (`p_RA`, `z_RF`, `z_RT`), not `p_LA`; "zz_LT" is `z_LT`. `F` and `T`
+//! are the sole's front (toe) and heel ("talon") points, `l_toe` / `l_heel` here. The "DS to LS,
+//! CoM to LFoot" goal is the printed `[x_LA, y_LA]` shifted by λ toward the left foot's centre,
+//! so the goal does not jump by λ when "Lift RFoot" (goal `[λ, 0]` in the LFoot model) follows;
+//! §III.B asks for that offset whenever a foot is lifted or lowered. During transitions the hands
+//! are free (§IV.B) and the moving foot is held horizontally: the paper lowers a foot straight
+//! down and slides it to its scaled position once in DS (§IV.D).
+//!
+//! # Overriding
+//!
+//! Tables are plain data: read one with [`TaskTables::table`], clone, edit and put it back with
+//! [`TaskTables::set`] (which validates it), e.g. to track the head as well in RS:
+//!
+//! ```
+//! use taskstack::imitation::human::HumanJoint;
+//! use taskstack::imitation::phase::SupportPhase;
+//! use taskstack::imitation::tables::{Axes, PointTarget, Task, TaskTables};
+//!
+//! let mut tables = TaskTables::paper();
+//! let mut rs = tables.table(SupportPhase::Right).clone();
+//! rs.levels[1].tasks.push(Task::Point {
+//!     frame: "head".into(),
+//!     axes: Axes::XYZ,
+//!     target: PointTarget::Scaled(HumanJoint::Head),
+//! });
+//! tables.set(rs)?;
+//! let shape = tables.table(SupportPhase::Right).shape(23);
+//! assert_eq!(shape.level_rows().collect::<Vec<_>>(), vec![2, 12]);
+//! # Ok::<(), taskstack::imitation::tables::TableError>(())
+//! ```
+//!
+//! # Table I
+//!
+//! Generated from [`TaskTables::paper`] (`cargo run --example table1 > src/imitation/table1.md`;
+//! a unit test keeps this copy equal to the data):
+//!
+#![doc = include_str!("table1.md")]
+
+use std::collections::HashSet;
+use std::fmt;
+
+use super::human::HumanJoint;
+use super::phase::{Landing, PhaseConfig, SupportPhase, TakeOff};
+use crate::robots::nao::Foot;
+use crate::solver::StackShape;
+
+/// Goal of the CoM ground projection, in the model root's frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ComGoal {
+    /// `[0, 0]`: under the support (root) ankle.
+    SupportAnkle,
+    /// `[λ, 0]`: `lambda` metres forward of the support ankle, toward the foot's centre.
+    SupportFootCentre {
+        /// Offset λ (m).
+        lambda: f64,
+    },
+    /// `p_A.xy / 2`: midway between the support ankle and the other ankle `A`.
+    MidAnkles,
+    /// `p_A.xy + λ·x̂_A`: `lambda` metres ahead of the other ankle along its sole's x axis.
+    OtherFootCentre {
+        /// Offset λ (m).
+        lambda: f64,
+    },
+}
+
+/// Which Cartesian coordinates of a frame are tracked.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Axes {
+    /// Track x (forward).
+    pub x: bool,
+    /// Track y (left).
+    pub y: bool,
+    /// Track z (up).
+    pub z: bool,
+}
+
+impl Axes {
+    /// All three coordinates.
+    pub const XYZ: Axes = Axes {
+        x: true,
+        y: true,
+        z: true,
+    };
+    /// The height only.
+    pub const Z: Axes = Axes {
+        x: false,
+        y: false,
+        z: true,
+    };
+
+    /// Number of tracked coordinates (task rows).
+    pub const fn count(self) -> usize {
+        self.x as usize + self.y as usize + self.z as usize
+    }
+
+    /// `""` for xyz, else `".xz"`-style suffix of the selected axes.
+    fn suffix(self) -> String {
+        if self == Axes::XYZ {
+            return String::new();
+        }
+        let picked = [(self.x, 'x'), (self.y, 'y'), (self.z, 'z')];
+        std::iter::once('.')
+            .chain(picked.iter().filter(|(on, _)| *on).map(|&(_, c)| c))
+            .collect()
+    }
+}
+
+/// Target of a [`Task::Point`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PointTarget {
+    /// The position of this joint of the scaled human (robot proportions, model root frame).
+    Scaled(HumanJoint),
+    /// The frame's horizontal position when the step began, at its rest height plus `lift`.
+    Held {
+        /// Height above the rest height (m): 0 on the ground, ρ for a lifted foot.
+        lift: f64,
+    },
+}
+
+/// One tracked task of an equality level.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Task {
+    /// The CoM ground projection (2 rows).
+    ComXY(ComGoal),
+    /// Coordinates of a named robot frame (see `robots::nao::FRAMES`), 1–3 rows.
+    Point {
+        /// Frame name, e.g. `"l_hand"`.
+        frame: String,
+        /// The tracked coordinates.
+        axes: Axes,
+        /// Where they go.
+        target: PointTarget,
+    },
+}
+
+impl Task {
+    /// The task's name in the stack: `"com_xy"`, the frame name, or the frame name with the axes
+    /// (`"l_toe.z"`) when not all three are tracked.
+    pub fn name(&self) -> String {
+        match self {
+            Task::ComXY(_) => "com_xy".to_owned(),
+            Task::Point { frame, axes, .. } => format!("{frame}{}", axes.suffix()),
+        }
+    }
+
+    /// Number of rows (tracked coordinates).
+    pub fn rows(&self) -> usize {
+        match self {
+            Task::ComXY(_) => 2,
+            Task::Point { axes, .. } => axes.count(),
+        }
+    }
+}
+
+/// An equality level: tasks of equal priority, stacked in order.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Level {
+    /// Level name (`"balance"`, `"tracking"`).
+    pub name: String,
+    /// The tasks.
+    pub tasks: Vec<Task>,
+}
+
+/// An optimization (gradient) task.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum GradientKind {
+    /// Stay near the middle of the joint ranges (eq. 7).
+    JointLimits,
+    /// Follow the human's joint angles (eq. 8).
+    HumanJoints,
+}
+
+/// A gradient task and its weight κ (dimensionless; negative descends `f`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Gradient {
+    /// Which function.
+    pub kind: GradientKind,
+    /// Weight κ.
+    pub kappa: f64,
+}
+
+/// Everything the IK solves in one phase.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TaskTable {
+    /// The phase this table is for.
+    pub phase: SupportPhase,
+    /// The sole the model is rooted at (all targets are in its frame).
+    pub model_root: Foot,
+    /// Equality levels, highest priority first.
+    pub levels: Vec<Level>,
+    /// Gradient tasks, summed in the null space of all levels.
+    pub gradients: Vec<Gradient>,
+    /// Whether the clamping loop (fix violating joints at their limit and re-solve) runs.
+    pub clamping: bool,
+}
+
+/// Errors of a task table.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum TableError {
+    /// The table has no equality level.
+    #[error("task table {phase}: no equality level")]
+    NoLevel {
+        /// The table's phase.
+        phase: SupportPhase,
+    },
+    /// A level has no rows.
+    #[error("task table {phase}: level {level:?} has no rows")]
+    EmptyLevel {
+        /// The table's phase.
+        phase: SupportPhase,
+        /// The level's name.
+        level: String,
+    },
+    /// A point task tracks no coordinate.
+    #[error("task table {phase}: task {task:?} tracks no axis")]
+    NoAxis {
+        /// The table's phase.
+        phase: SupportPhase,
+        /// The task's name.
+        task: String,
+    },
+    /// Two tasks share a name (the solver addresses tasks by name).
+    #[error("task table {phase}: task {task:?} appears twice")]
+    DuplicateTask {
+        /// The table's phase.
+        phase: SupportPhase,
+        /// The task's name.
+        task: String,
+    },
+    /// A number (κ, λ or lift) is NaN or infinite.
+    #[error("task table {phase}: {field} of {task:?} is not finite")]
+    NotFinite {
+        /// The table's phase.
+        phase: SupportPhase,
+        /// The task's name (or the gradient kind).
+        task: String,
+        /// Which number.
+        field: &'static str,
+    },
+}
+
+fn foot_name(foot: Foot) -> &'static str {
+    match foot {
+        Foot::Right => "RFoot",
+        Foot::Left => "LFoot",
+    }
+}
+
+/// Frame names of a foot's ankle, toe and heel points (see `robots::nao::FRAMES`).
+fn foot_frames(foot: Foot) -> [&'static str; 3] {
+    match foot {
+        Foot::Right => ["r_ankle", "r_toe", "r_heel"],
+        Foot::Left => ["l_ankle", "l_toe", "l_heel"],
+    }
+}
+
+fn human_ankle(foot: Foot) -> HumanJoint {
+    match foot {
+        Foot::Right => HumanJoint::RAnkle,
+        Foot::Left => HumanJoint::LAnkle,
+    }
+}
+
+impl TaskTable {
+    /// The paper's table for `phase` (Table I with the corrections in the module docs), with λ
+    /// and ρ from `config`.
+    pub fn paper(phase: SupportPhase, config: &PhaseConfig) -> Self {
+        let root = phase.model_root();
+        let free = root.other();
+        let [ankle, toe, heel] = foot_frames(free);
+        let point = |frame: &str, axes, target| Task::Point {
+            frame: frame.to_owned(),
+            axes,
+            target,
+        };
+        let hands = || {
+            vec![
+                point("l_hand", Axes::XYZ, PointTarget::Scaled(HumanJoint::LHand)),
+                point("r_hand", Axes::XYZ, PointTarget::Scaled(HumanJoint::RHand)),
+            ]
+        };
+        // The free foot held flat at `lift` above the ground: 5 rows.
+        let held_foot = |lift| {
+            let held = PointTarget::Held { lift };
+            vec![
+                point(ankle, Axes::XYZ, held),
+                point(toe, Axes::Z, held),
+                point(heel, Axes::Z, held),
+            ]
+        };
+        let lambda = config.lambda;
+        let (com, tracking) = match phase {
+            SupportPhase::Right | SupportPhase::Left => {
+                let mut tasks = hands();
+                tasks.push(point(
+                    ankle,
+                    Axes::XYZ,
+                    PointTarget::Scaled(human_ankle(free)),
+                ));
+                (ComGoal::SupportAnkle, tasks)
+            }
+            SupportPhase::Double => {
+                let mut tasks = hands();
+                tasks.push(point(
+                    ankle,
+                    Axes::XYZ,
+                    PointTarget::Scaled(human_ankle(free)),
+                ));
+                tasks.extend(held_foot(0.0).into_iter().skip(1));
+                (ComGoal::MidAnkles, tasks)
+            }
+            SupportPhase::DoubleToRight(step) | SupportPhase::DoubleToLeft(step) => {
+                let future_support = match phase {
+                    SupportPhase::DoubleToLeft(_) => Foot::Left,
+                    _ => Foot::Right,
+                };
+                let toward_root = future_support == root;
+                match step {
+                    TakeOff::ComToFoot if toward_root => {
+                        (ComGoal::SupportFootCentre { lambda }, held_foot(0.0))
+                    }
+                    TakeOff::ComToFoot => (ComGoal::OtherFootCentre { lambda }, held_foot(0.0)),
+                    TakeOff::LiftFoot => {
+                        (ComGoal::SupportFootCentre { lambda }, held_foot(config.rho))
+                    }
+                }
+            }
+            SupportPhase::RightToDouble(step) | SupportPhase::LeftToDouble(step) => match step {
+                Landing::LowerFoot => (ComGoal::SupportFootCentre { lambda }, held_foot(0.0)),
+                Landing::ComToMiddle => (ComGoal::MidAnkles, held_foot(0.0)),
+            },
+        };
+        Self {
+            phase,
+            model_root: root,
+            levels: vec![
+                Level {
+                    name: "balance".to_owned(),
+                    tasks: vec![Task::ComXY(com)],
+                },
+                Level {
+                    name: "tracking".to_owned(),
+                    tasks: tracking,
+                },
+            ],
+            gradients: vec![
+                Gradient {
+                    kind: GradientKind::JointLimits,
+                    kappa: -0.10,
+                },
+                Gradient {
+                    kind: GradientKind::HumanJoints,
+                    kappa: -0.02,
+                },
+            ],
+            clamping: true,
+        }
+    }
+
+    /// The solver stack shape over `dof` joints: one level per [`Level`], one named task (see
+    /// [`Task::name`]) per [`Task`].
+    pub fn shape(&self, dof: usize) -> StackShape {
+        self.levels
+            .iter()
+            .fold(StackShape::new(dof), |shape, level| {
+                let names: Vec<(String, usize)> =
+                    level.tasks.iter().map(|t| (t.name(), t.rows())).collect();
+                let tasks: Vec<(&str, usize)> =
+                    names.iter().map(|(n, r)| (n.as_str(), *r)).collect();
+                shape.with_level(&level.name, &tasks)
+            })
+    }
+
+    /// Checks the table: at least one level, every level with rows, every point task with an
+    /// axis, task names unique, every number finite.
+    pub fn validate(&self) -> Result<(), TableError> {
+        let phase = self.phase;
+        if self.levels.is_empty() {
+            return Err(TableError::NoLevel { phase });
+        }
+        let mut names = HashSet::new();
+        for level in &self.levels {
+            if level.tasks.iter().map(Task::rows).sum::<usize>() == 0 {
+                return Err(TableError::EmptyLevel {
+                    phase,
+                    level: level.name.clone(),
+                });
+            }
+            for task in &level.tasks {
+                let name = task.name();
+                let not_finite = |field| TableError::NotFinite {
+                    phase,
+                    task: name.clone(),
+                    field,
+                };
+                match task {
+                    Task::ComXY(
+                        ComGoal::SupportFootCentre { lambda } | ComGoal::OtherFootCentre { lambda },
+                    ) if !lambda.is_finite() => return Err(not_finite("lambda")),
+                    Task::Point { axes, .. } if axes.count() == 0 => {
+                        return Err(TableError::NoAxis { phase, task: name });
+                    }
+                    Task::Point {
+                        target: PointTarget::Held { lift },
+                        ..
+                    } if !lift.is_finite() => return Err(not_finite("lift")),
+                    Task::ComXY(_) | Task::Point { .. } => {}
+                }
+                if !names.insert(name.clone()) {
+                    return Err(TableError::DuplicateTask { phase, task: name });
+                }
+            }
+        }
+        if let Some(g) = self.gradients.iter().find(|g| !g.kappa.is_finite()) {
+            return Err(TableError::NotFinite {
+                phase,
+                task: format!("{:?}", g.kind),
+                field: "kappa",
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Millimetres of a length in metres, for the rendering (`0.03` → `"30 mm"`, `0.0` → `"0"`).
+fn mm(metres: f64) -> String {
+    if metres == 0.0 {
+        return "0".to_owned();
+    }
+    format!("{} mm", (metres * 1000.0 * 1000.0).round() / 1000.0)
+}
+
+struct ComCell<'a>(&'a ComGoal, Foot);
+
+impl fmt::Display for ComCell<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let other = foot_frames(self.1.other())[0];
+        match *self.0 {
+            ComGoal::SupportAnkle => f.write_str("[0, 0]"),
+            ComGoal::SupportFootCentre { lambda } => write!(f, "[λ, 0], λ = {}", mm(lambda)),
+            ComGoal::MidAnkles => write!(f, "p({other}).xy / 2"),
+            ComGoal::OtherFootCentre { lambda } => {
+                write!(
+                    f,
+                    "p({other}).xy + λ·x̂({}), λ = {}",
+                    self.1.other().sole(),
+                    mm(lambda)
+                )
+            }
+        }
+    }
+}
+
+struct PointCell<'a>(&'a str, Axes, PointTarget);
+
+impl fmt::Display for PointCell<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let PointCell(frame, axes, target) = *self;
+        let coords = if axes == Axes::XYZ {
+            format!("p({frame})")
+        } else {
+            format!("{}({frame})", &axes.suffix()[1..])
+        };
+        match target {
+            PointTarget::Scaled(joint) => write!(f, "{coords} ← {}", joint.name()),
+            PointTarget::Held { lift } if axes == Axes::Z => write!(f, "{coords} = {}", mm(lift)),
+            PointTarget::Held { lift: 0.0 } => write!(f, "{coords} held"),
+            PointTarget::Held { lift } => write!(f, "{coords} held, lifted {}", mm(lift)),
+        }
+    }
+}
+
+impl fmt::Display for TaskTable {
+    /// One markdown row like Table I: Support | Step | Model | X_t | X'_c | Gradients (κ).
+    /// Levels after the first CoM level are separated by ` ≻ ` (higher priority first).
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let mut tracked = Vec::new();
+        let mut coms = Vec::new();
+        let mut rows = 0;
+        for level in &self.levels {
+            let mut cells = Vec::new();
+            for task in &level.tasks {
+                match task {
+                    Task::ComXY(goal) => coms.push(ComCell(goal, self.model_root).to_string()),
+                    Task::Point {
+                        frame,
+                        axes,
+                        target,
+                    } => {
+                        rows += task.rows();
+                        cells.push(PointCell(frame, *axes, *target).to_string());
+                    }
+                }
+            }
+            if !cells.is_empty() {
+                tracked.push(cells.join(", "));
+            }
+        }
+        let gradients: Vec<String> = self
+            .gradients
+            .iter()
+            .map(|g| {
+                let name = match g.kind {
+                    GradientKind::JointLimits => "limits",
+                    GradientKind::HumanJoints => "human joints",
+                };
+                format!("{name} {:.2}", g.kappa)
+            })
+            .collect();
+        write!(
+            f,
+            "| {} | {} | {} | ({rows}×1) {} | ({}×1) {} | {}{} |",
+            self.phase.support_name(),
+            self.phase.step_name().unwrap_or(""),
+            foot_name(self.model_root),
+            tracked.join(" ≻ "),
+            2 * coms.len(),
+            coms.join("; "),
+            gradients.join(", "),
+            if self.clamping { "; clamping" } else { "" },
+        )
+    }
+}
+
+/// The task tables of all 11 phases.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TaskTables {
+    /// Indexed by [`SupportPhase::index`].
+    tables: Vec<TaskTable>,
+}
+
+impl TaskTables {
+    /// Table I with the paper's λ = 15 mm and ρ = 30 mm.
+    pub fn paper() -> Self {
+        Self::from_config(&PhaseConfig::default())
+    }
+
+    /// Table I with λ and ρ from `config`.
+    pub fn from_config(config: &PhaseConfig) -> Self {
+        Self {
+            tables: SupportPhase::ALL
+                .iter()
+                .map(|&phase| TaskTable::paper(phase, config))
+                .collect(),
+        }
+    }
+
+    /// The table of `phase`.
+    pub fn table(&self, phase: SupportPhase) -> &TaskTable {
+        &self.tables[phase.index()]
+    }
+
+    /// Replaces the table of `table.phase` after validating it.
+    pub fn set(&mut self, table: TaskTable) -> Result<(), TableError> {
+        table.validate()?;
+        let index = table.phase.index();
+        self.tables[index] = table;
+        Ok(())
+    }
+
+    /// All tables, in the row order of Table I ([`SupportPhase::ALL`]).
+    pub fn iter(&self) -> impl Iterator<Item = &TaskTable> {
+        self.tables.iter()
+    }
+}
+
+impl fmt::Display for TaskTables {
+    /// The whole table as markdown (header, then one row per phase in Table I order).
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(f, "| Support | Step | Model | X_t | X'_c | Gradients (κ) |")?;
+        writeln!(f, "|---|---|---|---|---|---|")?;
+        for table in &self.tables {
+            writeln!(f, "{table}")?;
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The docs include `table1.md`; it must be exactly the rendering of the data.
+    #[test]
+    fn checked_in_table_matches_the_data() {
+        assert_eq!(
+            include_str!("table1.md"),
+            TaskTables::paper().to_string(),
+            "regenerate with `cargo run --example table1 > src/imitation/table1.md`"
+        );
+    }
+}

@@ -1,0 +1,473 @@
+//! The support-phase machine and the paper's task tables (Poubel §III.B, §IV.B, Table I).
+
+use proptest::prelude::*;
+use taskstack::imitation::phase::{
+    Landing, Measurements, PhaseConfig, PhaseError, PhaseMachine, SupportPhase, TakeOff,
+};
+use taskstack::imitation::support::HumanSupport;
+use taskstack::imitation::tables::{Gradient, GradientKind, TableError, Task, TaskTables};
+use taskstack::robots::nao::Foot;
+
+use HumanSupport as H;
+use SupportPhase as P;
+
+/// CoM far from its goal (40 mm > 5 mm tolerance), swing sole on the ground.
+const FAR: Measurements = Measurements {
+    com_error: 0.040,
+    swing_toe_height: 0.0,
+    swing_heel_height: 0.0,
+};
+/// CoM 1 mm from its goal (< 5 mm), swing sole on the ground.
+const COM_OK: Measurements = Measurements {
+    com_error: 0.001,
+    swing_toe_height: 0.0,
+    swing_heel_height: 0.0,
+};
+/// Swing sole half-way up (10 mm: neither ≥ ρ − 2 mm = 28 mm nor ≤ 2 mm).
+const HALF_UP: Measurements = Measurements {
+    com_error: 0.001,
+    swing_toe_height: 0.010,
+    swing_heel_height: 0.010,
+};
+/// Swing sole lifted: toe 30 mm, heel 28.5 mm, both ≥ 28 mm.
+const LIFTED: Measurements = Measurements {
+    com_error: 0.001,
+    swing_toe_height: 0.030,
+    swing_heel_height: 0.0285,
+};
+/// Swing sole down: 1 mm ≤ 2 mm.
+const DOWN: Measurements = Measurements {
+    com_error: 0.040,
+    swing_toe_height: 0.001,
+    swing_heel_height: 0.001,
+};
+
+fn run(machine: &mut PhaseMachine, steps: &[(HumanSupport, Measurements, SupportPhase)]) {
+    for (i, (human, measured, expected)) in steps.iter().enumerate() {
+        assert_eq!(
+            machine.update(*human, measured),
+            *expected,
+            "step {i}: human {human:?}, {measured:?}"
+        );
+    }
+}
+
+fn machine() -> PhaseMachine {
+    PhaseMachine::new(PhaseConfig::default()).unwrap()
+}
+
+#[test]
+fn a_step_forward_goes_through_every_step_in_order() {
+    let mut m = machine();
+    run(
+        &mut m,
+        &[
+            (H::Double, FAR, P::Double),
+            (H::Right, FAR, P::DoubleToRight(TakeOff::ComToFoot)),
+            (H::Right, FAR, P::DoubleToRight(TakeOff::ComToFoot)),
+            (H::Right, COM_OK, P::DoubleToRight(TakeOff::LiftFoot)),
+            (H::Right, HALF_UP, P::DoubleToRight(TakeOff::LiftFoot)),
+            (H::Right, LIFTED, P::Right),
+            (H::Right, DOWN, P::Right),
+            (H::Double, LIFTED, P::RightToDouble(Landing::LowerFoot)),
+            (H::Double, HALF_UP, P::RightToDouble(Landing::LowerFoot)),
+            (H::Double, DOWN, P::RightToDouble(Landing::ComToMiddle)),
+            (H::Double, FAR, P::RightToDouble(Landing::ComToMiddle)),
+            (H::Double, COM_OK, P::Double),
+        ],
+    );
+}
+
+#[test]
+fn foot_put_back_down_mid_lift_lands_it_then_recentres() {
+    let mut m = machine();
+    run(
+        &mut m,
+        &[
+            (H::Left, COM_OK, P::DoubleToLeft(TakeOff::ComToFoot)),
+            (H::Left, COM_OK, P::DoubleToLeft(TakeOff::LiftFoot)),
+            (H::Double, HALF_UP, P::LeftToDouble(Landing::LowerFoot)),
+            (H::Double, DOWN, P::LeftToDouble(Landing::ComToMiddle)),
+            (H::Double, COM_OK, P::Double),
+        ],
+    );
+}
+
+#[test]
+fn foot_put_back_down_during_the_com_shift_aborts_to_double_support() {
+    let mut m = machine();
+    run(
+        &mut m,
+        &[
+            (H::Right, FAR, P::DoubleToRight(TakeOff::ComToFoot)),
+            (H::Double, FAR, P::Double),
+        ],
+    );
+}
+
+#[test]
+fn foot_lifted_again_while_landing_is_lifted_again() {
+    let mut m = machine();
+    run(
+        &mut m,
+        &[
+            (H::Right, COM_OK, P::DoubleToRight(TakeOff::ComToFoot)),
+            (H::Right, COM_OK, P::DoubleToRight(TakeOff::LiftFoot)),
+            (H::Right, LIFTED, P::Right),
+            (H::Double, LIFTED, P::RightToDouble(Landing::LowerFoot)),
+            (H::Right, HALF_UP, P::DoubleToRight(TakeOff::LiftFoot)),
+            (H::Double, HALF_UP, P::RightToDouble(Landing::LowerFoot)),
+            (H::Double, DOWN, P::RightToDouble(Landing::ComToMiddle)),
+            // Lifted again once both feet are down: the CoM goes back over the right foot first.
+            (H::Right, DOWN, P::DoubleToRight(TakeOff::ComToFoot)),
+        ],
+    );
+}
+
+#[test]
+fn walking_from_right_to_left_support_goes_through_double_support() {
+    let mut m = machine();
+    run(
+        &mut m,
+        &[
+            (H::Right, COM_OK, P::DoubleToRight(TakeOff::ComToFoot)),
+            (H::Right, COM_OK, P::DoubleToRight(TakeOff::LiftFoot)),
+            (H::Right, LIFTED, P::Right),
+            (H::Left, LIFTED, P::RightToDouble(Landing::LowerFoot)),
+            (H::Left, DOWN, P::RightToDouble(Landing::ComToMiddle)),
+            (H::Left, COM_OK, P::Double),
+            (H::Left, FAR, P::DoubleToLeft(TakeOff::ComToFoot)),
+            (H::Left, COM_OK, P::DoubleToLeft(TakeOff::LiftFoot)),
+            (H::Left, LIFTED, P::Left),
+        ],
+    );
+}
+
+#[test]
+fn airborne_keeps_the_last_support() {
+    let mut m = machine();
+    run(
+        &mut m,
+        &[
+            (H::Airborne, COM_OK, P::Double),
+            (H::Right, COM_OK, P::DoubleToRight(TakeOff::ComToFoot)),
+            (H::Airborne, COM_OK, P::DoubleToRight(TakeOff::LiftFoot)),
+            (H::Airborne, LIFTED, P::Right),
+            (H::Airborne, DOWN, P::Right),
+        ],
+    );
+    assert_eq!(m.human_support(), H::Right);
+}
+
+#[test]
+fn nan_measurements_never_end_a_step() {
+    let nan = Measurements {
+        com_error: f64::NAN,
+        swing_toe_height: f64::NAN,
+        swing_heel_height: f64::NAN,
+    };
+    let half_nan = Measurements {
+        swing_heel_height: f64::NAN,
+        ..LIFTED
+    };
+    let mut m = machine();
+    run(
+        &mut m,
+        &[
+            (H::Right, nan, P::DoubleToRight(TakeOff::ComToFoot)),
+            (H::Right, nan, P::DoubleToRight(TakeOff::ComToFoot)),
+            (H::Right, COM_OK, P::DoubleToRight(TakeOff::LiftFoot)),
+            (H::Right, half_nan, P::DoubleToRight(TakeOff::LiftFoot)),
+            (H::Right, nan, P::DoubleToRight(TakeOff::LiftFoot)),
+        ],
+    );
+}
+
+#[test]
+fn bad_config_is_rejected_naming_the_field() {
+    let cases = [
+        (
+            PhaseConfig {
+                com_tolerance: f64::NAN,
+                ..PhaseConfig::default()
+            },
+            "com_tolerance",
+        ),
+        (
+            PhaseConfig {
+                lambda: -0.01,
+                ..PhaseConfig::default()
+            },
+            "lambda",
+        ),
+        (
+            PhaseConfig {
+                foot_height_tolerance: 0.0,
+                ..PhaseConfig::default()
+            },
+            "foot_height_tolerance",
+        ),
+        // ρ = 4 mm ≤ 2 × 2 mm: a foot could be "lifted" and "on the ground" at once.
+        (
+            PhaseConfig {
+                rho: 0.004,
+                ..PhaseConfig::default()
+            },
+            "rho",
+        ),
+    ];
+    for (config, field) in cases {
+        match PhaseMachine::new(config) {
+            Err(PhaseError::Config(f, _)) => assert_eq!(f, field),
+            other => panic!("{field}: expected a config error, got {other:?}"),
+        }
+    }
+}
+
+#[test]
+fn paper_defaults_are_the_papers_values() {
+    let c = PhaseConfig::default();
+    assert_eq!((c.lambda, c.rho), (0.015, 0.030));
+}
+
+fn level_rows(tables: &TaskTables, phase: SupportPhase) -> Vec<usize> {
+    tables.table(phase).shape(23).level_rows().collect()
+}
+
+fn tracks_a_hand(tables: &TaskTables, phase: SupportPhase) -> bool {
+    tables.table(phase).levels.iter().any(|l| {
+        l.tasks
+            .iter()
+            .any(|t| matches!(t, Task::Point { frame, .. } if frame.ends_with("_hand")))
+    })
+}
+
+#[test]
+fn paper_tables_have_table_one_row_counts() {
+    let tables = TaskTables::paper();
+    // Table I: X'_c is 2×1 everywhere; X_t is 9×1 in RS and LS, 11×1 in DS, 5×1 in transitions.
+    assert_eq!(level_rows(&tables, P::Right), vec![2, 9]);
+    assert_eq!(level_rows(&tables, P::Left), vec![2, 9]);
+    assert_eq!(level_rows(&tables, P::Double), vec![2, 11]);
+    for phase in SupportPhase::ALL.into_iter().filter(|p| p.is_transition()) {
+        assert_eq!(level_rows(&tables, phase), vec![2, 5], "{phase}");
+        assert!(!tracks_a_hand(&tables, phase), "{phase}: hands are free");
+    }
+    for phase in [P::Right, P::Left, P::Double] {
+        assert!(tracks_a_hand(&tables, phase), "{phase}");
+    }
+    for table in tables.iter() {
+        table.validate().unwrap();
+        assert_eq!(
+            table.levels[0].tasks.len(),
+            1,
+            "{}: balance first",
+            table.phase
+        );
+        assert!(matches!(table.levels[0].tasks[0], Task::ComXY(_)));
+        assert_eq!(
+            table.gradients,
+            vec![
+                Gradient {
+                    kind: GradientKind::JointLimits,
+                    kappa: -0.10
+                },
+                Gradient {
+                    kind: GradientKind::HumanJoints,
+                    kappa: -0.02
+                },
+            ]
+        );
+        assert!(table.clamping);
+    }
+    assert_eq!(tables.iter().count(), 11);
+}
+
+#[test]
+fn paper_model_roots_follow_section_iv_b() {
+    let tables = TaskTables::paper();
+    // LFoot only while the right foot is off the ground or being lowered (Table I "Model").
+    let left_rooted = [
+        P::Left,
+        P::DoubleToLeft(TakeOff::LiftFoot),
+        P::LeftToDouble(Landing::LowerFoot),
+    ];
+    for phase in SupportPhase::ALL {
+        let expected = if left_rooted.contains(&phase) {
+            Foot::Left
+        } else {
+            Foot::Right
+        };
+        assert_eq!(tables.table(phase).model_root, expected, "{phase}");
+    }
+}
+
+#[test]
+fn overrides_are_validated() {
+    let mut tables = TaskTables::paper();
+    let mut ds = tables.table(P::Double).clone();
+    let first = ds.levels[1].tasks[0].clone();
+    ds.levels[1].tasks.push(first);
+    assert!(matches!(
+        tables.set(ds),
+        Err(TableError::DuplicateTask { task, .. }) if task == "l_hand"
+    ));
+    let mut rs = tables.table(P::Right).clone();
+    rs.gradients[1].kappa = f64::NAN;
+    assert!(matches!(
+        tables.set(rs.clone()),
+        Err(TableError::NotFinite { field: "kappa", .. })
+    ));
+    rs.gradients.clear();
+    rs.clamping = false;
+    tables.set(rs.clone()).unwrap();
+    assert_eq!(tables.table(P::Right), &rs);
+    // The other tables are untouched.
+    assert_eq!(tables.table(P::Left), TaskTables::paper().table(P::Left));
+}
+
+#[test]
+fn phases_print_like_table_one() {
+    assert_eq!(P::Double.to_string(), "DS");
+    assert_eq!(
+        P::DoubleToLeft(TakeOff::ComToFoot).to_string(),
+        "DS to LS: CoM to LFoot"
+    );
+    assert_eq!(
+        P::LeftToDouble(Landing::ComToMiddle).to_string(),
+        "LS to DS: CoM to middle"
+    );
+    let row = TaskTables::paper().table(P::Right).to_string();
+    assert!(
+        row.starts_with("| RS |  | RFoot | (9×1) p(l_hand) ← LHand"),
+        "{row}"
+    );
+}
+
+/// The documented graph (module docs of `imitation::phase`), written out independently: every
+/// phase with its possible successors, itself included.
+fn allowed(from: SupportPhase, to: SupportPhase) -> bool {
+    use Landing::{ComToMiddle, LowerFoot};
+    use TakeOff::{ComToFoot, LiftFoot};
+    let edges: &[(SupportPhase, &[SupportPhase])] = &[
+        (
+            P::Double,
+            &[
+                P::Double,
+                P::DoubleToRight(ComToFoot),
+                P::DoubleToLeft(ComToFoot),
+            ],
+        ),
+        (P::Right, &[P::Right, P::RightToDouble(LowerFoot)]),
+        (P::Left, &[P::Left, P::LeftToDouble(LowerFoot)]),
+        (
+            P::DoubleToRight(ComToFoot),
+            &[P::Double, P::DoubleToRight(LiftFoot)],
+        ),
+        (
+            P::DoubleToLeft(ComToFoot),
+            &[P::Double, P::DoubleToLeft(LiftFoot)],
+        ),
+        (
+            P::DoubleToRight(LiftFoot),
+            &[P::Right, P::RightToDouble(LowerFoot)],
+        ),
+        (
+            P::DoubleToLeft(LiftFoot),
+            &[P::Left, P::LeftToDouble(LowerFoot)],
+        ),
+        (
+            P::RightToDouble(LowerFoot),
+            &[P::RightToDouble(ComToMiddle), P::DoubleToRight(LiftFoot)],
+        ),
+        (
+            P::LeftToDouble(LowerFoot),
+            &[P::LeftToDouble(ComToMiddle), P::DoubleToLeft(LiftFoot)],
+        ),
+        (
+            P::RightToDouble(ComToMiddle),
+            &[P::Double, P::DoubleToRight(ComToFoot)],
+        ),
+        (
+            P::LeftToDouble(ComToMiddle),
+            &[P::Double, P::DoubleToLeft(ComToFoot)],
+        ),
+    ];
+    from == to
+        || edges
+            .iter()
+            .any(|(f, targets)| *f == from && targets.contains(&to))
+}
+
+fn human() -> impl Strategy<Value = HumanSupport> {
+    prop_oneof![
+        Just(H::Double),
+        Just(H::Right),
+        Just(H::Left),
+        Just(H::Airborne)
+    ]
+}
+
+fn measurement() -> impl Strategy<Value = Measurements> {
+    let length = prop_oneof![
+        Just(0.0),
+        Just(0.001),
+        Just(0.030),
+        Just(f64::NAN),
+        Just(f64::INFINITY),
+        -0.01..0.06f64,
+    ];
+    (length.clone(), length.clone(), length).prop_map(|(c, t, h)| Measurements {
+        com_error: c,
+        swing_toe_height: t,
+        swing_heel_height: h,
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(256))]
+
+    #[test]
+    fn random_human_sequences_stay_on_the_graph(
+        steps in proptest::collection::vec((human(), measurement()), 1..80)
+    ) {
+        let tables = TaskTables::paper();
+        let config = PhaseConfig::default();
+        let mut m = PhaseMachine::new(config).unwrap();
+        let mut last_human = H::Double;
+        for (human, measured) in steps {
+            let from = m.phase();
+            let to = m.update(human, &measured);
+            if human != H::Airborne {
+                last_human = human;
+            }
+            prop_assert!(allowed(from, to), "{from} → {to} on {human:?}, {measured:?}");
+            prop_assert_eq!(m.phase(), to);
+            let table = tables.table(to);
+            prop_assert_eq!(table.phase, to);
+            prop_assert_eq!(table.model_root, to.model_root());
+            // The tracked foot is never the model root (it is fixed to the world).
+            let root_ankle = match to.model_root() { Foot::Right => "r_ankle", Foot::Left => "l_ankle" };
+            let tracks_root = table.levels.iter().flat_map(|l| &l.tasks).any(
+                |t| matches!(t, Task::Point { frame, .. } if frame == root_ankle)
+            );
+            prop_assert!(!tracks_root, "{to} tracks its own root ankle");
+            // A single support is entered only on the human's word and a measured lift.
+            let lift_goal = config.rho - config.foot_height_tolerance;
+            if matches!(to, P::Right | P::Left) && from != to {
+                prop_assert_eq!(last_human, if to == P::Right { H::Right } else { H::Left });
+                prop_assert!(measured.swing_toe_height >= lift_goal);
+                prop_assert!(measured.swing_heel_height >= lift_goal);
+            }
+            // Double support is reached only while the human stands on both feet or switches
+            // feet (never while they stand on the foot the robot was moving to).
+            if to == P::Double && from != P::Double {
+                let toward = match from {
+                    P::DoubleToRight(_) | P::RightToDouble(_) => H::Right,
+                    _ => H::Left,
+                };
+                prop_assert_ne!(last_human, toward);
+            }
+        }
+    }
+}
