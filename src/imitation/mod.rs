@@ -7,4 +7,5 @@
 //! [`support::HumanSupport`] phases (Poubel §III.A).
 
 pub mod human;
+pub mod scaler;
 pub mod support;
