@@ -69,7 +69,7 @@
 //! | ElbowYaw | left `atan2(−f'_z, −f'_y)`, right `atan2(f'_z, f'_y)` | if the elbow is bent |
 //! | HipRoll | `atan2(t_y, −t_z)` | yes if HipYawPitch = 0 |
 //! | HipPitch | `atan2(−t_x, √(t_y²+t_z²))` | yes if HipYawPitch = 0 |
-//! | KneePitch | `±atan2(|t×s|, t·s)`, sign of `(t×s)·R_x(hip roll)·y` | yes |
+//! | KneePitch | `±atan2(|t×s|, t·s)`, sign of `(t×s)·y` | yes |
 //! | AnklePitch | `atan2(n_x, n_z)`, `n = (R_x(hr)·R_y(hp+kp))⁻¹·z_world` | no: sole kept parallel to the ground |
 //! | AnkleRoll | `atan2(−n_y, √(n_x²+n_z²))` | no: same |
 //! | HeadPitch | `atan2(h_x, h_z)`, `h` = Neck→Head in `T` | roughly |
@@ -77,7 +77,9 @@
 //!
 //! Angles are clipped to the model's limits. Where an angle is undefined (arm along the
 //! shoulder-roll axis, straight elbow for ElbowYaw, thigh horizontal for HipRoll) the previous
-//! value is kept (0 at first). The ankles are not observable: the human ankle and toe points say
+//! value is kept (0 at first). NAO's forearm at ElbowRoll = 0 is parallel to the upper-arm
+//! frame, which is turned by `δ` from shoulder→elbow, so a straight human arm gives
+//! |ElbowRoll| = |δ| = 0.1419 (exactly what the robot's own straight-looking arm has). The ankles are not observable: the human ankle and toe points say
 //! little about the sole's orientation, so the ankles keep the robot's sole level.
 
 use nalgebra::{Matrix3, Rotation3, Vector2, Vector3};
@@ -1065,7 +1067,7 @@ impl NaoJointAngles {
             keep(
                 &mut a,
                 NaoIndex::ElbowYaw(side),
-                defined(f_yz).map(|_| (-sign * fl.z).atan2(-sign * fl.y)),
+                defined(f_yz).map(|_| (sign * fl.z).atan2(sign * fl.y)),
             );
 
             let t = to_torso * d(knee(side));
@@ -1079,10 +1081,11 @@ impl NaoJointAngles {
             keep(&mut a, NaoIndex::HipPitch(side), Some((-t.x).atan2(t_yz)));
             let hr = a[NaoIndex::HipRoll(side).slot()];
             let hp = a[NaoIndex::HipPitch(side).slot()];
-            let axis = Vector3::new(0.0, hr.cos(), hr.sin());
+            // The knee axis is within 90° of the torso's y axis for every hip angle within NAO's
+            // limits (HipYawPitch turns it at most 0.71 rad), so `t × s` along +y is flexion.
             let cross = t.cross(&s);
             let bend = cross.norm().atan2(t.dot(&s));
-            let kp = if cross.dot(&axis) < 0.0 { -bend } else { bend };
+            let kp = if cross.y < 0.0 { -bend } else { bend };
             keep(&mut a, NaoIndex::KneePitch(side), Some(kp));
             let shank = Rotation3::from_axis_angle(&Vector3::x_axis(), hr)
                 * Rotation3::from_axis_angle(&Vector3::y_axis(), hp + kp);
