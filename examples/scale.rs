@@ -224,7 +224,8 @@ fn run(args: &Args) -> Result<(), String> {
         r#"<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}" viewBox="0 0 {width} {height}"><rect width="100%" height="100%" fill="white"/>"#
     );
     svg.push('\n');
-    let front: fn(&Vector3<f64>) -> f64 = |p| -p.y;
+    // Seen from the front: the human's left (+y) on the viewer's right.
+    let front: fn(&Vector3<f64>) -> f64 = |p| p.y;
     let side: fn(&Vector3<f64>) -> f64 = |p| p.x;
     for (row, (k, frame, support, scaled)) in shown.iter().enumerate() {
         let y0 = 10.0 + row as f64 * (PANEL + 30.0) + 20.0;
