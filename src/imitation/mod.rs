@@ -11,5 +11,6 @@
 
 pub mod human;
 pub mod phase;
+pub mod scaler;
 pub mod support;
 pub mod tables;
