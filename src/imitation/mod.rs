@@ -10,6 +10,7 @@
 //! model root, equality levels and gradient tasks the IK solves (Table I as data).
 
 pub mod human;
+pub mod imitator;
 pub mod phase;
 pub mod scaler;
 pub mod support;

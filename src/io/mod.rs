@@ -5,6 +5,7 @@
 //! input is refused with a typed error instead of exhausting memory.
 
 pub mod bvh;
+pub mod clip;
 pub mod kinect;
 
 use std::io::{self, BufRead, Read};

@@ -51,6 +51,31 @@ pub struct DriverSettings {
     pub max_joint_step: f64,
 }
 
+impl DriverSettings {
+    fn validate(&self) -> Result<(), SolverError> {
+        for (name, value) in [
+            ("gain", self.gain),
+            ("dt", self.dt),
+            ("tolerance", self.tolerance),
+            ("stall_tolerance", self.stall_tolerance),
+            ("max_task_error", self.max_task_error),
+            ("max_joint_step", self.max_joint_step),
+        ] {
+            let unbounded_ok = matches!(name, "max_task_error" | "max_joint_step");
+            let positive = matches!(name, "gain" | "dt") || unbounded_ok;
+            let finite = value.is_finite() || unbounded_ok;
+            if value.is_nan() || !finite || value < 0.0 || (positive && value == 0.0) {
+                return Err(SolverError::InvalidParameter {
+                    name,
+                    value,
+                    reason: "must be >= 0 and finite (gain, dt and the step limits > 0; the step limits may be infinite)",
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
 impl Default for DriverSettings {
     fn default() -> Self {
         Self {
@@ -108,25 +133,7 @@ pub struct PositionDriver {
 impl PositionDriver {
     /// A driver for the stack of `solver`.
     pub fn new(solver: &Solver, settings: DriverSettings) -> Result<Self, SolverError> {
-        for (name, value) in [
-            ("gain", settings.gain),
-            ("dt", settings.dt),
-            ("tolerance", settings.tolerance),
-            ("stall_tolerance", settings.stall_tolerance),
-            ("max_task_error", settings.max_task_error),
-            ("max_joint_step", settings.max_joint_step),
-        ] {
-            let unbounded_ok = matches!(name, "max_task_error" | "max_joint_step");
-            let positive = matches!(name, "gain" | "dt") || unbounded_ok;
-            let finite = value.is_finite() || unbounded_ok;
-            if value.is_nan() || !finite || value < 0.0 || (positive && value == 0.0) {
-                return Err(SolverError::InvalidParameter {
-                    name,
-                    value,
-                    reason: "must be >= 0 and finite (gain, dt and the step limits > 0; the step limits may be infinite)",
-                });
-            }
-        }
+        settings.validate()?;
         let mut task_start = vec![0];
         for level in solver.stack().shape().levels() {
             for task in &level.tasks {
@@ -150,6 +157,13 @@ impl PositionDriver {
     /// The settings.
     pub fn settings(&self) -> &DriverSettings {
         &self.settings
+    }
+
+    /// Replaces the settings (e.g. a new `dt` for a frame that came late).
+    pub fn set_settings(&mut self, settings: DriverSettings) -> Result<(), SolverError> {
+        settings.validate()?;
+        self.settings = settings;
+        Ok(())
     }
 
     /// Moves `q` (in place, warm start) toward the model's targets. Every iterate, including the

@@ -1,0 +1,756 @@
+//! The online imitator (Poubel §III–IV): one human frame in, one robot posture out.
+//!
+//! Per frame:
+//!
+//! 1. **Support detection** ([`SupportDetector`]) tells which of the human's feet are on the ground.
+//! 2. **Phase machine** ([`PhaseMachine`]) decides the robot's support phase or transition step from
+//!    the human support and what the robot achieved at the previous frame ([`Measurements`]).
+//! 3. **Model switch**: the phase's table names the sole the model is rooted at (`RFoot` or
+//!    `LFoot`). On a switch the new root's world placement is computed from the old model's forward
+//!    kinematics at the current `q` ([`nao::switch_support`]), so the robot does not move in the
+//!    world: the support foot does not slip. Both models share the variables, so `q` carries over.
+//! 4. **Scaling** ([`Scaler`], eq. 1) of the human frame into the support-sole frame, re-expressed in
+//!    the model root's frame when the two differ (during a take-off toward the foot that is not
+//!    the root yet); human joint angles ([`NaoJointAngles`]) for the joint-tracking task.
+//! 5. **IK**: the phase's [`TaskTable`] is turned into the stack of a solver prepared for it: CoM
+//!    xy first, then the Cartesian tasks, then the gradient tasks (joint limits, human joints) in
+//!    the remaining null space, with the clamping loop. One Gauss–Newton step per frame
+//!    (configurable) with the joint velocities limited to a fraction of the robot's rated
+//!    velocities (the paper ran at 10 %), so the output trajectory is executable as it is: a
+//!    transition takes the time it needs and the robot catches up afterwards.
+//!
+//! Everything is allocated in [`Imitator::new`]; [`Imitator::step`] allocates nothing.
+//!
+//! World frame: the right sole's frame at the first frame (x forward, y left, z up, metres).
+
+use std::time::Instant;
+
+use nalgebra::{IsometryMatrix3, Vector2, Vector3};
+use thiserror::Error;
+
+use super::human::{HumanFrame, HumanJoint};
+use super::phase::{Measurements, PhaseConfig, PhaseError, PhaseMachine, SupportPhase};
+use super::scaler::{NAO_MAPPING, NaoJointAngles, RobotSkeleton, ScaleConfig, ScaleError, Scaler};
+use super::support::{HumanSupport, Side, SupportConfig, SupportDetector, SupportError};
+use super::tables::{ComGoal, GradientKind, PointTarget, TableError, Task, TaskTable, TaskTables};
+use crate::model::{Axis, FrameId, Model, ModelData, ModelError};
+use crate::robots::nao::{self, Foot};
+use crate::solver::driver::{DriverSettings, PositionDriver, StopReason, TaskModel};
+use crate::solver::{
+    JointBounds, JointLimitAvoidance, JointTracking, LevelReport, Settings, Solver, SolverError,
+    TaskStack,
+};
+
+/// Errors of the imitator.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum ImitationError {
+    /// A model query failed (a frame the tables name is missing from the model, …).
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    /// The solver refused its input.
+    #[error(transparent)]
+    Solver(#[from] SolverError),
+    /// The scaler refused its input.
+    #[error(transparent)]
+    Scale(#[from] ScaleError),
+    /// A task table is invalid.
+    #[error(transparent)]
+    Table(#[from] TableError),
+    /// Invalid phase-machine configuration.
+    #[error(transparent)]
+    Phase(#[from] PhaseError),
+    /// Invalid support-detection configuration.
+    #[error(transparent)]
+    Support(#[from] SupportError),
+    /// A configuration value out of range.
+    #[error("invalid {name} = {value}: {reason}")]
+    InvalidParameter {
+        /// Parameter name.
+        name: &'static str,
+        /// The value.
+        value: f64,
+        /// The valid range.
+        reason: &'static str,
+    },
+    /// Frame times must increase.
+    #[error("frame time {time} s does not follow the previous frame's {previous} s")]
+    TimeGoesBack {
+        /// This frame's time (s).
+        time: f64,
+        /// The previous frame's time (s).
+        previous: f64,
+    },
+}
+
+/// A biped's kinematic model rooted at each sole: the same variables and named frames, two roots.
+#[derive(Debug, Clone)]
+pub struct FootRootedModels {
+    /// Rooted at the right sole (`RFoot`).
+    pub right: Model,
+    /// Rooted at the left sole (`LFoot`).
+    pub left: Model,
+}
+
+impl FootRootedModels {
+    /// The NAO H25 V5 from the embedded DH tables.
+    pub fn nao() -> Self {
+        Self {
+            right: nao::rfoot(),
+            left: nao::lfoot(),
+        }
+    }
+
+    /// The model rooted at `foot`.
+    pub fn rooted_at(&self, foot: Foot) -> &Model {
+        match foot {
+            Foot::Right => &self.right,
+            Foot::Left => &self.left,
+        }
+    }
+}
+
+/// Settings of the imitator. Defaults are the paper's where it gives them.
+#[derive(Debug, Clone)]
+pub struct ImitatorConfig {
+    /// Support detection (default: optical motion capture).
+    pub support: SupportConfig,
+    /// Scaling (default: the NAO's foot area).
+    pub scale: ScaleConfig,
+    /// Phase machine: λ, ρ and the step-end tolerances.
+    pub phase: PhaseConfig,
+    /// The task tables (default: Table I).
+    pub tables: TaskTables,
+    /// Fraction of each joint's rated velocity the robot may use (paper: 0.1).
+    pub velocity_fraction: f64,
+    /// Gauss–Newton steps per frame (default 1, as the paper: one IK per time step). Each step
+    /// is limited to the velocity budget of the whole frame divided by this count.
+    pub iterations_per_frame: usize,
+    /// Largest speed a task asks for (m/s): each frame a task's error is clipped to
+    /// `max_task_speed · dt`, so the velocity limits are rarely hit and the clamping loop does not
+    /// have to take the tasks apart. Default 0.15 m/s, about what 10 % of the NAO's rated joint
+    /// velocities give at its hands (0.8 rad/s × 0.2 m).
+    pub max_task_speed: f64,
+    /// Time step assumed for the first frame, and for a frame with the same time as the previous
+    /// one (s). Default 1/120 s.
+    pub nominal_dt: f64,
+    /// Numerical settings of the solver.
+    pub solver: Settings,
+    /// Initial posture (model variable order, rad); default NAOqi's StandInit-like posture with
+    /// both feet flat.
+    pub initial_q: Option<Vec<f64>>,
+}
+
+impl Default for ImitatorConfig {
+    fn default() -> Self {
+        let phase = PhaseConfig::default();
+        Self {
+            support: SupportConfig::optical(),
+            scale: ScaleConfig::nao(),
+            tables: TaskTables::from_config(&phase),
+            phase,
+            velocity_fraction: 0.1,
+            iterations_per_frame: 1,
+            max_task_speed: 0.15,
+            nominal_dt: 1.0 / 120.0,
+            solver: Settings::default(),
+            initial_q: None,
+        }
+    }
+}
+
+/// The NAOqi StandInit-like posture (both feet flat: hip + knee + ankle pitch = 0), in the NAO
+/// variable order of [`nao::VARIABLES`].
+pub const NAO_STAND: [f64; 23] = [
+    0.0, 0.0, 1.4, 0.3, -1.39, -1.0, 0.0, 0.0, 0.0, -0.35, 0.7, -0.35, 0.0, 0.0, -0.35, 0.7, -0.35,
+    0.0, 1.4, -0.3, 1.39, 1.0, 0.0,
+];
+
+/// One robot output frame.
+#[derive(Debug, Clone)]
+pub struct RobotFrame {
+    /// Time of the human frame (s).
+    pub time: f64,
+    /// Joint angles in the model's variable order (rad); names in [`Imitator::variable_names`].
+    pub q: Vec<f64>,
+    /// The human's support at this frame.
+    pub human_support: HumanSupport,
+    /// The robot's phase or transition step.
+    pub phase: SupportPhase,
+    /// The sole the model was rooted at.
+    pub root: Foot,
+    /// World placement of the right sole.
+    pub right_sole: IsometryMatrix3<f64>,
+    /// World placement of the left sole.
+    pub left_sole: IsometryMatrix3<f64>,
+    /// Whole-body centre of mass in the world frame (m).
+    pub com: Vector3<f64>,
+    /// Error norm of each task of the phase's table after the step, in stack order (m).
+    pub task_errors: Vec<f64>,
+    /// Number of tasks of this phase (the first entries of `task_errors`).
+    pub task_count: usize,
+    /// Per-level outcome of the last solve (first `level_count` entries).
+    pub levels: Vec<LevelReport>,
+    /// Number of levels of this phase.
+    pub level_count: usize,
+    /// Joints clamped in the last solve (variable indices; first `clamped_count` entries).
+    pub clamped: Vec<usize>,
+    /// Number of clamped joints.
+    pub clamped_count: usize,
+    /// Why the per-frame iteration stopped.
+    pub stop: StopReason,
+    /// The scaled human reference of this frame, in the model root's frame (m): the targets of
+    /// the `Scaled` tasks come from here.
+    pub reference: [Option<Vector3<f64>>; HumanJoint::COUNT],
+    /// World placement of the model root (the support sole) this frame.
+    pub world_t_root: IsometryMatrix3<f64>,
+    /// Wall time of the step (µs): detection, scaling, IK.
+    pub micros: f64,
+}
+
+/// A task of a table, resolved against a model: frame id, axes, where its rows are.
+#[derive(Debug, Clone)]
+struct ResolvedTask {
+    task: Task,
+    frame: Option<FrameId>,
+    axes: [Option<Axis>; 3],
+    rows: usize,
+    level: usize,
+    row: usize,
+    /// Height of the frame above the ground when its foot is flat (q = 0), m.
+    rest_height: f64,
+    /// Held target (frame position when the step began), m, root frame.
+    held: Vector3<f64>,
+}
+
+/// Everything one phase needs: its table resolved, a solver and a driver sized for it.
+struct PhaseSolver {
+    table: TaskTable,
+    tasks: Vec<ResolvedTask>,
+    solver: Solver,
+    driver: PositionDriver,
+    other_ankle: FrameId,
+    other_sole: FrameId,
+}
+
+/// The online imitator.
+pub struct Imitator {
+    models: FootRootedModels,
+    data: [ModelData; 2],
+    phases: Vec<PhaseSolver>,
+    detector: SupportDetector,
+    scaler: Scaler,
+    angles: NaoJointAngles,
+    machine: PhaseMachine,
+    bounds: JointBounds,
+    velocity_fraction: f64,
+    iterations: usize,
+    max_task_speed: f64,
+    nominal_dt: f64,
+    limits: JointLimitAvoidance,
+    tracking: JointTracking,
+    human_q: Vec<f64>,
+    q: Vec<f64>,
+    root: Foot,
+    world_t_root: IsometryMatrix3<f64>,
+    phase: SupportPhase,
+    measurements: Measurements,
+    previous_time: Option<f64>,
+    output: RobotFrame,
+}
+
+fn foot_index(foot: Foot) -> usize {
+    match foot {
+        Foot::Right => 0,
+        Foot::Left => 1,
+    }
+}
+
+fn axes_of(task: &Task) -> [Option<Axis>; 3] {
+    match task {
+        Task::ComXY(_) => [Some(Axis::X), Some(Axis::Y), None],
+        Task::Point { axes, .. } => {
+            let mut out = [None; 3];
+            let picked = [(axes.x, Axis::X), (axes.y, Axis::Y), (axes.z, Axis::Z)];
+            for (slot, (_, a)) in out.iter_mut().zip(picked.iter().filter(|(on, _)| *on)) {
+                *slot = Some(*a);
+            }
+            out
+        }
+    }
+}
+
+impl PhaseSolver {
+    fn new(
+        table: &TaskTable,
+        models: &FootRootedModels,
+        settings: Settings,
+    ) -> Result<Self, ImitationError> {
+        table.validate()?;
+        let model = models.rooted_at(table.model_root);
+        let mut rest = model.new_data();
+        model.forward_kinematics(&mut rest, &vec![0.0; model.nv()])?;
+        let mut tasks = Vec::new();
+        for (level, l) in table.levels.iter().enumerate() {
+            let mut row = 0;
+            for task in &l.tasks {
+                let frame = match task {
+                    Task::ComXY(_) => None,
+                    Task::Point { frame, .. } => Some(model.frame_id(frame)?),
+                };
+                let rest_height =
+                    frame.map_or(0.0, |f| rest.frame_placement(f).translation.vector.z);
+                tasks.push(ResolvedTask {
+                    axes: axes_of(task),
+                    rows: task.rows(),
+                    task: task.clone(),
+                    frame,
+                    level,
+                    row,
+                    rest_height,
+                    held: Vector3::zeros(),
+                });
+                row += task.rows();
+            }
+        }
+        let solver = Solver::with_settings(&table.shape(model.nv()), settings)?;
+        let driver = PositionDriver::new(&solver, DriverSettings::default())?;
+        let other = table.model_root.other();
+        let ankle_name = match other {
+            Foot::Right => "r_ankle",
+            Foot::Left => "l_ankle",
+        };
+        Ok(Self {
+            table: table.clone(),
+            tasks,
+            solver,
+            driver,
+            other_ankle: model.frame_id(ankle_name)?,
+            other_sole: model.frame_id(other.sole())?,
+        })
+    }
+}
+
+impl Imitator {
+    /// An imitator for a biped's foot-rooted models. The models must have the NAO's variables
+    /// and named frames (the scaler's mapping and the joint-angle map are the NAO's).
+    pub fn new(models: FootRootedModels, config: ImitatorConfig) -> Result<Self, ImitationError> {
+        let fraction = config.velocity_fraction;
+        if !(fraction.is_finite() && fraction > 0.0) {
+            return Err(ImitationError::InvalidParameter {
+                name: "velocity_fraction",
+                value: fraction,
+                reason: "must be finite and > 0",
+            });
+        }
+        if !(config.nominal_dt.is_finite() && config.nominal_dt > 0.0) {
+            return Err(ImitationError::InvalidParameter {
+                name: "nominal_dt",
+                value: config.nominal_dt,
+                reason: "must be finite and > 0 s",
+            });
+        }
+        if !(config.max_task_speed.is_finite() && config.max_task_speed > 0.0) {
+            return Err(ImitationError::InvalidParameter {
+                name: "max_task_speed",
+                value: config.max_task_speed,
+                reason: "must be finite and > 0 m/s",
+            });
+        }
+        if config.iterations_per_frame == 0 {
+            return Err(ImitationError::InvalidParameter {
+                name: "iterations_per_frame",
+                value: 0.0,
+                reason: "must be >= 1",
+            });
+        }
+        let model = &models.right;
+        let nv = model.nv();
+        let lower: Vec<f64> = model.variables().iter().map(|v| v.lower).collect();
+        let upper: Vec<f64> = model.variables().iter().map(|v| v.upper).collect();
+        let rated_velocity: Vec<f64> = model.variables().iter().map(|v| v.velocity).collect();
+        let position_bounds = JointBounds::new(&lower, &upper)?;
+        let mut bounds = JointBounds::with_velocity(&lower, &upper, &rated_velocity)?;
+        bounds.scale_velocity(fraction)?;
+        let mut q = match &config.initial_q {
+            Some(q) if q.len() == nv => q.clone(),
+            Some(q) => {
+                return Err(SolverError::DimensionMismatch {
+                    what: "initial_q".into(),
+                    expected: nv,
+                    got: q.len(),
+                }
+                .into());
+            }
+            None if nv == NAO_STAND.len() => NAO_STAND.to_vec(),
+            None => vec![0.0; nv],
+        };
+        position_bounds.clamp_position(&mut q);
+        let phases = SupportPhase::ALL
+            .iter()
+            .map(|&phase| PhaseSolver::new(config.tables.table(phase), &models, config.solver))
+            .collect::<Result<Vec<_>, _>>()?;
+        let skeleton = RobotSkeleton::at_zero(&models.right, &NAO_MAPPING)?;
+        let angles = NaoJointAngles::new(&models.right)?;
+        let mut data = [models.right.new_data(), models.left.new_data()];
+        models.right.forward_kinematics(&mut data[0], &q)?;
+        let output = RobotFrame {
+            time: 0.0,
+            q: q.clone(),
+            human_support: HumanSupport::Double,
+            phase: SupportPhase::Double,
+            root: Foot::Right,
+            right_sole: IsometryMatrix3::identity(),
+            left_sole: IsometryMatrix3::identity(),
+            com: Vector3::zeros(),
+            task_errors: vec![0.0; 16],
+            task_count: 0,
+            levels: vec![LevelReport::default(); 4],
+            level_count: 0,
+            clamped: vec![0; nv],
+            clamped_count: 0,
+            stop: StopReason::Converged,
+            reference: [None; HumanJoint::COUNT],
+            world_t_root: IsometryMatrix3::identity(),
+            micros: 0.0,
+        };
+        Ok(Self {
+            detector: SupportDetector::new(config.support)?,
+            scaler: Scaler::new(skeleton, config.scale)?,
+            angles,
+            machine: PhaseMachine::new(config.phase)?,
+            limits: JointLimitAvoidance::new(&position_bounds),
+            tracking: JointTracking::new(&q)?,
+            human_q: q.clone(),
+            bounds,
+            velocity_fraction: fraction,
+            iterations: config.iterations_per_frame,
+            max_task_speed: config.max_task_speed,
+            nominal_dt: config.nominal_dt,
+            phases,
+            data,
+            q,
+            root: Foot::Right,
+            world_t_root: IsometryMatrix3::identity(),
+            phase: SupportPhase::Double,
+            measurements: Measurements {
+                com_error: f64::INFINITY,
+                swing_toe_height: 0.0,
+                swing_heel_height: 0.0,
+            },
+            previous_time: None,
+            output,
+            models,
+        })
+    }
+
+    /// Names of the joint angles of [`RobotFrame::q`] (NAOqi names for the NAO).
+    pub fn variable_names(&self) -> impl Iterator<Item = &str> {
+        self.models
+            .right
+            .variables()
+            .iter()
+            .map(|v| v.name.as_str())
+    }
+
+    /// The current phase.
+    pub fn phase(&self) -> SupportPhase {
+        self.phase
+    }
+
+    /// The task table of `phase`.
+    pub fn table(&self, phase: SupportPhase) -> &TaskTable {
+        &self.phases[phase.index()].table
+    }
+
+    /// The task names of `phase`'s table, in stack order.
+    pub fn task_names(&self, phase: SupportPhase) -> impl Iterator<Item = String> + '_ {
+        self.phases[phase.index()]
+            .tasks
+            .iter()
+            .map(|t| t.task.name())
+    }
+
+    /// The models.
+    pub fn models(&self) -> &FootRootedModels {
+        &self.models
+    }
+
+    /// The joint bounds the output respects: position limits and the rated velocities times the
+    /// velocity fraction.
+    pub fn bounds(&self) -> &JointBounds {
+        &self.bounds
+    }
+
+    /// The velocity fraction in use.
+    pub fn velocity_fraction(&self) -> f64 {
+        self.velocity_fraction
+    }
+
+    /// Imitates one human frame: returns the robot's posture for it.
+    pub fn step(&mut self, frame: &HumanFrame) -> Result<&RobotFrame, ImitationError> {
+        let start = Instant::now();
+        let dt = match self.previous_time {
+            None => self.nominal_dt,
+            Some(previous) if frame.time > previous => frame.time - previous,
+            Some(previous) if frame.time == previous => self.nominal_dt,
+            Some(previous) => {
+                return Err(ImitationError::TimeGoesBack {
+                    time: frame.time,
+                    previous,
+                });
+            }
+        };
+        if !frame.time.is_finite() {
+            return Err(ScaleError::NonFiniteTime(frame.time).into());
+        }
+        let human = self.detector.update(frame);
+        let phase = self.machine.update(human, &self.measurements);
+        let changed = phase != self.phase || self.previous_time.is_none();
+        self.switch_root(self.phases[phase.index()].table.model_root)?;
+        let root = foot_index(self.root);
+        let model = self.models.rooted_at(self.root);
+
+        let scaled = *self.scaler.scale(frame, human)?;
+        self.angles.compute(&scaled, &mut self.human_q)?;
+        self.tracking.set_reference(&self.human_q)?;
+        // The scaler's output frame is the sole of its stance; the model's is the root sole.
+        let root_t_base = if scaled.base() == side_of(self.root) {
+            IsometryMatrix3::identity()
+        } else {
+            *self.data[root].frame_placement(model.frame_id(sole_of(scaled.base()))?)
+        };
+        for (out, (_, p)) in self.output.reference.iter_mut().zip(scaled.points()) {
+            *out = p.map(|p| root_t_base.transform_point(&p.into()).coords);
+        }
+
+        let ps = &mut self.phases[phase.index()];
+        if changed {
+            for task in &mut ps.tasks {
+                if let Some(f) = task.frame {
+                    task.held = self.data[root].frame_placement(f).translation.vector;
+                }
+            }
+        }
+        // The velocity budget of the frame, split over its iterations.
+        let step_dt = dt / self.iterations as f64;
+        let driver_settings = DriverSettings {
+            gain: 1.0 / step_dt,
+            dt: step_dt,
+            max_iterations: self.iterations,
+            tolerance: 0.0,
+            stall_tolerance: 0.0,
+            max_task_error: self.max_task_speed * step_dt,
+            max_joint_step: f64::INFINITY,
+        };
+        ps.driver.set_settings(driver_settings)?;
+        let mut tasks = PhaseTasks {
+            model,
+            data: &mut self.data[root],
+            tasks: &ps.tasks,
+            reference: &self.output.reference,
+            other_ankle: ps.other_ankle,
+            other_sole: ps.other_sole,
+            table: &ps.table,
+            limits: &self.limits,
+            tracking: &self.tracking,
+        };
+        let report = ps
+            .driver
+            .run(&mut ps.solver, &mut tasks, &mut self.q, &self.bounds)?;
+        let stop = report.stop;
+        let errors = report.task_errors();
+
+        // The driver's last evaluation is at the final q: FK and errors are current.
+        let data = &self.data[root];
+        let out = &mut self.output;
+        out.task_count = errors.len().min(out.task_errors.len());
+        out.task_errors[..out.task_count].copy_from_slice(&errors[..out.task_count]);
+        let levels = ps.solver.report().levels();
+        out.level_count = levels.len().min(out.levels.len());
+        out.levels[..out.level_count].copy_from_slice(&levels[..out.level_count]);
+        let clamped = ps.solver.report().clamped_joints();
+        out.clamped_count = clamped.len();
+        out.clamped[..clamped.len()].copy_from_slice(clamped);
+        out.stop = stop;
+
+        // Measurements for the phase machine: CoM goal error and swing-foot heights.
+        let com_error = ps
+            .tasks
+            .iter()
+            .position(|t| matches!(t.task, Task::ComXY(_)))
+            .map_or(0.0, |i| errors[i]);
+        let swing = phase.swing_foot().unwrap_or(self.root.other());
+        let (toe, heel) = match swing {
+            Foot::Right => ("r_toe", "r_heel"),
+            Foot::Left => ("l_toe", "l_heel"),
+        };
+        let height = |name: &str| -> Result<f64, ModelError> {
+            Ok(data
+                .frame_placement(model.frame_id(name)?)
+                .translation
+                .vector
+                .z)
+        };
+        self.measurements = Measurements {
+            com_error,
+            swing_toe_height: height(toe)?,
+            swing_heel_height: height(heel)?,
+        };
+
+        let world_t_root = self.world_t_root;
+        let placement = |foot: Foot| -> Result<IsometryMatrix3<f64>, ModelError> {
+            model.placement_in_world(data, &world_t_root, model.frame_id(foot.sole())?)
+        };
+        out.right_sole = placement(Foot::Right)?;
+        out.left_sole = placement(Foot::Left)?;
+        out.com = world_t_root
+            .transform_point(&model.com(data)?.into())
+            .coords;
+        out.time = frame.time;
+        out.q.copy_from_slice(&self.q);
+        out.human_support = human;
+        out.phase = phase;
+        out.root = self.root;
+        out.world_t_root = world_t_root;
+        self.phase = phase;
+        self.previous_time = Some(frame.time);
+        out.micros = start.elapsed().as_secs_f64() * 1e6;
+        Ok(&self.output)
+    }
+
+    /// Re-roots the model at `foot` if it is not already, keeping the world placement.
+    fn switch_root(&mut self, foot: Foot) -> Result<(), ImitationError> {
+        let from = foot_index(self.root);
+        let model = self.models.rooted_at(self.root);
+        model.forward_kinematics(&mut self.data[from], &self.q)?;
+        if foot != self.root {
+            self.world_t_root =
+                nao::switch_support(model, &self.data[from], &self.world_t_root, foot)?;
+            self.root = foot;
+        }
+        let to = foot_index(self.root);
+        self.models
+            .rooted_at(self.root)
+            .forward_kinematics(&mut self.data[to], &self.q)?;
+        Ok(())
+    }
+}
+
+fn side_of(foot: Foot) -> Side {
+    match foot {
+        Foot::Right => Side::Right,
+        Foot::Left => Side::Left,
+    }
+}
+
+fn sole_of(side: Side) -> &'static str {
+    match side {
+        Side::Right => "r_sole",
+        Side::Left => "l_sole",
+    }
+}
+
+/// The `TaskModel` of one phase at one frame.
+struct PhaseTasks<'a> {
+    model: &'a Model,
+    data: &'a mut ModelData,
+    tasks: &'a [ResolvedTask],
+    reference: &'a [Option<Vector3<f64>>; HumanJoint::COUNT],
+    other_ankle: FrameId,
+    other_sole: FrameId,
+    table: &'a TaskTable,
+    limits: &'a JointLimitAvoidance,
+    tracking: &'a JointTracking,
+}
+
+impl PhaseTasks<'_> {
+    fn com_goal(&self, goal: ComGoal) -> Vector2<f64> {
+        let other = self
+            .data
+            .frame_placement(self.other_ankle)
+            .translation
+            .vector;
+        match goal {
+            ComGoal::SupportAnkle => Vector2::zeros(),
+            ComGoal::SupportFootCentre { lambda } => Vector2::new(lambda, 0.0),
+            ComGoal::MidAnkles => other.xy() * 0.5,
+            ComGoal::OtherFootCentre { lambda } => {
+                let sole = self.data.frame_placement(self.other_sole);
+                let forward = sole.rotation * Vector3::x();
+                other.xy() + lambda * forward.xy()
+            }
+        }
+    }
+}
+
+impl TaskModel for PhaseTasks<'_> {
+    type Error = ImitationError;
+
+    fn evaluate(&mut self, q: &[f64], stack: &mut TaskStack) -> Result<(), ImitationError> {
+        self.model.forward_kinematics(self.data, q)?;
+        for task in self.tasks {
+            let mut level = stack.level_mut(task.level);
+            let jac = level.jacobian_mut().subrows_mut(task.row, task.rows);
+            let mut current = [0.0; 3];
+            let mut target = [0.0; 3];
+            match (&task.task, task.frame) {
+                (Task::ComXY(goal), _) => {
+                    self.model.com_jacobian_rows(self.data, 2, jac)?;
+                    let c = self.model.com(self.data)?;
+                    let g = self.com_goal(*goal);
+                    current[..2].copy_from_slice(&[c.x, c.y]);
+                    target[..2].copy_from_slice(&[g.x, g.y]);
+                }
+                (
+                    Task::Point {
+                        target: point_target,
+                        ..
+                    },
+                    Some(frame),
+                ) => {
+                    let zero = Vector3::zeros();
+                    if task.rows == 3 {
+                        self.model.point_jacobian(self.data, frame, &zero, jac)?;
+                    } else {
+                        let mut jac = jac;
+                        for (r, axis) in task.axes.iter().flatten().enumerate() {
+                            self.model.point_jacobian_row(
+                                self.data,
+                                frame,
+                                &zero,
+                                *axis,
+                                jac.as_mut().subrows_mut(r, 1),
+                            )?;
+                        }
+                    }
+                    let p = self.data.frame_placement(frame).translation.vector;
+                    // Missing references (never after the scaler) hold the current position.
+                    let goal = match point_target {
+                        PointTarget::Scaled(joint) => self.reference[joint.index()].unwrap_or(p),
+                        PointTarget::Held { lift } => {
+                            Vector3::new(task.held.x, task.held.y, task.rest_height + lift)
+                        }
+                    };
+                    for (r, axis) in task.axes.iter().flatten().enumerate() {
+                        current[r] = p[*axis as usize];
+                        target[r] = goal[*axis as usize];
+                    }
+                }
+                (Task::Point { .. }, None) => unreachable!("point tasks are resolved to a frame"),
+            }
+            let errors = &mut level.target_mut()[task.row..task.row + task.rows];
+            for r in 0..task.rows {
+                errors[r] = target[r] - current[r];
+            }
+        }
+        stack.clear_gradient();
+        for g in &self.table.gradients {
+            match g.kind {
+                GradientKind::JointLimits => stack.add_gradient(g.kappa, self.limits, q)?,
+                GradientKind::HumanJoints => stack.add_gradient(g.kappa, self.tracking, q)?,
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,94 @@
+//! A motion clip of either supported format, chosen by file extension: `.csv` is a Kinect v2
+//! recording, anything else BVH (CMU conventions: ×0.056444 to metres, Y up, CMU-MB or CMU-MAX
+//! names). Streams frames and says which support-detection defaults suit the source.
+//!
+//! The CMU MotionBuilder-friendly release (CMU-MB names) prepends a synthetic T-pose as frame 0
+//! (`../shared/data/mocap/README.md`); [`Clip`] skips it, so the first frame is captured motion.
+
+use std::fs::File;
+use std::io::BufReader;
+use std::path::Path;
+
+use thiserror::Error;
+
+use super::bvh::{BvhConfig, BvhError, BvhReader, CMU_MB_NAMES};
+use super::kinect::{KinectConfig, KinectError, KinectReader};
+use crate::imitation::human::HumanFrame;
+use crate::imitation::support::SupportConfig;
+
+/// Error of either reader.
+#[derive(Debug, Error)]
+pub enum ClipError {
+    /// From the BVH reader.
+    #[error(transparent)]
+    Bvh(#[from] BvhError),
+    /// From the Kinect reader.
+    #[error(transparent)]
+    Kinect(#[from] KinectError),
+}
+
+enum Source {
+    Bvh(BvhReader<BufReader<File>>),
+    Kinect(KinectReader<BufReader<File>>),
+}
+
+/// A clip being read, one frame at a time.
+pub struct Clip {
+    source: Source,
+    support: SupportConfig,
+}
+
+impl Clip {
+    /// Opens `path` (the reader is chosen by extension; see the module docs).
+    pub fn open(path: impl AsRef<Path>) -> Result<Self, ClipError> {
+        let path = path.as_ref();
+        let is_csv = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("csv"));
+        if is_csv {
+            return Ok(Self {
+                source: Source::Kinect(KinectReader::open(path, KinectConfig::default())?),
+                support: SupportConfig::kinect(),
+            });
+        }
+        let mut reader = BvhReader::open(path, BvhConfig::cmu())?;
+        let skeleton = reader.skeleton();
+        let motion_builder = CMU_MB_NAMES
+            .iter()
+            .all(|(name, _)| skeleton.index_of(name).is_some());
+        if motion_builder {
+            let mut t_pose = HumanFrame::new(0.0);
+            reader.read_frame(&mut t_pose)?;
+        }
+        Ok(Self {
+            source: Source::Bvh(reader),
+            support: SupportConfig::optical(),
+        })
+    }
+
+    /// Support-detection defaults for this kind of source (optical mocap or Kinect).
+    pub fn support_config(&self) -> SupportConfig {
+        self.support
+    }
+
+    /// Reads the next frame into `out`; `Ok(false)` at the end of the clip.
+    pub fn read_frame(&mut self, out: &mut HumanFrame) -> Result<bool, ClipError> {
+        Ok(match &mut self.source {
+            Source::Bvh(r) => r.read_frame(out)?,
+            Source::Kinect(r) => r.read_frame(out)?,
+        })
+    }
+}
+
+impl Iterator for Clip {
+    type Item = Result<HumanFrame, ClipError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        let mut frame = HumanFrame::new(0.0);
+        match self.read_frame(&mut frame) {
+            Ok(true) => Some(Ok(frame)),
+            Ok(false) => None,
+            Err(e) => Some(Err(e)),
+        }
+    }
+}
