@@ -111,7 +111,12 @@ impl TaskModel for Nao {
         let zero = Vector3::zeros();
         let mut point = |level: usize, row: usize, frame: FrameId, target: &Vector3<f64>| {
             let mut l = stack.level_mut(level);
-            m.point_jacobian(&self.data, frame, &zero, l.jacobian_mut().subrows_mut(row, 3))?;
+            m.point_jacobian(
+                &self.data,
+                frame,
+                &zero,
+                l.jacobian_mut().subrows_mut(row, 3),
+            )?;
             let x = m.point_position(&self.data, frame, &zero)?;
             for r in 0..3 {
                 l.target_mut()[row + r] = target[r] - x[r];
@@ -165,12 +170,7 @@ fn check_solve(solver: &Solver, q: &[f64], bounds: &JointBounds, dt: f64) -> Vec
         let jac = stack.jacobian(j);
         let target = stack.target(j);
         let r: Vec<f64> = (0..jac.nrows())
-            .map(|row| {
-                (0..jac.ncols())
-                    .map(|c| jac[(row, c)] * v[c])
-                    .sum::<f64>()
-                    - target[row]
-            })
+            .map(|row| (0..jac.ncols()).map(|c| jac[(row, c)] * v[c]).sum::<f64>() - target[row])
             .collect();
         let residual = norm(&r);
         let scale = 1.0 + norm(target);
@@ -186,7 +186,11 @@ fn check_solve(solver: &Solver, q: &[f64], bounds: &JointBounds, dt: f64) -> Vec
         // Away from the threshold, `feasible` agrees with the recomputed residual.
         let threshold = tol * scale;
         if (residual - threshold).abs() > 1e-3 * threshold + rounding {
-            assert_eq!(level.feasible, residual <= threshold, "level {j}: {level:?}");
+            assert_eq!(
+                level.feasible,
+                residual <= threshold,
+                "level {j}: {level:?}"
+            );
         }
         residuals.push(residual);
     }
@@ -394,7 +398,9 @@ fn targets_a_kilometre_away_are_reported_infeasible_from_the_top() {
         posture: Posture::StretchedLegs,
         unit: vec![0.5; 23],
         log_distance: 3.0,
-        directions: vec![0.0, 0.0, -1.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, -1.0, 0.0, 1.0, 0.0, 0.0],
+        directions: vec![
+            0.0, 0.0, -1.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, -1.0, 0.0, 1.0, 0.0, 0.0,
+        ],
         contradictory: true,
         log_gain: 0.0,
         log_dt: 0.0,
@@ -406,7 +412,11 @@ fn targets_a_kilometre_away_are_reported_infeasible_from_the_top() {
     let mut driver = PositionDriver::new(&solver, DriverSettings::default()).unwrap();
     let report = driver.run(&mut solver, &mut nao, &mut q, &bounds).unwrap();
     // A sole 1 km below the ground cannot be reached: the error stays about 1 km.
-    assert!(report.task_errors()[0] > 999.0, "{:?}", report.task_errors());
+    assert!(
+        report.task_errors()[0] > 999.0,
+        "{:?}",
+        report.task_errors()
+    );
     nao.evaluate(&q, solver.stack_mut()).unwrap();
     solver.solve(&q, &bounds, 1.0).unwrap();
     check_solve(&solver, &q, &bounds, 1.0);
@@ -438,7 +448,11 @@ fn random_stack() -> impl Strategy<Value = RandomStack> {
             Just(n),
             Just(rows),
             proptest::collection::vec(
-                (-1.0..1.0f64, -150.0..150.0f64, proptest::bool::weighted(0.1)),
+                (
+                    -1.0..1.0f64,
+                    -150.0..150.0f64,
+                    proptest::bool::weighted(0.1),
+                ),
                 total * (n + 1),
             ),
             proptest::collection::vec(proptest::bool::weighted(0.15), levels),
@@ -508,7 +522,14 @@ proptest! {
         let report = solver.report();
         let mut rank_total = 0;
         for (level, l) in report.levels().iter().enumerate() {
-            prop_assert!(l.residual.is_finite() && l.damping.is_finite());
+            prop_assert!(
+                l.residual.is_finite() && l.damping.is_finite(),
+                "level {}: {:?}, q̇ = {:?}, stack {:?}",
+                level,
+                l,
+                v,
+                stacked
+            );
             prop_assert!(l.rank <= l.rows);
             if s.zero_levels[level] {
                 // An all-zero level uses no direction and is met by any q̇.
