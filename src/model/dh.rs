@@ -19,7 +19,8 @@
 //! `[[frames]]` (`name`, `link`, `position`, optional `rpy` = roll, pitch, yaw with rotation
 //! `Rz(yaw)·Ry(pitch)·Rx(roll)` as in URDF). Every field is checked (finite numbers, masses ≥ 0,
 //! lower ≤ upper, unique names, known antecedents, no cycle, every variable used, no unknown
-//! field); errors name the origin (file path), the row (`joints[7] (RAnkleRoll)`) and the field.
+//! field, no magnitude above [`MAX_MAGNITUDE`](super::MAX_MAGNITUDE)); errors name the origin
+//! (file path), the row (`joints[7] (RAnkleRoll)`) and the field.
 
 use std::path::Path;
 
@@ -45,6 +46,9 @@ pub enum DhProblem {
     /// A number is NaN or infinite.
     #[error("not a finite number ({0})")]
     NonFinite(f64),
+    /// A number above [`MAX_MAGNITUDE`](super::MAX_MAGNITUDE) in magnitude.
+    #[error("magnitude above 1e6 ({0})")]
+    TooLarge(f64),
     /// A mass or speed is negative.
     #[error("negative value ({0})")]
     Negative(f64),
@@ -425,10 +429,12 @@ impl<'a> Row<'a> {
             Value::Integer(i) => *i as f64,
             _ => return Err(self.err(field, DhProblem::WrongType("a number"))),
         };
-        if x.is_finite() {
-            Ok(x)
-        } else {
+        if !x.is_finite() {
             Err(self.err(field, DhProblem::NonFinite(x)))
+        } else if x.abs() > super::MAX_MAGNITUDE {
+            Err(self.err(field, DhProblem::TooLarge(x)))
+        } else {
+            Ok(x)
         }
     }
 

@@ -58,6 +58,14 @@ use thiserror::Error;
 pub use dh::DhError;
 pub use urdf::{UrdfError, UrdfFrame, UrdfOptions};
 
+/// Largest magnitude the loaders ([`dh`], [`urdf`]) accept for a number of a robot description
+/// (lengths in metres, angles in radians, masses in kilograms, multipliers, offsets, inertias,
+/// speeds; except a URDF velocity limit, which only bounds and may be infinite): `10^6`. No robot needs more, and with every number
+/// below it the sums and products of forward kinematics, the CoM and the Jacobians stay far from
+/// `f64` overflow for any tree that fits in memory. Without it a description with `1e308` in it
+/// would load and give an infinite centre of mass.
+pub const MAX_MAGNITUDE: f64 = 1e6;
+
 /// How a joint moves its link relative to the antecedent link.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum JointKind {

@@ -134,6 +134,23 @@ pub enum UrdfError {
         /// The offending value.
         value: f64,
     },
+    /// A number (origin, axis, limit, mimic, mass, CoM, inertia, locked value) above
+    /// [`MAX_MAGNITUDE`](super::MAX_MAGNITUDE) in magnitude.
+    #[error("{place}: magnitude above 1e6 ({value})")]
+    TooLarge {
+        /// E.g. "joint `HeadYaw` origin".
+        place: String,
+        /// The offending value.
+        value: f64,
+    },
+    /// A joint with a negative (or NaN) velocity limit.
+    #[error("joint `{joint}`: velocity limit {velocity} is not >= 0")]
+    NegativeVelocity {
+        /// Joint name.
+        joint: String,
+        /// The velocity limit (rad/s or m/s).
+        velocity: f64,
+    },
     /// A link with negative mass.
     #[error("link `{link}`: negative mass {mass}")]
     NegativeMass {
@@ -225,8 +242,16 @@ enum Drive {
     },
 }
 
+/// Every value finite and at most [`MAX_MAGNITUDE`](super::MAX_MAGNITUDE) in magnitude.
 fn finite(place: impl Fn() -> String, values: &[f64]) -> Result<(), UrdfError> {
-    match values.iter().find(|v| !v.is_finite()) {
+    match values
+        .iter()
+        .find(|v| v.is_nan() || v.abs() > super::MAX_MAGNITUDE)
+    {
+        Some(&value) if value.is_finite() => Err(UrdfError::TooLarge {
+            place: place(),
+            value,
+        }),
         Some(&value) => Err(UrdfError::NonFinite {
             place: place(),
             value,
@@ -314,6 +339,15 @@ fn build(robot: &urdf_rs::Robot, options: &UrdfOptions) -> Result<Model, UrdfErr
         finite(
             || format!("link `{name}` inertial origin"),
             &inertial.origin.xyz.0,
+        )?;
+        finite(
+            || format!("link `{name}` inertial origin"),
+            &inertial.origin.rpy.0,
+        )?;
+        let i = &inertial.inertia;
+        finite(
+            || format!("link `{name}` inertia"),
+            &[i.ixx, i.ixy, i.ixz, i.iyy, i.iyz, i.izz],
         )?;
     }
     let mut joint_index: HashMap<&str, usize> = HashMap::new();
@@ -673,10 +707,11 @@ fn number_variables(
                 upper,
             });
         }
-        if limit.velocity.is_nan() {
-            return Err(UrdfError::NonFinite {
-                place: format!("joint `{}` velocity limit", joint.name),
-                value: limit.velocity,
+        // An infinite limit means none.
+        if limit.velocity.is_nan() || limit.velocity < 0.0 {
+            return Err(UrdfError::NegativeVelocity {
+                joint: joint.name.clone(),
+                velocity: limit.velocity,
             });
         }
         variables.push(Variable {

@@ -15,8 +15,13 @@ pub(crate) fn norm(x: &[f64]) -> f64 {
     if scale == 0.0 || !scale.is_finite() {
         return scale;
     }
-    let inv = 1.0 / scale;
-    scale * x.iter().map(|v| (v * inv) * (v * inv)).sum::<f64>().sqrt()
+    // Divide rather than multiply by 1/scale: for a subnormal scale, 1/scale overflows to
+    // infinity and the norm came out NaN.
+    scale
+        * x.iter()
+            .map(|v| (v / scale) * (v / scale))
+            .sum::<f64>()
+            .sqrt()
 }
 
 pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
@@ -35,9 +40,13 @@ pub(crate) fn make_reflector(x: &mut [f64]) -> f64 {
     let full = norm(&[alpha, tail_norm]);
     let beta = if alpha >= 0.0 { -full } else { full };
     let tau = (beta - alpha) / beta;
-    let scale = 1.0 / (alpha - beta);
-    for v in tail.iter_mut() {
-        *v *= scale;
+    let denom = alpha - beta;
+    if denom.abs() >= f64::MIN_POSITIVE {
+        let scale = 1.0 / denom;
+        tail.iter_mut().for_each(|v| *v *= scale);
+    } else {
+        // 1/denom would overflow to infinity for a subnormal denom.
+        tail.iter_mut().for_each(|v| *v /= denom);
     }
     x[0] = beta;
     tau
@@ -169,5 +178,26 @@ mod tests {
     fn norm_survives_huge_and_tiny_entries() {
         assert!((norm(&[3e200, 4e200]) / 5e200 - 1.0).abs() < 1e-15);
         assert!((norm(&[3e-200, 4e-200]) - 5e-200).abs() < 1e-212);
+        // Subnormal largest entry (found by tests/hardening_solver.rs: the residual was NaN).
+        assert_eq!(norm(&[0.0, -5e-311]), 5e-311);
+        assert_eq!(norm(&[5e-324, 5e-324]), 5e-324 * 2f64.sqrt());
+    }
+
+    #[test]
+    fn reflector_of_subnormal_entries_is_finite() {
+        // ‖x‖ subnormal: the reflector must still be finite (1/(α − β) overflowed).
+        let mut x = [0.0, 3e-311, 4e-311];
+        let tau = make_reflector(&mut x);
+        assert!(
+            tau.is_finite() && x.iter().all(|v| v.is_finite()),
+            "{tau} {x:?}"
+        );
+        // Applied to the original vector it gives (β, 0, 0) with |β| = ‖x‖ = 5e-311.
+        let mut y = [0.0, 3e-311, 4e-311];
+        apply_reflector(&x, tau, &mut y);
+        assert!(
+            (y[0].abs() - 5e-311).abs() < 1e-323 && y[1].abs() < 1e-323,
+            "{y:?}"
+        );
     }
 }
