@@ -52,8 +52,16 @@ fn run(machine: &mut PhaseMachine, steps: &[(HumanSupport, Measurements, Support
     }
 }
 
+/// The measurements above are written for a 2 mm foot height tolerance.
+fn config() -> PhaseConfig {
+    PhaseConfig {
+        foot_height_tolerance: 0.002,
+        ..PhaseConfig::default()
+    }
+}
+
 fn machine() -> PhaseMachine {
-    PhaseMachine::new(PhaseConfig::default()).unwrap()
+    PhaseMachine::new(config()).unwrap()
 }
 
 #[test]
@@ -211,7 +219,7 @@ fn bad_config_is_rejected_naming_the_field() {
         (
             PhaseConfig {
                 rho: 0.004,
-                ..PhaseConfig::default()
+                ..config()
             },
             "rho",
         ),
@@ -432,7 +440,7 @@ proptest! {
         steps in proptest::collection::vec((human(), measurement()), 1..80)
     ) {
         let tables = TaskTables::paper();
-        let config = PhaseConfig::default();
+        let config = config();
         let mut m = PhaseMachine::new(config).unwrap();
         let mut last_human = H::Double;
         for (human, measured) in steps {

@@ -1,18 +1,28 @@
 //! Online imitation of a motion clip by the NAO (the README's main job).
 //!
-//! `cargo run --release --example imitate -- [CLIP.bvh|CLIP.csv] [--out DIR]`
+//! `cargo run --release --example imitate -- [CLIP.bvh|CLIP.csv] [--out DIR] [--velocity-fraction F]`
 //!
 //! With no clip, a bundled real clip with a support change (CMU 05_02: standing, arm gestures,
-//! then a stance on the right leg). Writes `DIR/joints.csv` (time + 23 joint angles, rad),
-//! `DIR/metrics.json` and SVG plots (effector trajectories, CoM with footprints, phase
-//! timeline), and prints a summary. DIR defaults to `target/imitate`.
+//! small steps, then a stance on the right leg). Writes into DIR (default `target/imitate`):
+//! `joints.csv` (time in s + the 23 joint angles in rad, NAOqi names), `metrics.json` (see
+//! `taskstack::imitation::metrics`), and the plots `effectors.svg` (Poubel Fig. 6), `com.svg`
+//! (Fig. 8) and `phases.svg`; prints a summary. `--velocity-fraction` is the share of the rated
+//! joint velocities the robot may use (default 0.1, as in the paper).
 
-use std::path::PathBuf;
+mod plots;
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+use serde_json::{Value, json};
 use taskstack::imitation::human::HumanFrame;
 use taskstack::imitation::imitator::{FootRootedModels, Imitator, ImitatorConfig};
+use taskstack::imitation::metrics::{
+    CONTACT_HEIGHT, EFFECTORS, ImitationMetrics, MeanMax, MetricsRecorder, Spread,
+};
 use taskstack::io::clip::Clip;
+use taskstack::robots::nao::Foot;
 
 const DEFAULT_CLIP: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
@@ -22,6 +32,7 @@ const DEFAULT_CLIP: &str = concat!(
 fn main() -> ExitCode {
     let mut clip = PathBuf::from(DEFAULT_CLIP);
     let mut out = PathBuf::from("target/imitate");
+    let mut fraction = ImitatorConfig::default().velocity_fraction;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
@@ -29,11 +40,15 @@ fn main() -> ExitCode {
                 Some(d) => out = d.into(),
                 None => return usage(),
             },
+            "--velocity-fraction" => match args.next().and_then(|v| v.parse().ok()) {
+                Some(f) => fraction = f,
+                None => return usage(),
+            },
             _ if a.starts_with("--") => return usage(),
             _ => clip = a.into(),
         }
     }
-    match run(&clip, &out) {
+    match run(&clip, &out, fraction) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("imitate: {}: {e}", clip.display());
@@ -43,67 +58,185 @@ fn main() -> ExitCode {
 }
 
 fn usage() -> ExitCode {
-    eprintln!("usage: imitate [CLIP.bvh|CLIP.csv] [--out DIR]");
+    eprintln!("usage: imitate [CLIP.bvh|CLIP.csv] [--out DIR] [--velocity-fraction F]");
     ExitCode::from(2)
 }
 
-fn run(path: &PathBuf, _out: &PathBuf) -> Result<(), Box<dyn std::error::Error>> {
+fn run(path: &Path, out: &Path, velocity_fraction: f64) -> Result<(), Box<dyn std::error::Error>> {
     let mut clip = Clip::open(path)?;
     let config = ImitatorConfig {
         support: clip.support_config(),
+        velocity_fraction,
         ..ImitatorConfig::default()
     };
     let mut imitator = Imitator::new(FootRootedModels::nao(), config)?;
+    let mut recorder = MetricsRecorder::new(&imitator);
+    let names: Vec<String> = imitator.variable_names().map(str::to_owned).collect();
+    let mut joints = format!("time,{}\n", names.join(","));
+    let mut samples = Vec::new();
+    let plotted = ["l_hand", "r_hand", "l_ankle"];
     let mut frame = HumanFrame::new(0.0);
-    let mut last_phase = None;
-    let mut n = 0;
     while clip.read_frame(&mut frame)? {
         let r = imitator.step(&frame)?;
-        n += 1;
-        if last_phase != Some(r.phase) {
-            println!(
-                "{:7.3} s  human {:?}  robot {}  errors {:.3?}  com ({:.3},{:.3})",
-                r.time,
-                r.human_support,
-                r.phase,
-                &r.task_errors[..r.task_count],
-                r.com.x,
-                r.com.y
-            );
-            last_phase = Some(r.phase);
+        let r = r.clone();
+        recorder.record(&imitator, &r)?;
+        let _ = write!(joints, "{:.6}", r.time);
+        for q in &r.q {
+            let _ = write!(joints, ",{q:.6}");
         }
-        if std::env::var("DBG").is_ok() && r.time > 6.1 && r.time < 6.8 && n % 4 == 0 {
-            println!(
-                "   {:6.3} {} root {:?} com ({:.3},{:.3}) lsole ({:.3},{:.3}) rsole ({:.3},{:.3}) err {:.3?} lv {:?} clamped {}",
-                r.time,
-                r.phase,
-                r.root,
-                r.com.x,
-                r.com.y,
-                r.left_sole.translation.x,
-                r.left_sole.translation.y,
-                r.right_sole.translation.x,
-                r.right_sole.translation.y,
-                &r.task_errors[..r.task_count],
-                r.levels[..r.level_count]
+        joints.push('\n');
+
+        // World positions for the plots.
+        let model = imitator.models().rooted_at(r.root);
+        let mut data = model.new_data();
+        model.forward_kinematics(&mut data, &r.q)?;
+        let world = |p: nalgebra::Vector3<f64>| {
+            let w = r.world_t_root.transform_point(&p.into());
+            [w.x, w.y, w.z]
+        };
+        let effectors = plotted
+            .iter()
+            .map(|name| {
+                let joint = EFFECTORS.iter().find(|(n, _)| n == name).map(|(_, j)| *j);
+                let robot = world(
+                    data.frame_placement(model.frame_id(name)?)
+                        .translation
+                        .vector,
+                );
+                let reference = joint.and_then(|j| r.reference[j.index()]).map(world);
+                Ok((robot, reference))
+            })
+            .collect::<Result<Vec<_>, taskstack::model::ModelError>>()?;
+        let footprints = [(Foot::Right, r.right_sole), (Foot::Left, r.left_sole)]
+            .into_iter()
+            .filter_map(|(foot, sole)| {
+                let outline = foot
+                    .sole_outline()
+                    .map(|[x, y]| sole.transform_point(&nalgebra::Point3::new(x, y, 0.0)));
+                outline
                     .iter()
-                    .map(|l| (l.rank, l.feasible))
-                    .collect::<Vec<_>>(),
-                r.clamped_count
-            );
-        }
-        if n % 120 == 0 {
-            println!(
-                "   {:7.3} s errors {:.3?} levels {:?}",
-                r.time,
-                &r.task_errors[..r.task_count],
-                r.levels[..r.level_count]
-                    .iter()
-                    .map(|l| (l.rank, l.feasible))
-                    .collect::<Vec<_>>()
-            );
-        }
+                    .all(|p| p.z.abs() <= CONTACT_HEIGHT)
+                    .then(|| (foot, outline.map(|p| [p.x, p.y])))
+            })
+            .collect();
+        samples.push(plots::Sample {
+            time: r.time,
+            effectors,
+            com: [r.com.x, r.com.y],
+            footprints,
+            human: match r.human_support {
+                taskstack::imitation::support::HumanSupport::Double => "Double",
+                taskstack::imitation::support::HumanSupport::Right => "Right",
+                taskstack::imitation::support::HumanSupport::Left => "Left",
+                taskstack::imitation::support::HumanSupport::Airborne => "Airborne",
+            },
+            robot: r.phase.to_string(),
+        });
     }
-    println!("{n} frames");
+    let metrics = recorder.finish();
+    std::fs::create_dir_all(out)?;
+    std::fs::write(out.join("joints.csv"), joints)?;
+    let json = metrics_json(&metrics, path);
+    std::fs::write(
+        out.join("metrics.json"),
+        serde_json::to_string_pretty(&json)? + "\n",
+    )?;
+    std::fs::write(
+        out.join("effectors.svg"),
+        plots::effectors(&samples, &plotted),
+    )?;
+    std::fs::write(out.join("com.svg"), plots::com_and_feet(&samples))?;
+    std::fs::write(out.join("phases.svg"), plots::phases(&samples))?;
+    print_summary(&metrics, path, out);
     Ok(())
+}
+
+fn mean_max(m: &MeanMax) -> Value {
+    json!({ "mean": m.mean, "max": m.max, "frames": m.count })
+}
+
+fn spread(s: &Spread) -> Value {
+    json!({ "min": s.min, "median": s.median, "p99": s.p99, "max": s.max, "count": s.count })
+}
+
+fn metrics_json(m: &ImitationMetrics, clip: &Path) -> Value {
+    let effectors: serde_json::Map<String, Value> = m
+        .effectors
+        .iter()
+        .map(|e| {
+            (
+                e.name.to_string(),
+                json!({ "single_support_m": mean_max(&e.single_support), "double_support_m": mean_max(&e.double_support) }),
+            )
+        })
+        .collect();
+    json!({
+        "clip": clip.file_name().map(|f| f.to_string_lossy().into_owned()),
+        "frames": m.frames,
+        "duration_s": m.duration,
+        "human_support_changes": m.human_support_changes,
+        "robot_support_changes": m.robot_support_changes,
+        "robot_support_sequence": m.robot_support_sequence,
+        "transition_durations_s": spread(&m.transition_durations),
+        "tracking_error": effectors,
+        "min_com_margin_m": m.min_com_margin,
+        "frames_com_outside_support": m.frames_com_outside,
+        "joint_limit_violations": m.joint_limit_violations,
+        "velocity_limit_violations": m.velocity_limit_violations,
+        "max_support_foot_slip_m": m.max_support_slip,
+        "max_support_foot_turn_rad": m.max_support_turn,
+        "solve_time_us": spread(&m.solve_time_us),
+    })
+}
+
+fn print_summary(m: &ImitationMetrics, clip: &Path, out: &Path) {
+    println!(
+        "clip {}: {} frames, {:.2} s",
+        clip.display(),
+        m.frames,
+        m.duration
+    );
+    println!(
+        "support changes: human {}, robot {} ({})",
+        m.human_support_changes,
+        m.robot_support_changes,
+        m.robot_support_sequence.join(" → ")
+    );
+    let t = &m.transition_durations;
+    println!(
+        "transitions: {} (min {:.2} s, median {:.2} s, max {:.2} s)",
+        t.count, t.min, t.median, t.max
+    );
+    for e in &m.effectors {
+        println!(
+            "tracking {:8}: single support mean {:.4} m max {:.4} m ({} frames); double support mean {:.4} m max {:.4} m ({} frames)",
+            e.name,
+            e.single_support.mean,
+            e.single_support.max,
+            e.single_support.count,
+            e.double_support.mean,
+            e.double_support.max,
+            e.double_support.count
+        );
+    }
+    println!(
+        "CoM margin in the support polygon: min {:.4} m ({} frames outside); limit violations: joints {}, velocities {}",
+        m.min_com_margin,
+        m.frames_com_outside,
+        m.joint_limit_violations,
+        m.velocity_limit_violations
+    );
+    println!(
+        "support foot slip: {:.2e} m, {:.2e} rad",
+        m.max_support_slip, m.max_support_turn
+    );
+    let s = &m.solve_time_us;
+    println!(
+        "time per frame: median {:.1} µs, p99 {:.1} µs, max {:.1} µs",
+        s.median, s.p99, s.max
+    );
+    println!(
+        "wrote {}/{{joints.csv, metrics.json, effectors.svg, com.svg, phases.svg}}",
+        out.display()
+    );
 }

@@ -29,7 +29,7 @@ use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 use thiserror::Error;
 
 use super::human::{HumanFrame, HumanJoint};
-use super::phase::{Measurements, PhaseConfig, PhaseError, PhaseMachine, SupportPhase};
+use super::phase::{Measurements, PhaseConfig, PhaseError, PhaseMachine, SupportPhase, TakeOff};
 use super::scaler::{NAO_MAPPING, NaoJointAngles, RobotSkeleton, ScaleConfig, ScaleError, Scaler};
 use super::support::{HumanSupport, Side, SupportConfig, SupportDetector, SupportError};
 use super::tables::{ComGoal, GradientKind, PointTarget, TableError, Task, TaskTable, TaskTables};
@@ -119,7 +119,8 @@ pub struct ImitatorConfig {
     pub scale: ScaleConfig,
     /// Phase machine: λ, ρ and the step-end tolerances.
     pub phase: PhaseConfig,
-    /// The task tables (default: Table I).
+    /// The task tables (default: [`TaskTables::contact_first`], Table I with the free foot's
+    /// ground contact as the highest level while it stands).
     pub tables: TaskTables,
     /// Fraction of each joint's rated velocity the robot may use (paper: 0.1).
     pub velocity_fraction: f64,
@@ -134,7 +135,9 @@ pub struct ImitatorConfig {
     /// Time step assumed for the first frame, and for a frame with the same time as the previous
     /// one (s). Default 1/120 s.
     pub nominal_dt: f64,
-    /// Numerical settings of the solver.
+    /// Numerical settings of the solver. The imitator always turns
+    /// [`Settings::scale_to_fit`] on: when the velocity limits bind, the whole step slows down
+    /// uniformly instead of the clamping loop pinning joints the balance level needs.
     pub solver: Settings,
     /// Initial posture (model variable order, rad); default NAOqi's StandInit-like posture with
     /// both feet flat.
@@ -147,7 +150,7 @@ impl Default for ImitatorConfig {
         Self {
             support: SupportConfig::optical(),
             scale: ScaleConfig::nao(),
-            tables: TaskTables::from_config(&phase),
+            tables: TaskTables::contact_first(&phase),
             phase,
             velocity_fraction: 0.1,
             iterations_per_frame: 1,
@@ -213,6 +216,8 @@ pub struct RobotFrame {
 struct ResolvedTask {
     task: Task,
     frame: Option<FrameId>,
+    /// The tracked point in the frame (m).
+    offset: Vector3<f64>,
     axes: [Option<Axis>; 3],
     rows: usize,
     level: usize,
@@ -294,17 +299,22 @@ impl PhaseSolver {
         for (level, l) in table.levels.iter().enumerate() {
             let mut row = 0;
             for task in &l.tasks {
-                let frame = match task {
-                    Task::ComXY(_) => None,
-                    Task::Point { frame, .. } => Some(model.frame_id(frame)?),
+                let (frame, offset) = match task {
+                    Task::ComXY(_) => (None, Vector3::zeros()),
+                    Task::Point { frame, offset, .. } => {
+                        (Some(model.frame_id(frame)?), Vector3::from(*offset))
+                    }
                 };
-                let rest_height =
-                    frame.map_or(0.0, |f| rest.frame_placement(f).translation.vector.z);
+                let rest_height = match frame {
+                    Some(f) => model.point_position(&rest, f, &offset)?.z,
+                    None => 0.0,
+                };
                 tasks.push(ResolvedTask {
                     axes: axes_of(task),
                     rows: task.rows(),
                     task: task.clone(),
                     frame,
+                    offset,
                     level,
                     row,
                     rest_height,
@@ -388,7 +398,13 @@ impl Imitator {
         position_bounds.clamp_position(&mut q);
         let phases = SupportPhase::ALL
             .iter()
-            .map(|&phase| PhaseSolver::new(config.tables.table(phase), &models, config.solver))
+            .map(|&phase| {
+                let settings = Settings {
+                    scale_to_fit: true,
+                    ..config.solver
+                };
+                PhaseSolver::new(config.tables.table(phase), &models, settings)
+            })
             .collect::<Result<Vec<_>, _>>()?;
         let skeleton = RobotSkeleton::at_zero(&models.right, &NAO_MAPPING)?;
         let angles = NaoJointAngles::new(&models.right)?;
@@ -528,7 +544,10 @@ impl Imitator {
         if changed {
             for task in &mut ps.tasks {
                 if let Some(f) = task.frame {
-                    task.held = self.data[root].frame_placement(f).translation.vector;
+                    task.held = self.data[root]
+                        .frame_placement(f)
+                        .transform_point(&task.offset.into())
+                        .coords;
                 }
             }
         }
@@ -580,22 +599,24 @@ impl Imitator {
             .iter()
             .position(|t| matches!(t.task, Task::ComXY(_)))
             .map_or(0.0, |i| errors[i]);
+        // Heights of the swing sole's outline corners: a lift is done when the lowest corner is
+        // at ρ, a landing when the highest is on the ground (flat, so that the foot can become
+        // the support without tilting the world).
         let swing = phase.swing_foot().unwrap_or(self.root.other());
-        let (toe, heel) = match swing {
-            Foot::Right => ("r_toe", "r_heel"),
-            Foot::Left => ("l_toe", "l_heel"),
-        };
-        let height = |name: &str| -> Result<f64, ModelError> {
-            Ok(data
-                .frame_placement(model.frame_id(name)?)
-                .translation
-                .vector
-                .z)
-        };
+        let sole = data.frame_placement(model.frame_id(swing.sole())?);
+        let corner_z = swing
+            .sole_outline()
+            .map(|[x, y]| sole.transform_point(&Vector3::new(x, y, 0.0).into()).z);
+        let lifting = matches!(
+            phase,
+            SupportPhase::DoubleToRight(TakeOff::LiftFoot)
+                | SupportPhase::DoubleToLeft(TakeOff::LiftFoot)
+        );
+        let pick = |a: f64, b: f64| if lifting { a.min(b) } else { a.max(b) };
         self.measurements = Measurements {
             com_error,
-            swing_toe_height: height(toe)?,
-            swing_heel_height: height(heel)?,
+            swing_toe_height: pick(corner_z[0], corner_z[1]),
+            swing_heel_height: pick(corner_z[2], corner_z[3]),
         };
 
         let world_t_root = self.world_t_root;
@@ -709,22 +730,26 @@ impl TaskModel for PhaseTasks<'_> {
                     },
                     Some(frame),
                 ) => {
-                    let zero = Vector3::zeros();
+                    let offset = &task.offset;
                     if task.rows == 3 {
-                        self.model.point_jacobian(self.data, frame, &zero, jac)?;
+                        self.model.point_jacobian(self.data, frame, offset, jac)?;
                     } else {
                         let mut jac = jac;
                         for (r, axis) in task.axes.iter().flatten().enumerate() {
                             self.model.point_jacobian_row(
                                 self.data,
                                 frame,
-                                &zero,
+                                offset,
                                 *axis,
                                 jac.as_mut().subrows_mut(r, 1),
                             )?;
                         }
                     }
-                    let p = self.data.frame_placement(frame).translation.vector;
+                    let p = self
+                        .data
+                        .frame_placement(frame)
+                        .transform_point(&(*offset).into())
+                        .coords;
                     // Missing references (never after the scaler) hold the current position.
                     let goal = match point_target {
                         PointTarget::Scaled(joint) => self.reference[joint.index()].unwrap_or(p),

@@ -11,6 +11,7 @@
 
 pub mod human;
 pub mod imitator;
+pub mod metrics;
 pub mod phase;
 pub mod scaler;
 pub mod support;

@@ -45,6 +45,7 @@
 //! let mut rs = tables.table(SupportPhase::Right).clone();
 //! rs.levels[1].tasks.push(Task::Point {
 //!     frame: "head".into(),
+//!     offset: [0.0; 3],
 //!     axes: Axes::XYZ,
 //!     target: PointTarget::Scaled(HumanJoint::Head),
 //! });
@@ -106,6 +107,12 @@ impl Axes {
         y: true,
         z: true,
     };
+    /// The horizontal coordinates.
+    pub const XY: Axes = Axes {
+        x: true,
+        y: true,
+        z: false,
+    };
     /// The height only.
     pub const Z: Axes = Axes {
         x: false,
@@ -147,10 +154,13 @@ pub enum PointTarget {
 pub enum Task {
     /// The CoM ground projection (2 rows).
     ComXY(ComGoal),
-    /// Coordinates of a named robot frame (see `robots::nao::FRAMES`), 1–3 rows.
+    /// Coordinates of a point fixed to a named robot frame (see `robots::nao::FRAMES`), 1–3
+    /// rows.
     Point {
         /// Frame name, e.g. `"l_hand"`.
         frame: String,
+        /// The point in that frame (m); zero for the frame's origin.
+        offset: [f64; 3],
         /// The tracked coordinates.
         axes: Axes,
         /// Where they go.
@@ -279,6 +289,21 @@ fn foot_frames(foot: Foot) -> [&'static str; 3] {
     }
 }
 
+/// Offset of the toe and heel height points toward the outer edge of the sole (m, in the sole
+/// frame, +y for the left foot). The ankle's position and the heights of two points fix the
+/// sole's pitch and roll only if the points are not on the sole's x axis: on the axis (the
+/// `l_toe`/`l_heel` frames themselves) a roll about that axis changes no tracked coordinate to
+/// first order, and the gradient tasks tilt the foot. 30 mm puts the points at the outer foot
+/// pressure sensors' line ([`Foot::sole_outline`]).
+pub const SOLE_EDGE_OFFSET: f64 = 0.03;
+
+fn outer_edge(foot: Foot) -> [f64; 3] {
+    match foot {
+        Foot::Right => [0.0, -SOLE_EDGE_OFFSET, 0.0],
+        Foot::Left => [0.0, SOLE_EDGE_OFFSET, 0.0],
+    }
+}
+
 fn human_ankle(foot: Foot) -> HumanJoint {
     match foot {
         Foot::Right => HumanJoint::RAnkle,
@@ -293,11 +318,14 @@ impl TaskTable {
         let root = phase.model_root();
         let free = root.other();
         let [ankle, toe, heel] = foot_frames(free);
-        let point = |frame: &str, axes, target| Task::Point {
+        let point_at = |frame: &str, offset, axes, target| Task::Point {
             frame: frame.to_owned(),
+            offset,
             axes,
             target,
         };
+        let point = |frame: &str, axes, target| point_at(frame, [0.0; 3], axes, target);
+        let edge = outer_edge(free);
         let hands = || {
             vec![
                 point("l_hand", Axes::XYZ, PointTarget::Scaled(HumanJoint::LHand)),
@@ -309,8 +337,8 @@ impl TaskTable {
             let held = PointTarget::Held { lift };
             vec![
                 point(ankle, Axes::XYZ, held),
-                point(toe, Axes::Z, held),
-                point(heel, Axes::Z, held),
+                point_at(toe, edge, Axes::Z, held),
+                point_at(heel, edge, Axes::Z, held),
             ]
         };
         let lambda = config.lambda;
@@ -382,6 +410,74 @@ impl TaskTable {
         }
     }
 
+    /// The paper's table for `phase` with the free foot's ground contact as its own, highest
+    /// level, in the steps where that foot stands on the ground (DS, "CoM to foot", "CoM to
+    /// middle"): the heights of the ankle and of two sole-edge points (3 rows) first, then the
+    /// CoM, then the rest — the ankle's horizontal position (scaled in DS, held otherwise) and
+    /// the hands. Same rows as Table I, other priorities. Table I puts the foot in the tracking
+    /// level with the hands, so when a hand is out of reach the least-squares compromise of that
+    /// level tilts a foot that stands on the ground; a contact is a constraint, not a target.
+    pub fn contact_first(phase: SupportPhase, config: &PhaseConfig) -> Self {
+        let mut table = Self::paper(phase, config);
+        let on_ground = matches!(
+            phase,
+            SupportPhase::Double
+                | SupportPhase::DoubleToRight(TakeOff::ComToFoot)
+                | SupportPhase::DoubleToLeft(TakeOff::ComToFoot)
+                | SupportPhase::RightToDouble(Landing::ComToMiddle)
+                | SupportPhase::LeftToDouble(Landing::ComToMiddle)
+        );
+        if !on_ground {
+            return table;
+        }
+        let free = table.model_root.other();
+        let [ankle, _, _] = foot_frames(free);
+        let mut contact = Vec::new();
+        let mut rest = Vec::new();
+        for task in table.levels.remove(1).tasks {
+            match task {
+                Task::Point {
+                    frame,
+                    offset,
+                    axes,
+                    target,
+                } if frame == ankle => {
+                    contact.push(Task::Point {
+                        frame: frame.clone(),
+                        offset,
+                        axes: Axes::Z,
+                        target: PointTarget::Held { lift: 0.0 },
+                    });
+                    let horizontal = Axes { z: false, ..axes };
+                    rest.push(Task::Point {
+                        frame,
+                        offset,
+                        axes: horizontal,
+                        target,
+                    });
+                }
+                Task::Point {
+                    axes: Axes::Z,
+                    target: PointTarget::Held { .. },
+                    ..
+                } => contact.push(task),
+                other => rest.push(other),
+            }
+        }
+        table.levels.insert(
+            0,
+            Level {
+                name: "contact".to_owned(),
+                tasks: contact,
+            },
+        );
+        table.levels.push(Level {
+            name: "tracking".to_owned(),
+            tasks: rest,
+        });
+        table
+    }
+
     /// The solver stack shape over `dof` joints: one level per [`Level`], one named task (see
     /// [`Task::name`]) per [`Task`].
     pub fn shape(&self, dof: usize) -> StackShape {
@@ -429,6 +525,9 @@ impl TaskTable {
                         target: PointTarget::Held { lift },
                         ..
                     } if !lift.is_finite() => return Err(not_finite("lift")),
+                    Task::Point { offset, .. } if offset.iter().any(|v| !v.is_finite()) => {
+                        return Err(not_finite("offset"));
+                    }
                     Task::ComXY(_) | Task::Point { .. } => {}
                 }
                 if !names.insert(name.clone()) {
@@ -476,15 +575,21 @@ impl fmt::Display for ComCell<'_> {
     }
 }
 
-struct PointCell<'a>(&'a str, Axes, PointTarget);
+struct PointCell<'a>(&'a str, [f64; 3], Axes, PointTarget);
 
 impl fmt::Display for PointCell<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let PointCell(frame, axes, target) = *self;
-        let coords = if axes == Axes::XYZ {
-            format!("p({frame})")
+        let PointCell(frame, offset, axes, target) = *self;
+        let point = if offset == [0.0; 3] {
+            frame.to_owned()
         } else {
-            format!("{}({frame})", &axes.suffix()[1..])
+            let [x, y, z] = offset.map(mm);
+            format!("{frame} + [{x}, {y}, {z}]")
+        };
+        let coords = if axes == Axes::XYZ {
+            format!("p({point})")
+        } else {
+            format!("{}({point})", &axes.suffix()[1..])
         };
         match target {
             PointTarget::Scaled(joint) => write!(f, "{coords} ← {}", joint.name()),
@@ -509,11 +614,12 @@ impl fmt::Display for TaskTable {
                     Task::ComXY(goal) => coms.push(ComCell(goal, self.model_root).to_string()),
                     Task::Point {
                         frame,
+                        offset,
                         axes,
                         target,
                     } => {
                         rows += task.rows();
-                        cells.push(PointCell(frame, *axes, *target).to_string());
+                        cells.push(PointCell(frame, *offset, *axes, *target).to_string());
                     }
                 }
             }
@@ -566,6 +672,17 @@ impl TaskTables {
             tables: SupportPhase::ALL
                 .iter()
                 .map(|&phase| TaskTable::paper(phase, config))
+                .collect(),
+        }
+    }
+
+    /// [`TaskTable::contact_first`] for every phase, with λ and ρ from `config`: the tables the
+    /// imitator uses by default.
+    pub fn contact_first(config: &PhaseConfig) -> Self {
+        Self {
+            tables: SupportPhase::ALL
+                .iter()
+                .map(|&phase| TaskTable::contact_first(phase, config))
                 .collect(),
         }
     }

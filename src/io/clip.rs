@@ -28,7 +28,8 @@ pub enum ClipError {
 }
 
 enum Source {
-    Bvh(BvhReader<BufReader<File>>),
+    // Boxed: the BVH reader is several times larger than the Kinect one.
+    Bvh(Box<BvhReader<BufReader<File>>>),
     Kinect(KinectReader<BufReader<File>>),
 }
 
@@ -61,7 +62,7 @@ impl Clip {
             reader.read_frame(&mut t_pose)?;
         }
         Ok(Self {
-            source: Source::Bvh(reader),
+            source: Source::Bvh(Box::new(reader)),
             support: SupportConfig::optical(),
         })
     }

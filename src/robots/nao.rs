@@ -130,6 +130,27 @@ impl Foot {
         }
     }
 
+    /// The sole's outline: the four foot pressure sensors (front left, front right, rear right,
+    /// rear left: clockwise seen from above) in the sole frame, metres, from the URDF's
+    /// `LFoot/FSR/*` and `RFoot/FSR/*` fixed joints (ankle offsets with z = −0.04511 dropped).
+    /// Their convex hull is the support area this foot gives.
+    pub fn sole_outline(self) -> [[f64; 2]; 4] {
+        match self {
+            Foot::Left => [
+                [0.07025, 0.0299],
+                [0.07025, -0.0231],
+                [-0.02965, -0.0191],
+                [-0.03025, 0.0299],
+            ],
+            Foot::Right => [
+                [0.07025, 0.0231],
+                [0.07025, -0.0299],
+                [-0.02965, -0.0299],
+                [-0.03025, 0.0191],
+            ],
+        }
+    }
+
     /// The DH model rooted at this foot's sole.
     pub fn model(self) -> Model {
         match self {

@@ -59,6 +59,14 @@ pub struct Settings {
     /// A level is reported feasible when `‖J_j q̇ − ẋ_j‖ ≤ feasibility_tolerance · (1 + ‖ẋ_j‖)`.
     /// Default `1e-8`.
     pub feasibility_tolerance: f64,
+    /// Before the clamping loop, scale the whole step (every desired velocity and the gradient
+    /// term alike) down so that the unconstrained solution fits each joint's velocity interval.
+    /// A uniform scale keeps every priority relation exactly — each level gets the same fraction
+    /// of its motion — and leaves the clamping loop only the joints whose interval excludes the
+    /// direction they need (a position limit reached). Off by default (the paper's clamping
+    /// loop alone, which keeps higher levels exact by pinning joints at their bounds, but can
+    /// leave them few joints when a lower level asks for much more than the limits allow).
+    pub scale_to_fit: bool,
 }
 
 impl Default for Settings {
@@ -68,6 +76,7 @@ impl Default for Settings {
             damping_threshold: 2e-2,
             max_damping: 2e-2,
             feasibility_tolerance: 1e-8,
+            scale_to_fit: false,
         }
     }
 }
@@ -134,6 +143,8 @@ pub struct Solver {
     step_lo: Vec<f64>,
     step_hi: Vec<f64>,
     velocity: Vec<f64>,
+    /// Scale applied to the desired velocities and the gradient term in this solve.
+    step_scale: f64,
     report: SolveReport,
 }
 
@@ -167,6 +178,7 @@ impl Solver {
             step_lo: vec![0.0; n],
             step_hi: vec![0.0; n],
             velocity: vec![0.0; n],
+            step_scale: 1.0,
             report: SolveReport::with_capacity(levels, n),
             stack,
             settings,
@@ -234,6 +246,11 @@ impl Solver {
         self.fixed_velocity.fill(0.0);
         self.report.clamped.clear();
         self.report.clamping_iterations = 0;
+        self.step_scale = 1.0;
+        if self.settings.scale_to_fit {
+            self.prioritized_pass();
+            self.step_scale = 1.0 / self.overshoot_ratio();
+        }
         loop {
             self.report.clamping_iterations += 1;
             self.prioritized_pass();
@@ -272,12 +289,27 @@ impl Solver {
         self.fixed_velocity.fill(0.0);
         self.report.clamped.clear();
         self.report.clamping_iterations = 1;
+        self.step_scale = 1.0;
         self.prioritized_pass();
         self.finish_report();
         Ok(Solution {
             velocity: &self.velocity,
             report: &self.report,
         })
+    }
+
+    /// By how much the current velocity exceeds the step intervals, over the joints whose interval
+    /// contains 0 (scaling toward 0 can fix those): `max(1, v_i / hi_i, v_i / lo_i)`.
+    fn overshoot_ratio(&self) -> f64 {
+        let mut ratio = 1.0_f64;
+        for ((&v, &lo), &hi) in self.velocity.iter().zip(&self.step_lo).zip(&self.step_hi) {
+            if v > hi && hi > 0.0 {
+                ratio = ratio.max(v / hi);
+            } else if v < lo && lo < 0.0 {
+                ratio = ratio.max(v / lo);
+            }
+        }
+        ratio
     }
 
     /// One prioritized solve over the joints not clamped; writes `self.velocity`.
@@ -304,7 +336,8 @@ impl Solver {
         let (head, tail) = self.qr.split_at_mut(n * start);
         for t in 0..rows {
             let row = self.stack.row(start + t);
-            let mut b = self.stack.stacked_target()[start + t] - dot(row, &self.fixed_velocity);
+            let mut b = self.step_scale * self.stack.stacked_target()[start + t]
+                - dot(row, &self.fixed_velocity);
             for (c, &i) in self.coords.iter_mut().zip(&self.free) {
                 *c = row[i];
             }
@@ -391,7 +424,7 @@ impl Solver {
         // Z_Nᵀ g: the gradient through every level's reflectors.
         let gradient = self.stack.gradient();
         for (c, &i) in self.coords.iter_mut().zip(&self.free) {
-            *c = gradient[i];
+            *c = self.step_scale * gradient[i];
         }
         let mut offset = 0;
         for j in 0..levels {
@@ -432,6 +465,7 @@ impl Solver {
 
     /// Residuals and feasibility of every level for the final velocity.
     fn finish_report(&mut self) {
+        self.report.step_scale = self.step_scale;
         for j in 0..self.stack.level_count() {
             let start = self.stack.level_start(j);
             let end = self.stack.level_start(j + 1);

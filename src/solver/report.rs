@@ -25,6 +25,7 @@ pub struct SolveReport {
     pub(crate) levels: Vec<LevelReport>,
     pub(crate) clamped: Vec<usize>,
     pub(crate) clamping_iterations: usize,
+    pub(crate) step_scale: f64,
 }
 
 impl SolveReport {
@@ -33,6 +34,7 @@ impl SolveReport {
             levels: vec![LevelReport::default(); levels],
             clamped: Vec::with_capacity(dof),
             clamping_iterations: 0,
+            step_scale: 1.0,
         }
     }
 
@@ -49,6 +51,13 @@ impl SolveReport {
     /// Number of prioritized solves the clamping loop ran (1 when no joint had to be clamped).
     pub fn clamping_iterations(&self) -> usize {
         self.clamping_iterations
+    }
+
+    /// The uniform scale applied to every desired velocity and the gradient term to fit the
+    /// velocity intervals ([`Settings::scale_to_fit`](super::Settings::scale_to_fit)); 1 when
+    /// no scaling was needed or it is off. Residuals are against the unscaled targets.
+    pub fn step_scale(&self) -> f64 {
+        self.step_scale
     }
 
     /// Index of the first level that is not feasible, if any: the highest level that gave way.
