@@ -132,6 +132,13 @@ pub struct ImitatorConfig {
     /// have to take the tasks apart. Default 0.15 m/s, about what 10 % of the NAO's rated joint
     /// velocities give at its hands (0.8 rad/s × 0.2 m).
     pub max_task_speed: f64,
+    /// A human stance on one foot that lasts this long (s) is a step the robot takes: it reaches
+    /// single support on that foot, at its own pace, even if the human has put the other foot
+    /// down meanwhile (a walking human changes support faster than a robot at 10 % speed can
+    /// follow; the robot finishes each step, then takes the human's current one). A shorter
+    /// stance that ends first is a change of mind: the robot puts its CoM back. Default 0.3 s;
+    /// `f64::INFINITY` never commits (the robot follows the human's support as it is).
+    pub step_commit_time: f64,
     /// Time step assumed for the first frame, and for a frame with the same time as the previous
     /// one (s). Default 1/120 s.
     pub nominal_dt: f64,
@@ -155,6 +162,7 @@ impl Default for ImitatorConfig {
             velocity_fraction: 0.1,
             iterations_per_frame: 1,
             max_task_speed: 0.15,
+            step_commit_time: 0.3,
             nominal_dt: 1.0 / 120.0,
             solver: Settings::default(),
             initial_q: None,
@@ -261,6 +269,7 @@ pub struct Imitator {
     phase: SupportPhase,
     measurements: Measurements,
     previous_time: Option<f64>,
+    commitment: StepCommitment,
     output: RobotFrame,
 }
 
@@ -367,6 +376,13 @@ impl Imitator {
                 reason: "must be finite and > 0 m/s",
             });
         }
+        if config.step_commit_time.is_nan() || config.step_commit_time < 0.0 {
+            return Err(ImitationError::InvalidParameter {
+                name: "step_commit_time",
+                value: config.step_commit_time,
+                reason: "must be >= 0 s (infinity: never commit)",
+            });
+        }
         if config.iterations_per_frame == 0 {
             return Err(ImitationError::InvalidParameter {
                 name: "iterations_per_frame",
@@ -455,6 +471,11 @@ impl Imitator {
                 swing_heel_height: 0.0,
             },
             previous_time: None,
+            commitment: StepCommitment {
+                commit_time: config.step_commit_time,
+                stance: None,
+                pending: None,
+            },
             output,
             models,
         })
@@ -521,7 +542,10 @@ impl Imitator {
             return Err(ScaleError::NonFiniteTime(frame.time).into());
         }
         let human = self.detector.update(frame);
-        let phase = self.machine.update(human, &self.measurements);
+        let phase = self.machine.update(
+            self.commitment.filter(human, self.phase, dt),
+            &self.measurements,
+        );
         let changed = phase != self.phase || self.previous_time.is_none();
         self.switch_root(self.phases[phase.index()].table.model_root)?;
         let root = foot_index(self.root);
@@ -655,6 +679,47 @@ impl Imitator {
             .rooted_at(self.root)
             .forward_kinematics(&mut self.data[to], &self.q)?;
         Ok(())
+    }
+}
+
+/// Turns every human stance on one foot that lasts long enough into a step the robot takes, at
+/// its own pace (see [`ImitatorConfig::step_commit_time`]).
+#[derive(Debug, Clone)]
+struct StepCommitment {
+    commit_time: f64,
+    /// The foot of the human's current single-support episode and how long it has lasted (s).
+    stance: Option<(HumanSupport, f64)>,
+    /// The long stance the robot is stepping to and has not reached yet.
+    pending: Option<HumanSupport>,
+}
+
+impl StepCommitment {
+    /// The human support the phase machine should see this frame.
+    fn filter(&mut self, human: HumanSupport, robot: SupportPhase, dt: f64) -> HumanSupport {
+        self.stance = match (human, self.stance) {
+            (HumanSupport::Right | HumanSupport::Left, Some((foot, t))) if foot == human => {
+                Some((foot, t + dt))
+            }
+            (HumanSupport::Right | HumanSupport::Left, _) => Some((human, dt)),
+            (HumanSupport::Airborne, stance) => stance,
+            (HumanSupport::Double, _) => None,
+        };
+        // One step at a time: the robot finishes the step it is taking before it takes the
+        // human's next one.
+        if let (None, Some((foot, t))) = (self.pending, self.stance) {
+            if t >= self.commit_time {
+                self.pending = Some(foot);
+            }
+        }
+        let reached = match robot {
+            SupportPhase::Right => Some(HumanSupport::Right),
+            SupportPhase::Left => Some(HumanSupport::Left),
+            _ => None,
+        };
+        if self.pending.is_some() && self.pending == reached {
+            self.pending = None;
+        }
+        self.pending.unwrap_or(human)
     }
 }
 

@@ -228,6 +228,20 @@ pub fn convex_margin(points: &mut [Vector2<f64>], p: Vector2<f64>) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
+/// The angle of a rotation, accurate near zero (`acos` of the trace loses half the digits).
+fn rotation_angle(r: &nalgebra::Rotation3<f64>) -> f64 {
+    let m = r.matrix();
+    let sin = 0.5
+        * Vector3::new(
+            m[(2, 1)] - m[(1, 2)],
+            m[(0, 2)] - m[(2, 0)],
+            m[(1, 0)] - m[(0, 1)],
+        )
+        .norm();
+    let cos = 0.5 * (m.trace() - 1.0);
+    sin.atan2(cos)
+}
+
 impl MetricsRecorder {
     /// A recorder for the runs of `imitator`.
     pub fn new(imitator: &Imitator) -> Self {
@@ -344,7 +358,7 @@ impl MetricsRecorder {
                 .max((now.translation.vector - then.translation.vector).norm());
             self.turn = self
                 .turn
-                .max((then.rotation.inverse() * now.rotation).angle());
+                .max(rotation_angle(&(then.rotation.inverse() * now.rotation)));
         }
         self.last_feet = Some(placement);
         self.last_grounded = on_ground;
@@ -355,6 +369,16 @@ impl MetricsRecorder {
                 self.human_changes += 1;
             }
             self.last_human = Some(frame.human_support);
+        }
+        if self.frames == 0 {
+            // The robot starts in a continuous phase even if its first frame is a transition.
+            let origin = match frame.phase {
+                SupportPhase::DoubleToRight(_) | SupportPhase::DoubleToLeft(_) => Some("DS"),
+                SupportPhase::RightToDouble(_) => Some("RS"),
+                SupportPhase::LeftToDouble(_) => Some("LS"),
+                _ => None,
+            };
+            self.sequence.extend(origin);
         }
         match continuous_name(frame.phase) {
             Some(name) => {
