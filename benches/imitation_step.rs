@@ -1,0 +1,57 @@
+//! `Imitator::step` on real clips: frames of double support (CMU 02_10, standing gestures) and of
+//! a walk with right and left single supports (CMU 07_04), streamed from memory in a loop.
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use std::hint::black_box;
+use taskstack::imitation::human::HumanFrame;
+use taskstack::imitation::imitator::{FootRootedModels, Imitator, ImitatorConfig};
+use taskstack::imitation::phase::SupportPhase;
+use taskstack::io::clip::Clip;
+
+fn frames(name: &str) -> Vec<HumanFrame> {
+    let path = format!("{}/tests/data/mocap/{name}", env!("CARGO_MANIFEST_DIR"));
+    Clip::open(path).unwrap().collect::<Result<_, _>>().unwrap()
+}
+
+fn bench(c: &mut Criterion) {
+    for (label, clip) in [
+        (
+            "double_support_02_10",
+            "cmu_02_10_wash_self_standing_arm_gestures.bvh",
+        ),
+        ("walk_07_04", "cmu_07_04_slow_walk.bvh"),
+    ] {
+        let frames = frames(clip);
+        let duration = frames.last().unwrap().time - frames[0].time + 1.0 / 120.0;
+        let mut imitator =
+            Imitator::new(FootRootedModels::nao(), ImitatorConfig::default()).unwrap();
+        // Warm up on the whole clip once, and count the phases the bench will see.
+        let mut single = 0;
+        for f in &frames {
+            let p = imitator.step(f).unwrap().phase;
+            single += usize::from(matches!(p, SupportPhase::Right | SupportPhase::Left));
+        }
+        eprintln!(
+            "{label}: {} frames, {single} in single support on the first pass",
+            frames.len()
+        );
+        let mut i = 0;
+        let mut lap = 1.0;
+        c.bench_function(&format!("imitator_step/{label}"), |b| {
+            b.iter(|| {
+                // Replay the clip with increasing times so the imitator sees a continuous stream.
+                let mut frame = frames[i];
+                frame.time += lap * duration;
+                i += 1;
+                if i == frames.len() {
+                    i = 0;
+                    lap += 1.0;
+                }
+                black_box(imitator.step(&frame).unwrap().q[0])
+            })
+        });
+    }
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
