@@ -1,13 +1,15 @@
 //! Online imitation of a motion clip by the NAO (the README's main job).
 //!
-//! `cargo run --release --example imitate -- [CLIP.bvh|CLIP.csv] [--out DIR] [--velocity-fraction F]`
+//! `cargo run --release --example imitate -- [CLIP.bvh|CLIP.csv] [--out DIR] [--velocity-fraction F] [--hold S]`
 //!
 //! With no clip, a bundled real clip with a support change (CMU 05_02: standing, arm gestures,
 //! small steps, then a stance on the right leg). Writes into DIR (default `target/imitate`):
 //! `joints.csv` (time in s + the 23 joint angles in rad, NAOqi names), `metrics.json` (see
 //! `taskstack::imitation::metrics`), and the plots `effectors.svg` (Poubel Fig. 6), `com.svg`
 //! (Fig. 8) and `phases.svg`; prints a summary. `--velocity-fraction` is the share of the rated
-//! joint velocities the robot may use (default 0.1, as in the paper).
+//! joint velocities the robot may use (default 0.1, as in the paper). After the clip the human's
+//! last pose is held for `--hold` seconds (default 5) so the robot can finish the step it is
+//! taking; those frames are in the outputs too.
 
 mod plots;
 
@@ -33,11 +35,16 @@ fn main() -> ExitCode {
     let mut clip = PathBuf::from(DEFAULT_CLIP);
     let mut out = PathBuf::from("target/imitate");
     let mut fraction = ImitatorConfig::default().velocity_fraction;
+    let mut hold = 5.0;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
             "--out" => match args.next() {
                 Some(d) => out = d.into(),
+                None => return usage(),
+            },
+            "--hold" => match args.next().and_then(|v| v.parse::<f64>().ok()).filter(|h| h.is_finite() && *h >= 0.0) {
+                Some(h) => hold = h,
                 None => return usage(),
             },
             "--velocity-fraction" => match args.next().and_then(|v| v.parse().ok()) {
@@ -48,7 +55,7 @@ fn main() -> ExitCode {
             _ => clip = a.into(),
         }
     }
-    match run(&clip, &out, fraction) {
+    match run(&clip, &out, fraction, hold) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("imitate: {}: {e}", clip.display());
@@ -58,11 +65,11 @@ fn main() -> ExitCode {
 }
 
 fn usage() -> ExitCode {
-    eprintln!("usage: imitate [CLIP.bvh|CLIP.csv] [--out DIR] [--velocity-fraction F]");
+    eprintln!("usage: imitate [CLIP.bvh|CLIP.csv] [--out DIR] [--velocity-fraction F] [--hold S]");
     ExitCode::from(2)
 }
 
-fn run(path: &Path, out: &Path, velocity_fraction: f64) -> Result<(), Box<dyn std::error::Error>> {
+fn run(path: &Path, out: &Path, velocity_fraction: f64, hold: f64) -> Result<(), Box<dyn std::error::Error>> {
     let mut clip = Clip::open(path)?;
     let config = ImitatorConfig {
         support: clip.support_config(),
@@ -76,7 +83,21 @@ fn run(path: &Path, out: &Path, velocity_fraction: f64) -> Result<(), Box<dyn st
     let mut samples = Vec::new();
     let plotted = ["l_hand", "r_hand", "l_ankle"];
     let mut frame = HumanFrame::new(0.0);
-    while clip.read_frame(&mut frame)? {
+    let mut last: Option<HumanFrame> = None;
+    let mut end = f64::INFINITY;
+    loop {
+        if clip.read_frame(&mut frame)? {
+            last = Some(frame);
+        } else {
+            // The clip is over: the human holds the last pose while the robot finishes.
+            let Some(held) = last.as_mut() else { break };
+            end = end.min(held.time + hold);
+            held.time += 1.0 / 120.0;
+            if held.time > end {
+                break;
+            }
+            frame = *held;
+        }
         let r = imitator.step(&frame)?;
         let r = r.clone();
         recorder.record(&imitator, &r)?;
