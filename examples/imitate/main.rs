@@ -43,7 +43,11 @@ fn main() -> ExitCode {
                 Some(d) => out = d.into(),
                 None => return usage(),
             },
-            "--hold" => match args.next().and_then(|v| v.parse::<f64>().ok()).filter(|h| h.is_finite() && *h >= 0.0) {
+            "--hold" => match args
+                .next()
+                .and_then(|v| v.parse::<f64>().ok())
+                .filter(|h| h.is_finite() && *h >= 0.0)
+            {
                 Some(h) => hold = h,
                 None => return usage(),
             },
@@ -69,7 +73,12 @@ fn usage() -> ExitCode {
     ExitCode::from(2)
 }
 
-fn run(path: &Path, out: &Path, velocity_fraction: f64, hold: f64) -> Result<(), Box<dyn std::error::Error>> {
+fn run(
+    path: &Path,
+    out: &Path,
+    velocity_fraction: f64,
+    hold: f64,
+) -> Result<(), Box<dyn std::error::Error>> {
     let mut clip = Clip::open(path)?;
     let config = ImitatorConfig {
         support: clip.support_config(),
