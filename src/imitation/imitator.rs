@@ -706,10 +706,10 @@ impl StepCommitment {
         };
         // One step at a time: the robot finishes the step it is taking before it takes the
         // human's next one.
-        if let (None, Some((foot, t))) = (self.pending, self.stance) {
-            if t >= self.commit_time {
-                self.pending = Some(foot);
-            }
+        if let (None, Some((foot, t))) = (self.pending, self.stance)
+            && t >= self.commit_time
+        {
+            self.pending = Some(foot);
         }
         let reached = match robot {
             SupportPhase::Right => Some(HumanSupport::Right),
