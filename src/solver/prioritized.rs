@@ -59,13 +59,16 @@ pub struct Settings {
     /// A level is reported feasible when `‖J_j q̇ − ẋ_j‖ ≤ feasibility_tolerance · (1 + ‖ẋ_j‖)`.
     /// Default `1e-8`.
     pub feasibility_tolerance: f64,
-    /// Before the clamping loop, scale the whole step (every desired velocity and the gradient
-    /// term alike) down so that the unconstrained solution fits each joint's velocity interval.
-    /// A uniform scale keeps every priority relation exactly — each level gets the same fraction
-    /// of its motion — and leaves the clamping loop only the joints whose interval excludes the
-    /// direction they need (a position limit reached). Off by default (the paper's clamping
-    /// loop alone, which keeps higher levels exact by pinning joints at their bounds, but can
-    /// leave them few joints when a lower level asks for much more than the limits allow).
+    /// Before the clamping loop, slow the levels down, lowest priority first, until the step fits
+    /// each joint's velocity interval: the step is `Σ_k s_k C_k`, with `C_k` the (linear) part of
+    /// the solution due to level `k`'s desired velocity (and last, the gradient term), and each
+    /// scale `s_k ∈ [0, 1]` taken as large as the joint intervals allow given the levels above it
+    /// ("saturation in the null space", Flacco et al. 2012, with whole-level scaling). A level
+    /// keeps its direction and never costs a higher level any of its motion. The clamping loop
+    /// then only has the joints whose interval excludes 0 (a start outside the limits). Off by
+    /// default: the paper's clamping loop alone, which keeps higher levels exact by pinning joints
+    /// at their bounds, but can leave them few joints when a lower level asks for much more than
+    /// the limits allow.
     pub scale_to_fit: bool,
 }
 
@@ -143,8 +146,15 @@ pub struct Solver {
     step_lo: Vec<f64>,
     step_hi: Vec<f64>,
     velocity: Vec<f64>,
-    /// Scale applied to the desired velocities and the gradient term in this solve.
-    step_scale: f64,
+    /// Scale of each level's desired velocity in this solve, then of the gradient term.
+    scales: Vec<f64>,
+    /// The part of the step due to each level, then to the gradient (levels + 1 rows of n).
+    contributions: Vec<f64>,
+    /// Velocity limits of this solve.
+    step_vmax: Vec<f64>,
+    /// The part of the step due to the clamped joints' fixed velocities, and a copy of those.
+    base_velocity: Vec<f64>,
+    saved_fixed: Vec<f64>,
     report: SolveReport,
 }
 
@@ -178,7 +188,11 @@ impl Solver {
             step_lo: vec![0.0; n],
             step_hi: vec![0.0; n],
             velocity: vec![0.0; n],
-            step_scale: 1.0,
+            scales: vec![1.0; levels + 1],
+            contributions: vec![0.0; (levels + 1) * n],
+            step_vmax: vec![0.0; n],
+            base_velocity: vec![0.0; n],
+            saved_fixed: vec![0.0; n],
             report: SolveReport::with_capacity(levels, n),
             stack,
             settings,
@@ -242,14 +256,14 @@ impl Solver {
         }
         self.stack.check_finite()?;
         bounds.step_interval(q, dt, &mut self.step_lo, &mut self.step_hi);
+        self.step_vmax.copy_from_slice(bounds.velocity());
         self.clamped.fill(false);
         self.fixed_velocity.fill(0.0);
         self.report.clamped.clear();
         self.report.clamping_iterations = 0;
-        self.step_scale = 1.0;
+        self.scales.fill(1.0);
         if self.settings.scale_to_fit {
-            self.prioritized_pass();
-            self.step_scale = 1.0 / self.overshoot_ratio();
+            self.fit_scales();
         }
         loop {
             self.report.clamping_iterations += 1;
@@ -289,7 +303,7 @@ impl Solver {
         self.fixed_velocity.fill(0.0);
         self.report.clamped.clear();
         self.report.clamping_iterations = 1;
-        self.step_scale = 1.0;
+        self.scales.fill(1.0);
         self.prioritized_pass();
         self.finish_report();
         Ok(Solution {
@@ -298,18 +312,75 @@ impl Solver {
         })
     }
 
-    /// By how much the current velocity exceeds the step intervals, over the joints whose interval
-    /// contains 0 (scaling toward 0 can fix those): `max(1, v_i / hi_i, v_i / lo_i)`.
-    fn overshoot_ratio(&self) -> f64 {
-        let mut ratio = 1.0_f64;
-        for ((&v, &lo), &hi) in self.velocity.iter().zip(&self.step_lo).zip(&self.step_hi) {
-            if v > hi && hi > 0.0 {
-                ratio = ratio.max(v / hi);
-            } else if v < lo && lo < 0.0 {
-                ratio = ratio.max(v / lo);
+    /// Sets `self.scales` (see [`Settings::scale_to_fit`]). The step is linear in the desired
+    /// velocities: `base + Σ_k s_k C_k`, with `base` the part due to the clamped joints' fixed
+    /// velocities and `C_k` the part due to level `k` alone (the last `k`: the gradient term), each
+    /// one prioritized pass. A free joint at a position limit that the unscaled step pushes
+    /// through it is clamped first (no scale can help it); then, highest level first, each scale
+    /// is the largest in [0, 1] that keeps the running sum inside every free joint's interval.
+    fn fit_scales(&mut self) {
+        let n = self.stack.dof();
+        let parts = self.scales.len();
+        for _ in 0..=n {
+            self.scales.fill(0.0);
+            self.prioritized_pass();
+            self.base_velocity.copy_from_slice(&self.velocity);
+            self.saved_fixed.copy_from_slice(&self.fixed_velocity);
+            self.fixed_velocity.fill(0.0);
+            for k in 0..parts {
+                self.scales.fill(0.0);
+                self.scales[k] = 1.0;
+                self.prioritized_pass();
+                self.contributions[k * n..(k + 1) * n].copy_from_slice(&self.velocity);
+            }
+            self.fixed_velocity.copy_from_slice(&self.saved_fixed);
+            let mut blocked = None;
+            for i in (0..n).filter(|&i| !self.clamped[i]) {
+                let total = self.base_velocity[i]
+                    + (0..parts)
+                        .map(|k| self.contributions[k * n + i])
+                        .sum::<f64>();
+                // A bound tighter than the velocity limit comes from a position limit: a joint
+                // pushed through it is clamped there (the paper's clamping), since slowing the
+                // step would only have it creep toward the limit. Velocity limits are left to the
+                // scales.
+                let (lo, hi, v) = (self.step_lo[i], self.step_hi[i], self.step_vmax[i]);
+                if total > hi && hi < v {
+                    blocked = Some((i, hi, total - hi));
+                } else if total < lo && lo > -v {
+                    blocked = Some((i, lo, lo - total));
+                } else {
+                    continue;
+                }
+                break;
+            }
+            let Some((i, bound, _)) = blocked else { break };
+            self.clamped[i] = true;
+            self.fixed_velocity[i] = bound;
+            self.report.clamped.push(i);
+        }
+        // Running sum of the scaled parts, kept in `velocity`.
+        self.velocity.copy_from_slice(&self.base_velocity);
+        for k in 0..parts {
+            let part = &self.contributions[k * n..(k + 1) * n];
+            let mut scale = 1.0_f64;
+            for i in (0..n).filter(|&i| !self.clamped[i]) {
+                let (lo, hi, sum, c) =
+                    (self.step_lo[i], self.step_hi[i], self.velocity[i], part[i]);
+                if lo > 0.0 || hi < 0.0 {
+                    continue; // outside its range: the clamping loop lands it
+                }
+                if sum + c > hi {
+                    scale = scale.min(((hi - sum) / c).max(0.0));
+                } else if sum + c < lo {
+                    scale = scale.min(((lo - sum) / c).max(0.0));
+                }
+            }
+            self.scales[k] = scale;
+            for (v, c) in self.velocity.iter_mut().zip(part) {
+                *v += scale * c;
             }
         }
-        ratio
     }
 
     /// One prioritized solve over the joints not clamped; writes `self.velocity`.
@@ -336,7 +407,7 @@ impl Solver {
         let (head, tail) = self.qr.split_at_mut(n * start);
         for t in 0..rows {
             let row = self.stack.row(start + t);
-            let mut b = self.step_scale * self.stack.stacked_target()[start + t]
+            let mut b = self.scales[j] * self.stack.stacked_target()[start + t]
                 - dot(row, &self.fixed_velocity);
             for (c, &i) in self.coords.iter_mut().zip(&self.free) {
                 *c = row[i];
@@ -424,7 +495,7 @@ impl Solver {
         // Z_Nᵀ g: the gradient through every level's reflectors.
         let gradient = self.stack.gradient();
         for (c, &i) in self.coords.iter_mut().zip(&self.free) {
-            *c = self.step_scale * gradient[i];
+            *c = self.scales[levels] * gradient[i];
         }
         let mut offset = 0;
         for j in 0..levels {
@@ -465,7 +536,7 @@ impl Solver {
 
     /// Residuals and feasibility of every level for the final velocity.
     fn finish_report(&mut self) {
-        self.report.step_scale = self.step_scale;
+        self.report.gradient_scale = self.scales[self.scales.len() - 1];
         for j in 0..self.stack.level_count() {
             let start = self.stack.level_start(j);
             let end = self.stack.level_start(j + 1);
@@ -480,6 +551,7 @@ impl Solver {
             level.residual = residual;
             level.feasible =
                 residual <= self.settings.feasibility_tolerance * (1.0 + norm(targets));
+            level.scale = self.scales[j];
         }
     }
 }

@@ -17,6 +17,10 @@ pub struct LevelReport {
     pub feasible: bool,
     /// The damping factor `μ` used for this level (0 when it was well conditioned).
     pub damping: f64,
+    /// The fraction of its desired velocity the level was given to fit the velocity intervals
+    /// ([`Settings::scale_to_fit`](super::Settings::scale_to_fit)); 1 when it was not needed or
+    /// scaling is off. The residual is against the unscaled desired velocity.
+    pub scale: f64,
 }
 
 /// Outcome of a solve, including the clamping loop.
@@ -25,7 +29,7 @@ pub struct SolveReport {
     pub(crate) levels: Vec<LevelReport>,
     pub(crate) clamped: Vec<usize>,
     pub(crate) clamping_iterations: usize,
-    pub(crate) step_scale: f64,
+    pub(crate) gradient_scale: f64,
 }
 
 impl SolveReport {
@@ -34,7 +38,7 @@ impl SolveReport {
             levels: vec![LevelReport::default(); levels],
             clamped: Vec::with_capacity(dof),
             clamping_iterations: 0,
-            step_scale: 1.0,
+            gradient_scale: 1.0,
         }
     }
 
@@ -53,11 +57,11 @@ impl SolveReport {
         self.clamping_iterations
     }
 
-    /// The uniform scale applied to every desired velocity and the gradient term to fit the
-    /// velocity intervals ([`Settings::scale_to_fit`](super::Settings::scale_to_fit)); 1 when
-    /// no scaling was needed or it is off. Residuals are against the unscaled targets.
-    pub fn step_scale(&self) -> f64 {
-        self.step_scale
+    /// The scale applied to the gradient term to fit the velocity intervals
+    /// ([`Settings::scale_to_fit`](super::Settings::scale_to_fit)); 1 when it was not needed or
+    /// scaling is off.
+    pub fn gradient_scale(&self) -> f64 {
+        self.gradient_scale
     }
 
     /// Index of the first level that is not feasible, if any: the highest level that gave way.
