@@ -9,7 +9,9 @@
 //! (Fig. 8) and `phases.svg`; prints a summary. `--velocity-fraction` is the share of the rated
 //! joint velocities the robot may use (default 0.1, as in the paper). After the clip the human's
 //! last pose is held for `--hold` seconds (default 5) so the robot can finish the step it is
-//! taking; those frames are in the outputs too.
+//! taking; those frames are in the outputs too. `--task-speed` (m/s, default 0.15) and
+//! `--iterations` (per frame, default 1) set `ImitatorConfig::max_task_speed` and
+//! `iterations_per_frame`.
 
 mod plots;
 
@@ -36,6 +38,7 @@ fn main() -> ExitCode {
     let mut out = PathBuf::from("target/imitate");
     let mut fraction = ImitatorConfig::default().velocity_fraction;
     let mut hold = 5.0;
+    let mut config = ImitatorConfig::default();
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
@@ -55,11 +58,20 @@ fn main() -> ExitCode {
                 Some(f) => fraction = f,
                 None => return usage(),
             },
+            "--task-speed" => match args.next().and_then(|v| v.parse().ok()) {
+                Some(v) => config.max_task_speed = v,
+                None => return usage(),
+            },
+            "--iterations" => match args.next().and_then(|v| v.parse().ok()) {
+                Some(n) => config.iterations_per_frame = n,
+                None => return usage(),
+            },
             _ if a.starts_with("--") => return usage(),
             _ => clip = a.into(),
         }
     }
-    match run(&clip, &out, fraction, hold) {
+    config.velocity_fraction = fraction;
+    match run(&clip, &out, config, hold) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("imitate: {}: {e}", clip.display());
@@ -69,21 +81,22 @@ fn main() -> ExitCode {
 }
 
 fn usage() -> ExitCode {
-    eprintln!("usage: imitate [CLIP.bvh|CLIP.csv] [--out DIR] [--velocity-fraction F] [--hold S]");
+    eprintln!(
+        "usage: imitate [CLIP.bvh|CLIP.csv] [--out DIR] [--velocity-fraction F] [--hold S] [--task-speed V] [--iterations N]"
+    );
     ExitCode::from(2)
 }
 
 fn run(
     path: &Path,
     out: &Path,
-    velocity_fraction: f64,
+    config: ImitatorConfig,
     hold: f64,
 ) -> Result<(), Box<dyn std::error::Error>> {
     let mut clip = Clip::open(path)?;
     let config = ImitatorConfig {
         support: clip.support_config(),
-        velocity_fraction,
-        ..ImitatorConfig::default()
+        ..config
     };
     let mut imitator = Imitator::new(FootRootedModels::nao(), config)?;
     let mut recorder = MetricsRecorder::new(&imitator);
