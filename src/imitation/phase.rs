@@ -230,21 +230,22 @@ pub struct PhaseConfig {
     /// Paper: 30 mm.
     pub rho: f64,
     /// A lift ends when both sole points are within this of ρ; a lowering ends when both are
-    /// within this of the ground. Default 0.1 mm: a foot that lands becomes a support, and the
-    /// model rooted at it takes its sole as the ground, so a landing must end flat (0.1 mm over
-    /// the sole's 0.1 m is a 1 mrad tilt handed on to the world); the IK closes the last
-    /// millimetres in a few frames.
+    /// within this of the ground. Default 1 µm: a foot that lands becomes a support, and the
+    /// model rooted at it takes its sole as the ground, so a landing must end flat — any tilt
+    /// left is handed on to the world and adds up over steps (at 0.1 mm, 50 steps of a walk at
+    /// full speed tilted the world enough to lift the soles off the floor by millimetres). The
+    /// IK closes the last millimetres in a few frames.
     pub foot_height_tolerance: f64,
 }
 
 impl Default for PhaseConfig {
-    /// The paper's λ = 15 mm and ρ = 30 mm, with a 5 mm CoM and a 0.1 mm foot height tolerance.
+    /// The paper's λ = 15 mm and ρ = 30 mm, with a 5 mm CoM and a 1 µm foot height tolerance.
     fn default() -> Self {
         Self {
             com_tolerance: 0.005,
             lambda: 0.015,
             rho: 0.030,
-            foot_height_tolerance: 0.0001,
+            foot_height_tolerance: 0.000001,
         }
     }
 }
