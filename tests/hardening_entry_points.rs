@@ -29,7 +29,8 @@ fn shape() -> StackShape {
 
 #[test]
 fn settings_out_of_range_are_refused_by_name_at_construction_and_on_update() {
-    let fields: [(&str, fn(&mut Settings, f64)); 4] = [
+    type Set = fn(&mut Settings, f64);
+    let fields: [(&str, Set); 4] = [
         ("rank_tolerance", |s, v| s.rank_tolerance = v),
         ("damping_threshold", |s, v| s.damping_threshold = v),
         ("max_damping", |s, v| s.max_damping = v),

@@ -91,23 +91,14 @@ pub enum BatchError {
     },
 }
 
-/// Options of a batch.
-#[derive(Debug, Clone)]
+/// Options of a batch. The default: one thread per core, default imitator settings.
+#[derive(Debug, Clone, Default)]
 pub struct BatchOptions {
     /// Worker threads; 0 means one per core. Ignored (always 1) without the `parallel` feature.
     pub threads: usize,
     /// Imitator settings shared by every clip, except `support`, which each clip replaces by the
     /// defaults of its kind of source ([`Clip::support_config`]: optical mocap or Kinect).
     pub imitator: ImitatorConfig,
-}
-
-impl Default for BatchOptions {
-    fn default() -> Self {
-        Self {
-            threads: 0,
-            imitator: ImitatorConfig::default(),
-        }
-    }
 }
 
 /// What one clip's run gave.
