@@ -8,10 +8,6 @@
 /// Euclidean norm, scaled only when the plain sum of squares over- or underflows.
 pub(crate) fn norm(x: &[f64]) -> f64 {
     let sum_sq: f64 = x.iter().map(|v| v * v).sum();
-    // NaN only from a NaN entry (squares are >= 0); the rescaling below would turn it into 0.
-    if sum_sq.is_nan() {
-        return sum_sq;
-    }
     if sum_sq.is_finite() && sum_sq > f64::MIN_POSITIVE {
         return sum_sq.sqrt();
     }
