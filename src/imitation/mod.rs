@@ -8,7 +8,10 @@
 //! robot's [`phase::SupportPhase`] (DS, RS, LS and the two-step transitions of Table I), ending
 //! each transition step on measured conditions; [`tables::TaskTables`] says, per phase, which
 //! model root, equality levels and gradient tasks the IK solves (Table I as data).
+//! [`imitator::Imitator`] runs the whole pipeline frame by frame; [`batch`] runs it over many
+//! clips in parallel.
 
+pub mod batch;
 pub mod human;
 pub mod imitator;
 pub mod metrics;

@@ -12,7 +12,7 @@ use super::SolverError;
 use super::bounds::JointBounds;
 use super::householder::norm;
 use super::prioritized::Solver;
-use super::stack::{TaskStack, check_len};
+use super::stack::{TaskStack, check_finite_slice, check_len};
 
 /// Something that gives task errors and Jacobians for a configuration: a robot model with its
 /// targets, or any other differentiable map.
@@ -167,7 +167,9 @@ impl PositionDriver {
     }
 
     /// Moves `q` (in place, warm start) toward the model's targets. Every iterate, including the
-    /// result, is within the position limits of `bounds`.
+    /// result, is within the position limits of `bounds`. Errors: wrong sizes, a non-finite `q`,
+    /// a non-finite Jacobian entry, task error or gradient from the model
+    /// ([`SolverError::NonFinite`], naming the place), or the model's own error.
     pub fn run<M: TaskModel>(
         &mut self,
         solver: &mut Solver,
@@ -177,6 +179,7 @@ impl PositionDriver {
     ) -> Result<&DriverReport, M::Error> {
         check_len("q", solver.stack().dof(), q.len())?;
         check_len("joint bounds", self.step_bounds.dof(), bounds.dof())?;
+        check_finite_slice("q", q)?;
         self.step_bounds
             .copy_with_velocity_cap(bounds, self.settings.max_joint_step / self.settings.dt);
         check_len(
@@ -188,6 +191,8 @@ impl PositionDriver {
         let mut iterations = 0;
         let stop = loop {
             model.evaluate(q, solver.stack_mut())?;
+            // Before measuring: a NaN task error must not pass the tolerance test as converged.
+            solver.stack().check_finite()?;
             self.measure_errors(solver.stack());
             let errors = &self.report.task_errors;
             if errors.iter().all(|&e| e <= s.tolerance) {

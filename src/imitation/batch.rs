@@ -1,0 +1,403 @@
+//! Batch retargeting: many clips, one output folder per clip, a summary of the batch.
+//!
+//! Each clip is an independent job: the models ([`FootRootedModels`]) are built once and cloned
+//! into each job, which then owns its [`Imitator`] (all the solver and kinematics workspaces) and
+//! its [`MetricsRecorder`], so jobs share nothing mutable. With the cargo feature `parallel` (on by
+//! default) the jobs run on a rayon thread pool of [`BatchOptions::threads`] threads; without it
+//! they run one after the other, with the same API and the same results: a clip's output does not
+//! depend on which thread ran it or on the other clips.
+//!
+//! For a clip `name.bvh` (or `name.csv`) the job writes into `OUT/name/`:
+//!
+//! * `joints.csv`: a header `time,<23 NAOqi joint names>`, then per frame the time (s) and the
+//!   joint angles (rad), six decimals;
+//! * `metrics.json`: the [`ImitationMetrics`] of the run (lengths in m, angles in rad, times in
+//!   s, solve time in µs; a non-finite value is written as `null`).
+//!
+//! A clip that fails (unreadable file, an error in a frame) does not stop the batch: its
+//! [`ClipOutcome`] holds the error, which names the file and the frame.
+
+use std::collections::HashSet;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use serde_json::{Value, json};
+use thiserror::Error;
+
+use super::human::HumanFrame;
+use super::imitator::{FootRootedModels, ImitationError, Imitator, ImitatorConfig};
+use super::metrics::{ImitationMetrics, MeanMax, MetricsRecorder, Spread};
+use crate::io::clip::{Clip, ClipError};
+use crate::model::ModelError;
+
+/// Errors of a batch or of one of its clips. Each names the clip file.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum BatchError {
+    /// The clip could not be opened or read.
+    #[error("{}: {source}", path.display())]
+    Clip {
+        /// The clip file.
+        path: PathBuf,
+        /// The reader's error.
+        source: ClipError,
+    },
+    /// The imitator could not be built or refused a frame.
+    #[error("{}: frame {frame}: {source}", path.display())]
+    Imitation {
+        /// The clip file.
+        path: PathBuf,
+        /// Index of the frame (0 = first frame of captured motion).
+        frame: usize,
+        /// The imitator's error.
+        source: ImitationError,
+    },
+    /// The metrics of a frame could not be computed.
+    #[error("{}: frame {frame}: metrics: {source}", path.display())]
+    Metrics {
+        /// The clip file.
+        path: PathBuf,
+        /// Index of the frame.
+        frame: usize,
+        /// The model's error.
+        source: ModelError,
+    },
+    /// Reading a folder or writing an output file failed.
+    #[error("{}: {source}", path.display())]
+    Io {
+        /// The file or folder.
+        path: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// Two clips have the same file stem, so they would write into the same output folder.
+    #[error("clips {} and {} would both write into {}", first.display(), second.display(), output.display())]
+    DuplicateOutput {
+        /// The first clip.
+        first: PathBuf,
+        /// The second clip.
+        second: PathBuf,
+        /// Their common output folder.
+        output: PathBuf,
+    },
+    /// The thread pool could not be started.
+    #[error("cannot start a pool of {threads} threads: {message}")]
+    ThreadPool {
+        /// Requested number of threads.
+        threads: usize,
+        /// The pool's error message.
+        message: String,
+    },
+}
+
+/// Options of a batch. The default: one thread per core, default imitator settings.
+#[derive(Debug, Clone, Default)]
+pub struct BatchOptions {
+    /// Worker threads; 0 means one per core. Ignored (always 1) without the `parallel` feature.
+    pub threads: usize,
+    /// Imitator settings shared by every clip, except `support`, which each clip replaces by the
+    /// defaults of its kind of source ([`Clip::support_config`]: optical mocap or Kinect).
+    pub imitator: ImitatorConfig,
+}
+
+/// What one clip's run gave.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ClipSummary {
+    /// Frames imitated.
+    pub frames: usize,
+    /// Time from the first to the last frame of the clip (s).
+    pub duration: f64,
+    /// Wall time of the job: reading, imitating, measuring and writing (s).
+    pub wall_time: f64,
+    /// Changes of the robot's continuous phase (DS, RS, LS).
+    pub robot_support_changes: usize,
+    /// Smallest signed distance of the CoM ground projection to the support polygon's edge (m,
+    /// positive inside; −∞ if some frame had no support polygon, +∞ with no frame).
+    pub min_com_margin: f64,
+    /// Frames whose CoM projection was outside the support polygon.
+    pub frames_com_outside: usize,
+    /// Joint positions outside their limits (joint × frame).
+    pub joint_limit_violations: usize,
+    /// Joint velocities above the allowed fraction of the rated velocity (joint × frame).
+    pub velocity_limit_violations: usize,
+    /// Largest move of the support foot between frames it stood on (m).
+    pub max_support_slip: f64,
+    /// Mean distance of the left and right hand to their scaled references over the frames
+    /// where they were tracked, single and double support together (m); `None` if never tracked.
+    pub hand_tracking_mean: [Option<f64>; 2],
+    /// All the metrics of the run (also written to `metrics.json`).
+    pub metrics: ImitationMetrics,
+}
+
+/// One clip of a batch and how it went.
+#[derive(Debug)]
+pub struct ClipOutcome {
+    /// The clip file.
+    pub clip: PathBuf,
+    /// Its output folder.
+    pub output: PathBuf,
+    /// The summary, or why the clip failed.
+    pub result: Result<ClipSummary, BatchError>,
+}
+
+/// The outcome of a batch.
+#[derive(Debug)]
+pub struct BatchSummary {
+    /// One entry per clip, in the order the clips were given.
+    pub clips: Vec<ClipOutcome>,
+    /// Threads that ran the jobs.
+    pub threads: usize,
+    /// Wall time of the whole batch (s).
+    pub wall_time: f64,
+}
+
+impl BatchSummary {
+    /// Clips that were retargeted without error.
+    pub fn succeeded(&self) -> impl Iterator<Item = &ClipSummary> {
+        self.clips.iter().filter_map(|c| c.result.as_ref().ok())
+    }
+
+    /// Frames imitated over the batch (successful clips).
+    pub fn frames(&self) -> usize {
+        self.succeeded().map(|c| c.frames).sum()
+    }
+
+    /// Clips per second of wall time (all clips, failed ones included).
+    pub fn clips_per_second(&self) -> f64 {
+        self.clips.len() as f64 / self.wall_time.max(f64::MIN_POSITIVE)
+    }
+
+    /// Frames per second of wall time.
+    pub fn frames_per_second(&self) -> f64 {
+        self.frames() as f64 / self.wall_time.max(f64::MIN_POSITIVE)
+    }
+}
+
+/// The clips in `dir`: files ending in `.bvh` or `.csv` (any case), sorted by path.
+pub fn clips_in(dir: &Path) -> Result<Vec<PathBuf>, BatchError> {
+    let io = |source| BatchError::Io {
+        path: dir.to_path_buf(),
+        source,
+    };
+    let mut clips = Vec::new();
+    for entry in std::fs::read_dir(dir).map_err(io)? {
+        let path = entry.map_err(io)?.path();
+        let is_clip = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("bvh") || e.eq_ignore_ascii_case("csv"));
+        if is_clip && path.is_file() {
+            clips.push(path);
+        }
+    }
+    clips.sort();
+    Ok(clips)
+}
+
+/// Retargets every clip of `clips` into its folder under `out` (see the module docs), in
+/// parallel with the `parallel` feature. Fails as a whole only when the output folders would
+/// collide or the thread pool cannot start; a clip's own failure is in its [`ClipOutcome`].
+pub fn retarget_all(
+    clips: &[PathBuf],
+    out: &Path,
+    options: &BatchOptions,
+) -> Result<BatchSummary, BatchError> {
+    let mut outputs: Vec<PathBuf> = Vec::with_capacity(clips.len());
+    let mut seen = HashSet::new();
+    for (i, clip) in clips.iter().enumerate() {
+        let output = out.join(clip.file_stem().unwrap_or(clip.as_os_str()));
+        if !seen.insert(output.clone()) {
+            let first = outputs.iter().position(|o| *o == output).unwrap_or(i);
+            return Err(BatchError::DuplicateOutput {
+                first: clips[first].clone(),
+                second: clip.clone(),
+                output,
+            });
+        }
+        outputs.push(output);
+    }
+    let models = FootRootedModels::nao();
+    let start = Instant::now();
+    let job = |(clip, output): (&PathBuf, &PathBuf)| ClipOutcome {
+        clip: clip.clone(),
+        output: output.clone(),
+        result: retarget_clip(models.clone(), &options.imitator, clip, output),
+    };
+    let (clips, threads) = run_jobs(clips, &outputs, options.threads, job)?;
+    Ok(BatchSummary {
+        clips,
+        threads,
+        wall_time: start.elapsed().as_secs_f64(),
+    })
+}
+
+#[cfg(feature = "parallel")]
+fn run_jobs<F>(
+    clips: &[PathBuf],
+    outputs: &[PathBuf],
+    threads: usize,
+    job: F,
+) -> Result<(Vec<ClipOutcome>, usize), BatchError>
+where
+    F: Fn((&PathBuf, &PathBuf)) -> ClipOutcome + Send + Sync,
+{
+    use rayon::prelude::*;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| BatchError::ThreadPool {
+            threads,
+            message: e.to_string(),
+        })?;
+    // One clip per task: clips are long (10^3–10^4 frames), so no finer split is needed.
+    let outcomes = pool.install(|| {
+        clips
+            .par_iter()
+            .zip(outputs.par_iter())
+            .with_max_len(1)
+            .map(job)
+            .collect()
+    });
+    Ok((outcomes, pool.current_num_threads()))
+}
+
+#[cfg(not(feature = "parallel"))]
+fn run_jobs<F>(
+    clips: &[PathBuf],
+    outputs: &[PathBuf],
+    _threads: usize,
+    job: F,
+) -> Result<(Vec<ClipOutcome>, usize), BatchError>
+where
+    F: Fn((&PathBuf, &PathBuf)) -> ClipOutcome,
+{
+    Ok((clips.iter().zip(outputs).map(job).collect(), 1))
+}
+
+/// Retargets one clip with `models` and writes `joints.csv` and `metrics.json` into `output`
+/// (created if needed). `config.support` is replaced by the clip's defaults.
+pub fn retarget_clip(
+    models: FootRootedModels,
+    config: &ImitatorConfig,
+    clip: &Path,
+    output: &Path,
+) -> Result<ClipSummary, BatchError> {
+    let start = Instant::now();
+    let path = || clip.to_path_buf();
+    let mut source = Clip::open(clip).map_err(|source| BatchError::Clip {
+        path: path(),
+        source,
+    })?;
+    let config = ImitatorConfig {
+        support: source.support_config(),
+        ..config.clone()
+    };
+    let mut imitator = Imitator::new(models, config).map_err(|source| BatchError::Imitation {
+        path: path(),
+        frame: 0,
+        source,
+    })?;
+    let mut recorder = MetricsRecorder::new(&imitator);
+    let names: Vec<&str> = imitator.variable_names().collect();
+    let mut joints = format!("time,{}\n", names.join(","));
+    let mut frame = HumanFrame::new(0.0);
+    let mut index = 0;
+    loop {
+        let more = source
+            .read_frame(&mut frame)
+            .map_err(|source| BatchError::Clip {
+                path: path(),
+                source,
+            })?;
+        if !more {
+            break;
+        }
+        let imitation = |source| BatchError::Imitation {
+            path: path(),
+            frame: index,
+            source,
+        };
+        let robot = imitator.step(&frame).map_err(imitation)?;
+        let _ = write!(joints, "{:.6}", robot.time);
+        for q in &robot.q {
+            let _ = write!(joints, ",{q:.6}");
+        }
+        joints.push('\n');
+        // `record` borrows the imitator too: the frame is read again through a second borrow.
+        let robot = robot.clone();
+        recorder
+            .record(&imitator, &robot)
+            .map_err(|source| BatchError::Metrics {
+                path: path(),
+                frame: index,
+                source,
+            })?;
+        index += 1;
+    }
+    let metrics = recorder.finish();
+    let io = |file: &Path| {
+        let file = file.to_path_buf();
+        move |source| BatchError::Io { path: file, source }
+    };
+    std::fs::create_dir_all(output).map_err(io(output))?;
+    let joints_path = output.join("joints.csv");
+    std::fs::write(&joints_path, joints).map_err(io(&joints_path))?;
+    let metrics_path = output.join("metrics.json");
+    std::fs::write(&metrics_path, metrics_json(&metrics, clip)).map_err(io(&metrics_path))?;
+    let hand = |name: &str| {
+        let e = metrics.effectors.iter().find(|e| e.name == name)?;
+        let (s, d) = (&e.single_support, &e.double_support);
+        let count = s.count + d.count;
+        (count > 0).then(|| (s.mean * s.count as f64 + d.mean * d.count as f64) / count as f64)
+    };
+    Ok(ClipSummary {
+        frames: metrics.frames,
+        duration: metrics.duration,
+        wall_time: start.elapsed().as_secs_f64(),
+        robot_support_changes: metrics.robot_support_changes,
+        min_com_margin: metrics.min_com_margin,
+        frames_com_outside: metrics.frames_com_outside,
+        joint_limit_violations: metrics.joint_limit_violations,
+        velocity_limit_violations: metrics.velocity_limit_violations,
+        max_support_slip: metrics.max_support_slip,
+        hand_tracking_mean: [hand("l_hand"), hand("r_hand")],
+        metrics,
+    })
+}
+
+/// The metrics of a run of `clip` as pretty-printed JSON (the fields of [`ImitationMetrics`]
+/// with their units in the key names; non-finite numbers become `null`).
+pub fn metrics_json(m: &ImitationMetrics, clip: &Path) -> String {
+    let mean_max = |m: &MeanMax| json!({ "mean": m.mean, "max": m.max, "frames": m.count });
+    let spread = |s: &Spread| json!({ "min": s.min, "median": s.median, "p99": s.p99, "max": s.max, "count": s.count });
+    let effectors: serde_json::Map<String, Value> = m
+        .effectors
+        .iter()
+        .map(|e| {
+            let value = json!({
+                "single_support_m": mean_max(&e.single_support),
+                "double_support_m": mean_max(&e.double_support),
+            });
+            (e.name.to_string(), value)
+        })
+        .collect();
+    let value = json!({
+        "clip": clip.file_name().map(|f| f.to_string_lossy().into_owned()),
+        "frames": m.frames,
+        "duration_s": m.duration,
+        "human_support_changes": m.human_support_changes,
+        "robot_support_changes": m.robot_support_changes,
+        "robot_support_sequence": m.robot_support_sequence,
+        "transition_durations_s": spread(&m.transition_durations),
+        "tracking_error": effectors,
+        "min_com_margin_m": m.min_com_margin,
+        "frames_com_outside_support": m.frames_com_outside,
+        "joint_limit_violations": m.joint_limit_violations,
+        "velocity_limit_violations": m.velocity_limit_violations,
+        "max_support_foot_slip_m": m.max_support_slip,
+        "max_support_foot_turn_rad": m.max_support_turn,
+        "solve_time_us": spread(&m.solve_time_us),
+    });
+    // A `Value` built by `json!` always serialises.
+    serde_json::to_string_pretty(&value).unwrap_or_default() + "\n"
+}

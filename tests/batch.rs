@@ -1,0 +1,119 @@
+//! Batch retargeting: outputs per clip, failures kept per clip, results independent of the
+//! number of threads, and the models shareable across threads.
+
+use std::path::{Path, PathBuf};
+
+use taskstack::imitation::batch::{BatchError, BatchOptions, clips_in, retarget_all};
+use taskstack::imitation::imitator::FootRootedModels;
+use taskstack::model::Model;
+
+// Compile-time: the batch shares one model set between worker threads (`Sync`) and moves clones
+// into them (`Send`).
+const _: () = {
+    const fn send_sync<T: Send + Sync>() {}
+    send_sync::<Model>();
+    send_sync::<FootRootedModels>();
+};
+
+fn mocap(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/mocap")
+        .join(name)
+}
+
+fn out_dir(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+const SHORT: [&str; 3] = [
+    "kinect2_labanotation_ges01_wavehand.csv",
+    "cmu_07_04_slow_walk.bvh",
+    "kinect2_labanotation_ges02_balancinghands.csv",
+];
+
+#[test]
+fn clips_in_lists_the_bundled_clips_sorted() {
+    let clips = clips_in(&mocap("")).unwrap();
+    // 6 BVH + 2 Kinect CSV files; README.md is not a clip.
+    assert_eq!(clips.len(), 8);
+    assert!(clips.windows(2).all(|w| w[0] < w[1]));
+    assert!(clips.iter().all(|c| c.extension().unwrap() != "md"));
+}
+
+#[test]
+fn writes_one_folder_per_clip_and_same_results_with_1_and_2_threads() {
+    let clips: Vec<PathBuf> = SHORT.iter().map(|c| mocap(c)).collect();
+    let mut joints = Vec::new();
+    for threads in [1, 2] {
+        let out = out_dir(&format!("batch_threads_{threads}"));
+        let options = BatchOptions {
+            threads,
+            ..BatchOptions::default()
+        };
+        let summary = retarget_all(&clips, &out, &options).unwrap();
+        assert_eq!(summary.clips.len(), 3);
+        if cfg!(feature = "parallel") {
+            assert_eq!(summary.threads, threads);
+        }
+        let mut files = Vec::new();
+        for (outcome, name) in summary.clips.iter().zip(SHORT) {
+            // Order of the input, whichever thread finished first.
+            assert_eq!(outcome.clip, mocap(name));
+            let stem = name.rsplit_once('.').unwrap().0;
+            assert_eq!(outcome.output, out.join(stem));
+            let r = outcome.result.as_ref().unwrap();
+            assert!(r.frames > 100, "{name}: {} frames", r.frames);
+            // Frames at 120 Hz (BVH) or 30 Hz (Kinect): duration within the frame count's span.
+            assert!(r.duration > 0.0 && r.duration < r.frames as f64 / 25.0);
+            assert_eq!(r.joint_limit_violations, 0, "{name}");
+            assert_eq!(r.velocity_limit_violations, 0, "{name}");
+            assert!(
+                r.max_support_slip < 1e-9,
+                "{name}: slip {}",
+                r.max_support_slip
+            );
+            let csv = std::fs::read_to_string(outcome.output.join("joints.csv")).unwrap();
+            let mut lines = csv.lines();
+            let header = lines.next().unwrap();
+            assert!(header.starts_with("time,HeadYaw,"), "{header}");
+            // time + 23 NAO joints on every line, one line per frame.
+            assert_eq!(header.split(',').count(), 24);
+            assert_eq!(lines.clone().count(), r.frames);
+            assert!(lines.all(|l| l.split(',').count() == 24));
+            let metrics: serde_json::Value = serde_json::from_str(
+                &std::fs::read_to_string(outcome.output.join("metrics.json")).unwrap(),
+            )
+            .unwrap();
+            assert_eq!(metrics["frames"], r.frames);
+            assert_eq!(metrics["clip"], name);
+            files.push(csv);
+        }
+        joints.push(files);
+    }
+    // Each clip owns its imitator: the thread count cannot change a single joint angle.
+    assert_eq!(joints[0], joints[1]);
+}
+
+#[test]
+fn a_failing_clip_is_reported_and_the_others_still_run() {
+    let out = out_dir("batch_failure");
+    let clips = vec![mocap("no_such_clip.bvh"), mocap(SHORT[0])];
+    let summary = retarget_all(&clips, &out, &BatchOptions::default()).unwrap();
+    let err = summary.clips[0].result.as_ref().unwrap_err();
+    assert!(matches!(err, BatchError::Clip { .. }), "{err}");
+    assert!(err.to_string().contains("no_such_clip.bvh"), "{err}");
+    assert!(summary.clips[1].result.is_ok());
+    assert_eq!(summary.succeeded().count(), 1);
+    assert!(!summary.clips[0].output.exists());
+}
+
+#[test]
+fn clips_with_the_same_stem_are_refused_before_any_work() {
+    let out = out_dir("batch_duplicate");
+    let clips = vec![mocap(SHORT[0]), PathBuf::from("elsewhere").join(SHORT[0])];
+    let err = retarget_all(&clips, &out, &BatchOptions::default()).unwrap_err();
+    assert!(matches!(err, BatchError::DuplicateOutput { .. }), "{err}");
+    assert!(!out.exists());
+}

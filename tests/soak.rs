@@ -1,0 +1,304 @@
+//! Soak: the bundled clips back to back, several passes, through ONE [`Imitator`] in one process.
+//!
+//! * Every frame: no NaN, joints within their position limits, per-frame joint motion within the
+//!   velocity limits of [`Imitator::bounds`], CoM ground projection inside the support polygon of
+//!   the grounded soles, support-foot slip below 1e-9 m. A [`MetricsRecorder`] per pass
+//!   cross-checks the same invariants.
+//! * Heap: a counting global allocator (live bytes and allocation count, per thread so that tests
+//!   running in parallel do not see each other). After the first pass (warm-up) the live heap at
+//!   the end of a pass must not grow, and `Imitator::step` must not allocate at all.
+//! * Determinism: a second run (a new imitator, same frames) gives bit-identical joint
+//!   trajectories (hash of the bits of every q of every frame).
+//!
+//! **One imitator across clips.** A clip's times start near 0, so each clip (and each pass) is
+//! shifted to start one nominal frame (1/120 s) after the previous one ended; the human "jumps"
+//! from the last posture of a clip to the first of the next and the robot catches up within its
+//! velocity limits, which makes the boundaries the hardest frames of the soak. One imitator has
+//! one support-detection configuration: the optical one ([`ImitatorConfig::default`]) is used
+//! for the Kinect clips too; the invariants checked do not depend on the detection being right.
+//! The clips are read into memory once, so that the passes measure the imitator, not the readers.
+//!
+//! CI runs the short version (3 short clips, 3 passes, ≈ 2 300 frames, twice). The full soak
+//! (all 8 bundled clips, 10 passes, ≈ 8.6 × 10^4 frames, twice) is ignored by default:
+//!
+//! ```text
+//! cargo test --release --test soak -- --ignored --nocapture
+//! ```
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+use std::hash::{DefaultHasher, Hasher};
+use std::path::Path;
+
+use nalgebra::{IsometryMatrix3, Vector2, Vector3};
+use taskstack::imitation::human::HumanFrame;
+use taskstack::imitation::imitator::{FootRootedModels, Imitator, ImitatorConfig, RobotFrame};
+use taskstack::imitation::metrics::{CONTACT_HEIGHT, MetricsRecorder, convex_margin};
+use taskstack::io::clip::Clip;
+use taskstack::robots::nao::Foot;
+
+struct Counting;
+
+thread_local! {
+    // Const-initialised, no destructor: using them from the allocator never allocates.
+    static LIVE_BYTES: Cell<isize> = const { Cell::new(0) };
+    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
+}
+
+fn count(bytes: isize, allocations: usize) {
+    // `try_with`: the allocator may be called while a thread's locals are being torn down.
+    let _ = LIVE_BYTES.try_with(|b| b.set(b.get() + bytes));
+    let _ = ALLOCATIONS.try_with(|a| a.set(a.get() + allocations));
+}
+
+// SAFETY: forwards every call unchanged to the system allocator; only counts.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        count(layout.size() as isize, 1);
+        // SAFETY: same contract as the caller's.
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
+        count(layout.size() as isize, 1);
+        // SAFETY: same contract as the caller's.
+        unsafe { System.alloc_zeroed(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        count(-(layout.size() as isize), 0);
+        // SAFETY: same contract as the caller's.
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        count(new_size as isize - layout.size() as isize, 1);
+        // SAFETY: same contract as the caller's.
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+fn live_bytes() -> isize {
+    LIVE_BYTES.with(Cell::get)
+}
+
+fn allocations() -> usize {
+    ALLOCATIONS.with(Cell::get)
+}
+
+const ALL: [&str; 8] = [
+    "cmu_02_10_wash_self_standing_arm_gestures.bvh",
+    "cmu_05_02_stand_arm_gestures_turn_single_leg.bvh",
+    "cmu_05_12_slow_dance_tendu_arms_high.bvh",
+    "cmu_07_04_slow_walk.bvh",
+    "cmu_09_12_walk_forward_backward_sideways.bvh",
+    "cmu_131_01_start_walk_stop_maxskel.bvh",
+    "kinect2_labanotation_ges01_wavehand.csv",
+    "kinect2_labanotation_ges02_balancinghands.csv",
+];
+
+const SHORT: [&str; 3] = [
+    "kinect2_labanotation_ges01_wavehand.csv",
+    "cmu_07_04_slow_walk.bvh",
+    "kinect2_labanotation_ges02_balancinghands.csv",
+];
+
+fn load(names: &[&str]) -> Vec<Vec<HumanFrame>> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/mocap");
+    names
+        .iter()
+        .map(|n| {
+            Clip::open(dir.join(n))
+                .unwrap()
+                .collect::<Result<Vec<_>, _>>()
+                .unwrap()
+        })
+        .collect()
+}
+
+/// What a soak run measured.
+struct Soak {
+    frames: usize,
+    /// Hash of the bits of every joint angle of every frame, in order.
+    q_hash: u64,
+    /// Live heap of this thread at the end of each pass (bytes, relative to the start).
+    live_after_pass: Vec<isize>,
+    /// Allocations inside `Imitator::step` per pass.
+    step_allocations: Vec<usize>,
+    min_com_margin: f64,
+    max_slip: f64,
+}
+
+fn grounded_outline(foot: Foot, sole: &IsometryMatrix3<f64>) -> Option<[Vector2<f64>; 4]> {
+    let outline = foot
+        .sole_outline()
+        .map(|[x, y]| sole.transform_point(&Vector3::new(x, y, 0.0).into()));
+    outline
+        .iter()
+        .all(|p| p.z.abs() <= CONTACT_HEIGHT)
+        .then(|| outline.map(|p| p.xy().coords))
+}
+
+/// Checks the per-frame invariants of `r` against the previous frame; returns (CoM margin, slip).
+fn check_frame(
+    imitator: &Imitator,
+    r: &RobotFrame,
+    previous: Option<&RobotFrame>,
+    at: &str,
+) -> (f64, f64) {
+    let finite = r.q.iter().all(|q| q.is_finite())
+        && r.com.iter().all(|c| c.is_finite())
+        && r.right_sole.to_homogeneous().iter().all(|x| x.is_finite())
+        && r.left_sole.to_homogeneous().iter().all(|x| x.is_finite());
+    assert!(finite, "{at}: non-finite output");
+    let bounds = imitator.bounds();
+    for (i, &q) in r.q.iter().enumerate() {
+        assert!(
+            q >= bounds.lower()[i] && q <= bounds.upper()[i],
+            "{at}: joint {i} = {q} outside [{}, {}]",
+            bounds.lower()[i],
+            bounds.upper()[i]
+        );
+    }
+    let mut points = [Vector2::zeros(); 8];
+    let mut n = 0;
+    for (foot, sole) in [(Foot::Right, &r.right_sole), (Foot::Left, &r.left_sole)] {
+        if let Some(outline) = grounded_outline(foot, sole) {
+            points[n..n + 4].copy_from_slice(&outline);
+            n += 4;
+        }
+    }
+    let margin = convex_margin(&mut points[..n], r.com.xy());
+    assert!(
+        margin > 0.0,
+        "{at}: CoM margin {margin} m ({n} sole corners on the ground)"
+    );
+    let mut slip = 0.0;
+    if let Some(p) = previous {
+        let dt = r.time - p.time;
+        assert!(dt > 0.0, "{at}: time {} after {}", r.time, p.time);
+        for (i, (&q, &q0)) in r.q.iter().zip(&p.q).enumerate() {
+            // The solver's bound is exact up to rounding of q + q̇ Δt.
+            let allowed = bounds.velocity()[i] * dt * (1.0 + 1e-9) + 1e-12;
+            assert!(
+                (q - q0).abs() <= allowed,
+                "{at}: joint {i} moved {} rad in {dt} s (limit {allowed})",
+                (q - q0).abs()
+            );
+        }
+        let (now, before) = match r.root {
+            Foot::Right => (&r.right_sole, &p.right_sole),
+            Foot::Left => (&r.left_sole, &p.left_sole),
+        };
+        if grounded_outline(r.root, before).is_some() {
+            slip = (now.translation.vector - before.translation.vector).norm();
+            assert!(slip < 1e-9, "{at}: support foot slipped {slip} m");
+        }
+    }
+    (margin, slip)
+}
+
+fn soak(clips: &[Vec<HumanFrame>], passes: usize) -> Soak {
+    let start_bytes = live_bytes();
+    let mut imitator = Imitator::new(FootRootedModels::nao(), ImitatorConfig::default()).unwrap();
+    let mut previous: Option<RobotFrame> = None;
+    let mut hasher = DefaultHasher::new();
+    let mut out = Soak {
+        frames: 0,
+        q_hash: 0,
+        live_after_pass: Vec::with_capacity(passes),
+        step_allocations: Vec::with_capacity(passes),
+        min_com_margin: f64::INFINITY,
+        max_slip: 0.0,
+    };
+    let mut next_start = 0.0;
+    for pass in 0..passes {
+        let mut recorder = MetricsRecorder::new(&imitator);
+        let mut step_allocations = 0;
+        for (c, clip) in clips.iter().enumerate() {
+            let offset = next_start - clip[0].time;
+            for (f, human) in clip.iter().enumerate() {
+                let mut human = *human;
+                human.time += offset;
+                let before = allocations();
+                let r = imitator.step(&human);
+                step_allocations += allocations() - before;
+                // A copy: the frame borrows the imitator, which the checks read too.
+                let r = r
+                    .unwrap_or_else(|e| panic!("pass {pass} clip {c} frame {f}: {e}"))
+                    .clone();
+                let at = format!("pass {pass} clip {c} frame {f} (t = {:.4} s)", r.time);
+                let (margin, slip) = check_frame(&imitator, &r, previous.as_ref(), &at);
+                out.min_com_margin = out.min_com_margin.min(margin);
+                out.max_slip = out.max_slip.max(slip);
+                for q in &r.q {
+                    hasher.write_u64(q.to_bits());
+                }
+                recorder.record(&imitator, &r).unwrap();
+                previous = Some(r);
+                out.frames += 1;
+            }
+            next_start = previous.as_ref().map_or(0.0, |p| p.time) + 1.0 / 120.0;
+        }
+        let m = recorder.finish();
+        assert_eq!(m.joint_limit_violations, 0, "pass {pass}");
+        assert_eq!(m.velocity_limit_violations, 0, "pass {pass}");
+        assert_eq!(m.frames_com_outside, 0, "pass {pass}");
+        assert!(
+            m.max_support_slip < 1e-9,
+            "pass {pass}: {}",
+            m.max_support_slip
+        );
+        drop(m);
+        drop(recorder);
+        out.step_allocations.push(step_allocations);
+        out.live_after_pass.push(live_bytes() - start_bytes);
+    }
+    out.q_hash = hasher.finish();
+    out
+}
+
+fn check_soak(clips: &[Vec<HumanFrame>], passes: usize) {
+    let first = soak(clips, passes);
+    let second = soak(clips, passes);
+    println!(
+        "soak: {} frames per run; live heap after each pass (bytes): {:?}; allocations in step per pass: {:?}; min CoM margin {:.4} m; max slip {:.1e} m; q hash {:016x}",
+        first.frames,
+        first.live_after_pass,
+        first.step_allocations,
+        first.min_com_margin,
+        first.max_slip,
+        first.q_hash
+    );
+    let expected: usize = clips.iter().map(Vec::len).sum::<usize>() * passes;
+    assert_eq!(first.frames, expected);
+    // Warm-up is the first pass; after it nothing grows and step never allocates.
+    let warm = first.live_after_pass[0];
+    // The instrument works: the imitator's workspaces (over 10 kB) are live on this thread.
+    assert!(warm > 10_000, "live heap after the first pass: {warm} B");
+    for (pass, &live) in first.live_after_pass.iter().enumerate().skip(1) {
+        assert!(
+            live <= warm,
+            "pass {pass}: live heap {live} B > {warm} B after warm-up"
+        );
+    }
+    for (pass, &n) in first.step_allocations.iter().enumerate().skip(1) {
+        assert_eq!(n, 0, "pass {pass}: {n} allocations inside Imitator::step");
+    }
+    assert_eq!(
+        first.q_hash, second.q_hash,
+        "a second run differs in some bit of some joint angle"
+    );
+    assert_eq!(first.live_after_pass, second.live_after_pass);
+}
+
+#[test]
+fn short_soak_three_clips_three_passes() {
+    check_soak(&load(&SHORT), 3);
+}
+
+#[test]
+#[ignore = "full soak, about 1.7 × 10^5 frames: cargo test --release --test soak -- --ignored"]
+fn full_soak_all_clips_ten_passes() {
+    check_soak(&load(&ALL), 10);
+}
