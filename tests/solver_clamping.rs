@@ -116,3 +116,55 @@ fn clamped_joint_contribution_moves_to_the_right_hand_side() {
         "{v:?}"
     );
 }
+
+/// Regression (found by `hardening_solver`): rows of 1e140 left rounding noise of ~1e124 after the
+/// projection, which the absolute rank tolerance counted as a direction; the huge coefficient on
+/// it overflowed to NaN in the clamping loop. All joints are locked ([0, 0]), so the only right
+/// answer is q̇ = 0.
+#[test]
+fn rows_of_huge_scale_give_a_finite_step() {
+    let shape = taskstack::solver::StackShape::from_level_rows(6, &[2, 1, 1]);
+    let mut solver = taskstack::solver::Solver::new(&shape).unwrap();
+    let row = |entries: &[(usize, f64)]| {
+        let mut r = [0.0; 6];
+        for &(i, v) in entries {
+            r[i] = v;
+        }
+        r
+    };
+    let stack = solver.stack_mut();
+    stack
+        .level_mut(0)
+        .set_row(0, &row(&[(4, 3.3e140)]), 0.0)
+        .unwrap();
+    stack
+        .level_mut(0)
+        .set_row(1, &row(&[(4, 7.9e50)]), 2.2e132)
+        .unwrap();
+    stack
+        .level_mut(1)
+        .set_row(0, &row(&[(2, -5.8e136), (5, 5.3e64)]), 0.0)
+        .unwrap();
+    stack
+        .level_mut(2)
+        .set_row(0, &row(&[(5, 3.2e139)]), 0.0)
+        .unwrap();
+    let bounds = JointBounds::with_velocity(&[0.0; 6], &[0.0; 6], &[1.0; 6]).unwrap();
+    let free = solver.solve_unbounded().unwrap();
+    assert_eq!(
+        free.report.levels()[0].rank,
+        1,
+        "two rows along one column have rank 1"
+    );
+    assert!(
+        free.velocity.iter().all(|v| v.is_finite()),
+        "{:?}",
+        free.velocity
+    );
+    let solution = solver.solve(&[0.0; 6], &bounds, 1.0).unwrap();
+    assert!(
+        solution.velocity.iter().all(|v| *v == 0.0),
+        "{:?}",
+        solution.velocity
+    );
+}

@@ -527,6 +527,9 @@ impl Imitator {
     /// Imitates one human frame: returns the robot's posture for it.
     pub fn step(&mut self, frame: &HumanFrame) -> Result<&RobotFrame, ImitationError> {
         let start = Instant::now();
+        if !frame.time.is_finite() {
+            return Err(ScaleError::NonFiniteTime(frame.time).into());
+        }
         let dt = match self.previous_time {
             None => self.nominal_dt,
             Some(previous) if frame.time > previous => frame.time - previous,
@@ -538,9 +541,6 @@ impl Imitator {
                 });
             }
         };
-        if !frame.time.is_finite() {
-            return Err(ScaleError::NonFiniteTime(frame.time).into());
-        }
         let human = self.detector.update(frame);
         let phase = self.machine.update(
             self.commitment.filter(human, self.phase, dt),

@@ -43,13 +43,18 @@ use super::householder::{
 use super::report::{Solution, SolveReport};
 use super::stack::{StackShape, TaskStack, check_finite_slice, check_len};
 
+/// Directions whose remaining norm is below this fraction of their level's largest row norm are
+/// rounding noise, whatever [`Settings::rank_tolerance`] says.
+const RELATIVE_RANK_TOLERANCE: f64 = 1e-12;
+
 /// Numerical settings of the solve. All are absolute, in the units of the task rows (e.g. m/rad
 /// for position tasks); the defaults suit Jacobians whose entries are of order 0.01–1.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Settings {
     /// Directions of a projected level whose remaining norm (≈ singular value) is at or below this
     /// are treated as null: they are neither used by the level nor removed from the space left to
-    /// lower levels. Default `1e-9`.
+    /// lower levels. Default `1e-9`. Never below 1e-12 times the level's largest row norm, the
+    /// rounding noise of the projection.
     pub rank_tolerance: f64,
     /// A level whose smallest kept singular value estimate `σ` is below this is damped. Default
     /// `2e-2`. Set to 0 to disable damping (pure truncation).
@@ -152,6 +157,8 @@ pub struct Solver {
     contributions: Vec<f64>,
     /// Velocity limits of this solve.
     step_vmax: Vec<f64>,
+    /// Largest row norm of the level being projected.
+    row_scale: f64,
     /// The part of the step due to the clamped joints' fixed velocities, and a copy of those.
     base_velocity: Vec<f64>,
     saved_fixed: Vec<f64>,
@@ -191,6 +198,7 @@ impl Solver {
             scales: vec![1.0; levels + 1],
             contributions: vec![0.0; (levels + 1) * n],
             step_vmax: vec![0.0; n],
+            row_scale: 0.0,
             base_velocity: vec![0.0; n],
             saved_fixed: vec![0.0; n],
             report: SolveReport::with_capacity(levels, n),
@@ -405,8 +413,10 @@ impl Solver {
         let start = self.stack.level_start(j);
         let rows = self.stack.level_start(j + 1) - start;
         let (head, tail) = self.qr.split_at_mut(n * start);
+        self.row_scale = 0.0;
         for t in 0..rows {
             let row = self.stack.row(start + t);
+            self.row_scale = self.row_scale.max(norm(row));
             let mut b = self.scales[j] * self.stack.stacked_target()[start + t]
                 - dot(row, &self.fixed_velocity);
             for (c, &i) in self.coords.iter_mut().zip(&self.free) {
@@ -444,7 +454,13 @@ impl Solver {
         let a = &mut self.qr[n * start..n * start + dim * rows];
         let tau = &mut self.tau[start..start + rows];
         let perm = &mut self.perm[start..start + rows];
-        let rank = qr_col_pivoting(a, dim, rows, self.settings.rank_tolerance, tau, perm);
+        // Rounding leaves ~1e-16 of a row's norm behind in the directions removed by the levels
+        // above; on rows of any scale that noise must not count as rank.
+        let tolerance = self
+            .settings
+            .rank_tolerance
+            .max(RELATIVE_RANK_TOLERANCE * self.row_scale);
+        let rank = qr_col_pivoting(a, dim, rows, tolerance, tau, perm);
         let w = &mut self.coeff[start..start + rows];
         w.fill(0.0);
         let mut damping = 0.0;
