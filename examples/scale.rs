@@ -25,8 +25,7 @@ use nalgebra::{Rotation3, Vector3};
 use taskstack::imitation::human::{HumanFrame, HumanJoint};
 use taskstack::imitation::scaler::{RobotSkeleton, ScaleConfig, ScaledSkeleton, Scaler, Stance};
 use taskstack::imitation::support::{HumanSupport, Side, SupportConfig, SupportDetector};
-use taskstack::io::bvh::{BvhConfig, BvhReader};
-use taskstack::io::kinect::{KinectConfig, KinectReader};
+use taskstack::io::clip::Clip;
 
 const DEFAULT_CLIP: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
@@ -69,22 +68,12 @@ fn parse_args() -> Result<Args, String> {
 
 /// Every frame of the clip, and the support detector settings that suit its source.
 fn read_clip(path: &Path) -> Result<(Vec<HumanFrame>, SupportConfig), String> {
-    let is_csv = path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("csv"));
-    if is_csv {
-        let frames = KinectReader::open(path, KinectConfig::default())
-            .map_err(|e| e.to_string())?
-            .collect::<Result<Vec<_>, _>>()
-            .map_err(|e| e.to_string())?;
-        Ok((frames, SupportConfig::kinect()))
-    } else {
-        let frames = BvhReader::open(path, BvhConfig::cmu())
-            .map_err(|e| e.to_string())?
-            .collect::<Result<Vec<_>, _>>()
-            .map_err(|e| e.to_string())?;
-        Ok((frames, SupportConfig::optical()))
-    }
+    let clip = Clip::open(path).map_err(|e| e.to_string())?;
+    let support = clip.support_config();
+    let frames = clip
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| e.to_string())?;
+    Ok((frames, support))
 }
 
 /// Bones as (from, to) point pairs.

@@ -19,12 +19,10 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use serde_json::{Value, json};
+use taskstack::imitation::batch::metrics_json;
 use taskstack::imitation::human::HumanFrame;
 use taskstack::imitation::imitator::{FootRootedModels, Imitator, ImitatorConfig};
-use taskstack::imitation::metrics::{
-    CONTACT_HEIGHT, EFFECTORS, ImitationMetrics, MeanMax, MetricsRecorder, Spread,
-};
+use taskstack::imitation::metrics::{CONTACT_HEIGHT, EFFECTORS, ImitationMetrics, MetricsRecorder};
 use taskstack::io::clip::Clip;
 use taskstack::robots::nao::Foot;
 
@@ -179,11 +177,7 @@ fn run(
     let metrics = recorder.finish();
     std::fs::create_dir_all(out)?;
     std::fs::write(out.join("joints.csv"), joints)?;
-    let json = metrics_json(&metrics, path);
-    std::fs::write(
-        out.join("metrics.json"),
-        serde_json::to_string_pretty(&json)? + "\n",
-    )?;
+    std::fs::write(out.join("metrics.json"), metrics_json(&metrics, path))?;
     std::fs::write(
         out.join("effectors.svg"),
         plots::effectors(&samples, &plotted),
@@ -192,44 +186,6 @@ fn run(
     std::fs::write(out.join("phases.svg"), plots::phases(&samples))?;
     print_summary(&metrics, path, out);
     Ok(())
-}
-
-fn mean_max(m: &MeanMax) -> Value {
-    json!({ "mean": m.mean, "max": m.max, "frames": m.count })
-}
-
-fn spread(s: &Spread) -> Value {
-    json!({ "min": s.min, "median": s.median, "p99": s.p99, "max": s.max, "count": s.count })
-}
-
-fn metrics_json(m: &ImitationMetrics, clip: &Path) -> Value {
-    let effectors: serde_json::Map<String, Value> = m
-        .effectors
-        .iter()
-        .map(|e| {
-            (
-                e.name.to_string(),
-                json!({ "single_support_m": mean_max(&e.single_support), "double_support_m": mean_max(&e.double_support) }),
-            )
-        })
-        .collect();
-    json!({
-        "clip": clip.file_name().map(|f| f.to_string_lossy().into_owned()),
-        "frames": m.frames,
-        "duration_s": m.duration,
-        "human_support_changes": m.human_support_changes,
-        "robot_support_changes": m.robot_support_changes,
-        "robot_support_sequence": m.robot_support_sequence,
-        "transition_durations_s": spread(&m.transition_durations),
-        "tracking_error": effectors,
-        "min_com_margin_m": m.min_com_margin,
-        "frames_com_outside_support": m.frames_com_outside,
-        "joint_limit_violations": m.joint_limit_violations,
-        "velocity_limit_violations": m.velocity_limit_violations,
-        "max_support_foot_slip_m": m.max_support_slip,
-        "max_support_foot_turn_rad": m.max_support_turn,
-        "solve_time_us": spread(&m.solve_time_us),
-    })
 }
 
 fn print_summary(m: &ImitationMetrics, clip: &Path, out: &Path) {
