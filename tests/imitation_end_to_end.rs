@@ -176,3 +176,71 @@ fn a_walk_at_full_speed_keeps_the_invariants() {
         m.robot_support_sequence
     );
 }
+
+/// A user table with more tasks than Table I (the head tracked too in every phase, and nine more
+/// frames' heights held: up to 17 tasks) is solved and reported whole.
+#[test]
+fn overridden_tables_are_solved_and_reported_whole() {
+    use taskstack::imitation::human::HumanJoint;
+    use taskstack::imitation::phase::PhaseConfig;
+    use taskstack::imitation::tables::{Axes, PointTarget, Task, TaskTables};
+    let mut tables = TaskTables::contact_first(&PhaseConfig::default());
+    for phase in SupportPhase::ALL {
+        let mut table = tables.table(phase).clone();
+        let last = table.levels.len() - 1;
+        table.levels[last].tasks.push(Task::Point {
+            frame: "gaze".into(),
+            offset: [0.0; 3],
+            axes: Axes::XYZ,
+            target: PointTarget::Scaled(HumanJoint::Head),
+        });
+        // And the heights of nine more frames held, for a table larger than any of Table I's.
+        for frame in [
+            "head",
+            "l_elbow",
+            "r_elbow",
+            "l_knee",
+            "r_knee",
+            "l_wrist",
+            "r_wrist",
+            "l_shoulder",
+            "r_shoulder",
+        ] {
+            table.levels[last].tasks.push(Task::Point {
+                frame: frame.into(),
+                offset: [0.0; 3],
+                axes: Axes::Z,
+                target: PointTarget::Held { lift: 0.0 },
+            });
+        }
+        tables.set(table).unwrap();
+    }
+    let config = ImitatorConfig {
+        tables: tables.clone(),
+        ..ImitatorConfig::default()
+    };
+    // Double support (17 tasks) and a walk's single supports and transitions (14 and 15 tasks).
+    for name in [
+        "cmu_02_10_wash_self_standing_arm_gestures.bvh",
+        "cmu_07_04_slow_walk.bvh",
+    ] {
+        let mut clip = Clip::open(clip_path(name)).unwrap();
+        let config = ImitatorConfig {
+            support: clip.support_config(),
+            ..config.clone()
+        };
+        let mut imitator = Imitator::new(FootRootedModels::nao(), config).unwrap();
+        let mut frame = HumanFrame::new(0.0);
+        while clip.read_frame(&mut frame).unwrap() && frame.time < 3.0 {
+            let r = imitator.step(&frame).unwrap();
+            let expected: usize = tables
+                .table(r.phase)
+                .levels
+                .iter()
+                .map(|l| l.tasks.len())
+                .sum();
+            assert_eq!(r.task_count, expected, "{}", r.phase);
+            assert!(r.task_errors[..r.task_count].iter().all(|e| e.is_finite()));
+        }
+    }
+}

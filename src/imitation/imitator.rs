@@ -422,6 +422,12 @@ impl Imitator {
                 PhaseSolver::new(config.tables.table(phase), &models, settings)
             })
             .collect::<Result<Vec<_>, _>>()?;
+        let max_tasks = phases.iter().map(|p| p.tasks.len()).max().unwrap_or(0);
+        let max_levels = phases
+            .iter()
+            .map(|p| p.table.levels.len())
+            .max()
+            .unwrap_or(0);
         let skeleton = RobotSkeleton::at_zero(&models.right, &NAO_MAPPING)?;
         let angles = NaoJointAngles::new(&models.right)?;
         let mut data = [models.right.new_data(), models.left.new_data()];
@@ -435,9 +441,10 @@ impl Imitator {
             right_sole: IsometryMatrix3::identity(),
             left_sole: IsometryMatrix3::identity(),
             com: Vector3::zeros(),
-            task_errors: vec![0.0; 16],
+            // Sized for the largest table, so a user's bigger table is reported whole.
+            task_errors: vec![0.0; max_tasks],
             task_count: 0,
-            levels: vec![LevelReport::default(); 4],
+            levels: vec![LevelReport::default(); max_levels],
             level_count: 0,
             clamped: vec![0; nv],
             clamped_count: 0,
