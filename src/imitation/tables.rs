@@ -225,7 +225,9 @@ pub struct TaskTable {
     pub levels: Vec<Level>,
     /// Gradient tasks, summed in the null space of all levels.
     pub gradients: Vec<Gradient>,
-    /// Whether the clamping loop (fix violating joints at their limit and re-solve) runs.
+    /// Whether the clamping loop (fix violating joints at their limit and re-solve) runs, as
+    /// Table I describes the method. The [`Imitator`](super::imitator::Imitator) always keeps the
+    /// joint limits, whatever this says: its output is sent to a robot.
     pub clamping: bool,
 }
 
