@@ -250,6 +250,8 @@ struct PhaseSolver {
 pub struct Imitator {
     models: FootRootedModels,
     data: [ModelData; 2],
+    /// The sole frames of each model, resolved once: `soles[root][foot]`.
+    soles: [[FrameId; 2]; 2],
     phases: Vec<PhaseSolver>,
     detector: SupportDetector,
     scaler: Scaler,
@@ -431,6 +433,13 @@ impl Imitator {
         let skeleton = RobotSkeleton::at_zero(&models.right, &NAO_MAPPING)?;
         let angles = NaoJointAngles::new(&models.right)?;
         let mut data = [models.right.new_data(), models.left.new_data()];
+        let sole_ids = |model: &Model| -> Result<[FrameId; 2], ModelError> {
+            Ok([
+                model.frame_id(Foot::Right.sole())?,
+                model.frame_id(Foot::Left.sole())?,
+            ])
+        };
+        let soles = [sole_ids(&models.right)?, sole_ids(&models.left)?];
         models.right.forward_kinematics(&mut data[0], &q)?;
         let output = RobotFrame {
             time: 0.0,
@@ -468,6 +477,7 @@ impl Imitator {
             nominal_dt: config.nominal_dt,
             phases,
             data,
+            soles,
             q,
             root: Foot::Right,
             world_t_root: IsometryMatrix3::identity(),
@@ -565,7 +575,7 @@ impl Imitator {
         let root_t_base = if scaled.base() == side_of(self.root) {
             IsometryMatrix3::identity()
         } else {
-            *self.data[root].frame_placement(model.frame_id(sole_of(scaled.base()))?)
+            *self.data[root].frame_placement(self.soles[root][foot_index(foot_of(scaled.base()))])
         };
         for (out, (_, p)) in self.output.reference.iter_mut().zip(scaled.points()) {
             *out = p.map(|p| root_t_base.transform_point(&p.into()).coords);
@@ -634,7 +644,7 @@ impl Imitator {
         // at ρ, a landing when the highest is on the ground (flat, so that the foot can become
         // the support without tilting the world).
         let swing = phase.swing_foot().unwrap_or(self.root.other());
-        let sole = data.frame_placement(model.frame_id(swing.sole())?);
+        let sole = data.frame_placement(self.soles[root][foot_index(swing)]);
         let corner_z = swing
             .sole_outline()
             .map(|[x, y]| sole.transform_point(&Vector3::new(x, y, 0.0).into()).z);
@@ -652,7 +662,7 @@ impl Imitator {
 
         let world_t_root = self.world_t_root;
         let placement = |foot: Foot| -> Result<IsometryMatrix3<f64>, ModelError> {
-            model.placement_in_world(data, &world_t_root, model.frame_id(foot.sole())?)
+            model.placement_in_world(data, &world_t_root, self.soles[root][foot_index(foot)])
         };
         out.right_sole = placement(Foot::Right)?;
         out.left_sole = placement(Foot::Left)?;
@@ -737,10 +747,10 @@ fn side_of(foot: Foot) -> Side {
     }
 }
 
-fn sole_of(side: Side) -> &'static str {
+fn foot_of(side: Side) -> Foot {
     match side {
-        Side::Right => "r_sole",
-        Side::Left => "l_sole",
+        Side::Right => Foot::Right,
+        Side::Left => Foot::Left,
     }
 }
 
