@@ -684,12 +684,7 @@ impl<R: BufRead> Iterator for BvhReader<R> {
     type Item = Result<HumanFrame, BvhError>;
 
     fn next(&mut self) -> Option<Self::Item> {
-        let mut frame = HumanFrame::new(0.0);
-        match self.read_frame(&mut frame) {
-            Ok(true) => Some(Ok(frame)),
-            Ok(false) => None,
-            Err(e) => Some(Err(e)),
-        }
+        super::next_frame(|frame| self.read_frame(frame))
     }
 }
 

@@ -85,11 +85,6 @@ impl Iterator for Clip {
     type Item = Result<HumanFrame, ClipError>;
 
     fn next(&mut self) -> Option<Self::Item> {
-        let mut frame = HumanFrame::new(0.0);
-        match self.read_frame(&mut frame) {
-            Ok(true) => Some(Ok(frame)),
-            Ok(false) => None,
-            Err(e) => Some(Err(e)),
-        }
+        super::next_frame(|frame| self.read_frame(frame))
     }
 }

@@ -321,11 +321,6 @@ impl<R: BufRead> Iterator for KinectReader<R> {
     type Item = Result<HumanFrame, KinectError>;
 
     fn next(&mut self) -> Option<Self::Item> {
-        let mut frame = HumanFrame::new(0.0);
-        match self.read_frame(&mut frame) {
-            Ok(true) => Some(Ok(frame)),
-            Ok(false) => None,
-            Err(e) => Some(Err(e)),
-        }
+        super::next_frame(|frame| self.read_frame(frame))
     }
 }

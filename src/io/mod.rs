@@ -10,6 +10,21 @@ pub mod kinect;
 
 use std::io::{self, BufRead, Read};
 
+use crate::imitation::human::HumanFrame;
+
+/// The iterator item of a reader with `read_frame(&mut HumanFrame) -> Result<bool, E>`: the next
+/// frame, `None` at the end, or the error.
+fn next_frame<E>(
+    read: impl FnOnce(&mut HumanFrame) -> Result<bool, E>,
+) -> Option<Result<HumanFrame, E>> {
+    let mut frame = HumanFrame::new(0.0);
+    match read(&mut frame) {
+        Ok(true) => Some(Ok(frame)),
+        Ok(false) => None,
+        Err(e) => Some(Err(e)),
+    }
+}
+
 /// Reads one line (without its `\n` / `\r\n`) into `buf`, reading at most `max_bytes` bytes.
 /// Returns `Ok(None)` at end of input and `Ok(Some(true))` if the line was longer than
 /// `max_bytes` (the rest of it is left unread). Invalid UTF-8 is an `InvalidData` error.
