@@ -1,4 +1,4 @@
-//! The whole `solve` frame on the NAO benchmark problems (`../shared/bench/problem_*.json`):
+//! The whole `solve` frame on the NAO benchmark problems (`tests/data/bench/problem_*.json`):
 //! targets set + all driver iterations + stop test, warm-started from the previous frame, cycling
 //! through the file's frames. Same code as the `solve` example.
 
@@ -11,7 +11,7 @@ use problem::{Problem, Runner};
 use std::hint::black_box;
 
 fn bench(c: &mut Criterion) {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/bench");
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/bench");
     for name in [
         "problem_rs",
         "problem_ds",

@@ -1,4 +1,4 @@
-//! Solves a NAO benchmark problem file (`../shared/bench/problem_*.json`, schema
+//! Solves a NAO benchmark problem file (`tests/data/bench/problem_*.json`, schema
 //! `nao-prioritized-ik-benchmark/1`) frame by frame, warm-started, following the file's protocol,
 //! and prints a JSON result: per frame the final q (in the file's `joint_order`), every task's
 //! error (m), the iterations and the stop reason; overall the limit violations and the wall time

@@ -1,4 +1,4 @@
-//! The NAO prioritized-IK benchmark problems of `../shared/bench/` (schema
+//! The NAO prioritized-IK benchmark problems of `tests/data/bench/` (schema
 //! `nao-prioritized-ik-benchmark/1`): reading a file, and solving it frame by frame with the
 //! position-level driver following the file's protocol. Shared by the `solve` example and the
 //! `bench_problems` benchmark.

@@ -10,7 +10,7 @@
 //!
 //! # Forward kinematics
 //!
-//! The convention checked on the CMU files (`shared/data/mocap/README.md`): for each joint,
+//! The convention checked on the CMU files (`tests/data/mocap/README.md` in the repository): for each joint,
 //! `R_local = R_c1·R_c2·R_c3` with the rotation channels multiplied **in the order the joint
 //! lists them** (so CMU-MB's `Zrotation Yrotation Xrotation` gives `Rz·Ry·Rx`, and CMU-MAX's arm
 //! joints' `Zrotation Xrotation Yrotation` give `Rz·Rx·Ry`), `t_local = OFFSET + (position
@@ -347,7 +347,7 @@ pub enum BvhNames {
     Custom(Vec<(String, HumanJoint)>),
 }
 
-/// Name map of the CMU MotionBuilder-friendly BVH release (`shared/data/mocap/README.md`).
+/// Name map of the CMU MotionBuilder-friendly BVH release (`tests/data/mocap/README.md` in the repository).
 /// MidHip is derived from the hips. `LeftHandIndex1` (the knuckles) stands for the hand because
 /// `LeftFingerBase` sits exactly on the wrist.
 pub const CMU_MB_NAMES: [(&str, HumanJoint); 20] = [

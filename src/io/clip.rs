@@ -3,7 +3,7 @@
 //! names). Streams frames and says which support-detection defaults suit the source.
 //!
 //! The CMU MotionBuilder-friendly release (CMU-MB names) prepends a synthetic T-pose as frame 0
-//! (`../shared/data/mocap/README.md`); [`Clip`] skips it, so the first frame is captured motion.
+//! (`tests/data/mocap/README.md` in the repository); [`Clip`] skips it, so the first frame is captured motion.
 
 use std::fs::File;
 use std::io::BufReader;
