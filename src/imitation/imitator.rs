@@ -25,14 +25,18 @@
 
 use std::time::Instant;
 
-use nalgebra::{IsometryMatrix3, Vector2, Vector3};
+use faer::Mat;
+use nalgebra::{IsometryMatrix3, Rotation3, UnitQuaternion, Vector2, Vector3};
 use thiserror::Error;
 
 use super::human::{HumanFrame, HumanJoint};
 use super::phase::{Measurements, PhaseConfig, PhaseError, PhaseMachine, SupportPhase, TakeOff};
 use super::scaler::{NAO_MAPPING, NaoJointAngles, RobotSkeleton, ScaleConfig, ScaleError, Scaler};
+use super::shaping::{ComReference, MotionLimits, SwingHeight};
 use super::support::{HumanSupport, Side, SupportConfig, SupportDetector, SupportError};
-use super::tables::{ComGoal, GradientKind, PointTarget, TableError, Task, TaskTable, TaskTables};
+use super::tables::{
+    ComGoal, GradientKind, OrientationTarget, PointTarget, TableError, Task, TaskTable, TaskTables,
+};
 use crate::model::{Axis, FrameId, Model, ModelData, ModelError};
 use crate::robots::nao::{self, Foot};
 use crate::solver::driver::{DriverSettings, PositionDriver, StopReason, TaskModel};
@@ -119,11 +123,21 @@ pub struct ImitatorConfig {
     pub scale: ScaleConfig,
     /// Phase machine: λ, ρ and the step-end tolerances.
     pub phase: PhaseConfig,
-    /// The task tables (default: [`TaskTables::contact_first`], Table I with the free foot's
-    /// ground contact as the highest level while it stands).
+    /// The task tables (default: [`TaskTables::executable`], Table I with the feet held fully
+    /// while they stand, the CoM at the middle of the contact area and an upright torso).
     pub tables: TaskTables,
-    /// Fraction of each joint's rated velocity the robot may use (paper: 0.1).
+    /// Fraction of each joint's rated velocity the robot may use (paper: 0.1). With
+    /// `upper_body_velocity_fraction` set, this applies to the legs only: the joints on the
+    /// chain between the two soles, which carry the robot and close a loop in double support.
     pub velocity_fraction: f64,
+    /// Fraction of the rated velocity of every joint off the sole-to-sole chain (arms, head),
+    /// or `None` for `velocity_fraction`. Default 0.5: the arms follow the human closely, while
+    /// the legs keep the paper's 10 %; the balance level sees the arms' effect on the CoM and
+    /// the solver slows the arms down when the legs cannot compensate.
+    pub upper_body_velocity_fraction: Option<f64>,
+    /// Speed and acceleration bounds of the CoM reference and of the swing foot (see
+    /// [`super::shaping`]).
+    pub motion: MotionLimits,
     /// Gauss–Newton steps per frame (default 1, as the paper: one IK per time step). Each step
     /// is limited to the velocity budget of the whole frame divided by this count.
     pub iterations_per_frame: usize,
@@ -157,9 +171,11 @@ impl Default for ImitatorConfig {
         Self {
             support: SupportConfig::optical(),
             scale: ScaleConfig::nao(),
-            tables: TaskTables::contact_first(&phase),
+            tables: TaskTables::executable(&phase),
             phase,
             velocity_fraction: 0.1,
+            upper_body_velocity_fraction: Some(0.5),
+            motion: MotionLimits::default(),
             iterations_per_frame: 1,
             max_task_speed: 0.15,
             step_commit_time: 0.3,
@@ -234,6 +250,8 @@ struct ResolvedTask {
     rest_height: f64,
     /// Held target (frame position when the step began), m, root frame.
     held: Vector3<f64>,
+    /// Held heading (yaw of the frame's x axis when the step began), rad, root frame.
+    held_yaw: f64,
 }
 
 /// Everything one phase needs: its table resolved, a solver and a driver sized for it.
@@ -272,6 +290,13 @@ pub struct Imitator {
     measurements: Measurements,
     previous_time: Option<f64>,
     commitment: StepCommitment,
+    motion: MotionLimits,
+    /// The shaped CoM ground projection (world frame); `None` before the first frame.
+    com_reference: Option<ComReference>,
+    /// The shaped height of the swing foot above the ground.
+    swing: SwingHeight,
+    /// 3 × nv scratch for the orientation rows of 2-row tasks.
+    orientation_rows: Mat<f64>,
     output: RobotFrame,
 }
 
@@ -284,7 +309,7 @@ fn foot_index(foot: Foot) -> usize {
 
 fn axes_of(task: &Task) -> [Option<Axis>; 3] {
     match task {
-        Task::ComXY(_) => [Some(Axis::X), Some(Axis::Y), None],
+        Task::ComXY(_) | Task::Orientation { .. } => [Some(Axis::X), Some(Axis::Y), None],
         Task::Point { axes, .. } => {
             let mut out = [None; 3];
             let picked = [(axes.x, Axis::X), (axes.y, Axis::Y), (axes.z, Axis::Z)];
@@ -315,6 +340,9 @@ impl PhaseSolver {
                     Task::Point { frame, offset, .. } => {
                         (Some(model.frame_id(frame)?), Vector3::from(*offset))
                     }
+                    Task::Orientation { frame, .. } => {
+                        (Some(model.frame_id(frame)?), Vector3::zeros())
+                    }
                 };
                 let rest_height = match frame {
                     Some(f) => model.point_position(&rest, f, &offset)?.z,
@@ -330,6 +358,7 @@ impl PhaseSolver {
                     row,
                     rest_height,
                     held: Vector3::zeros(),
+                    held_yaw: 0.0,
                 });
                 row += task.rows();
             }
@@ -385,6 +414,22 @@ impl Imitator {
                 reason: "must be >= 0 s (infinity: never commit)",
             });
         }
+        if let Some(fraction) = config.upper_body_velocity_fraction
+            && !(fraction.is_finite() && fraction > 0.0)
+        {
+            return Err(ImitationError::InvalidParameter {
+                name: "upper_body_velocity_fraction",
+                value: fraction,
+                reason: "must be finite and > 0",
+            });
+        }
+        if let Some((name, value)) = config.motion.invalid_field() {
+            return Err(ImitationError::InvalidParameter {
+                name,
+                value,
+                reason: "motion limits must be finite and > 0",
+            });
+        }
         if config.iterations_per_frame == 0 {
             return Err(ImitationError::InvalidParameter {
                 name: "iterations_per_frame",
@@ -396,10 +441,7 @@ impl Imitator {
         let nv = model.nv();
         let lower: Vec<f64> = model.variables().iter().map(|v| v.lower).collect();
         let upper: Vec<f64> = model.variables().iter().map(|v| v.upper).collect();
-        let rated_velocity: Vec<f64> = model.variables().iter().map(|v| v.velocity).collect();
         let position_bounds = JointBounds::new(&lower, &upper)?;
-        let mut bounds = JointBounds::with_velocity(&lower, &upper, &rated_velocity)?;
-        bounds.scale_velocity(fraction)?;
         let mut q = match &config.initial_q {
             Some(q) if q.len() == nv => q.clone(),
             Some(q) => {
@@ -414,6 +456,23 @@ impl Imitator {
             None => vec![0.0; nv],
         };
         position_bounds.clamp_position(&mut q);
+        let legs = sole_chain_variables(&models, &q)?;
+        let velocity: Vec<f64> = model
+            .variables()
+            .iter()
+            .zip(&legs)
+            .map(|(v, &leg)| match config.upper_body_velocity_fraction {
+                Some(upper) if !leg => v.velocity * upper,
+                _ => v.velocity * fraction,
+            })
+            .collect();
+        let bounds = JointBounds::with_velocity(&lower, &upper, &velocity)?;
+        // The legs' posture follows from the feet, the CoM and the torso; the human's leg angles
+        // would only drive the closed chain of double support against itself.
+        let tracking_weight: Vec<f64> = legs
+            .iter()
+            .map(|&leg| if leg { 0.0 } else { 1.0 })
+            .collect();
         let phases = SupportPhase::ALL
             .iter()
             .map(|&phase| {
@@ -468,7 +527,7 @@ impl Imitator {
             angles,
             machine: PhaseMachine::new(config.phase)?,
             limits: JointLimitAvoidance::new(&position_bounds),
-            tracking: JointTracking::new(&q)?,
+            tracking: JointTracking::weighted(&q, &tracking_weight)?,
             human_q: q.clone(),
             bounds,
             velocity_fraction: fraction,
@@ -493,6 +552,10 @@ impl Imitator {
                 stance: None,
                 pending: None,
             },
+            motion: config.motion,
+            com_reference: None,
+            swing: SwingHeight::at(0.0),
+            orientation_rows: Mat::zeros(3, nv),
             output,
             models,
         })
@@ -566,7 +629,6 @@ impl Imitator {
         let changed = phase != self.phase || self.previous_time.is_none();
         self.switch_root(self.phases[phase.index()].table.model_root)?;
         let root = foot_index(self.root);
-        let model = self.models.rooted_at(self.root);
 
         let scaled = *self.scaler.scale(frame, human)?;
         self.angles.compute(&scaled, &mut self.human_q)?;
@@ -581,17 +643,13 @@ impl Imitator {
             *out = p.map(|p| root_t_base.transform_point(&p.into()).coords);
         }
 
-        let ps = &mut self.phases[phase.index()];
         if changed {
-            for task in &mut ps.tasks {
-                if let Some(f) = task.frame {
-                    task.held = self.data[root]
-                        .frame_placement(f)
-                        .transform_point(&task.offset.into())
-                        .coords;
-                }
-            }
+            self.hold_targets(phase);
         }
+        let (com_target, goal_distance) = self.shape_references(phase, dt)?;
+        let swing_lift = self.swing.height();
+        let model = self.models.rooted_at(self.root);
+        let ps = &mut self.phases[phase.index()];
         // The velocity budget of the frame, split over its iterations.
         let step_dt = dt / self.iterations as f64;
         let driver_settings = DriverSettings {
@@ -609,8 +667,9 @@ impl Imitator {
             data: &mut self.data[root],
             tasks: &ps.tasks,
             reference: &self.output.reference,
-            other_ankle: ps.other_ankle,
-            other_sole: ps.other_sole,
+            com_target,
+            swing_lift,
+            orientation_rows: &mut self.orientation_rows,
             table: &ps.table,
             limits: &self.limits,
             tracking: &self.tracking,
@@ -639,7 +698,7 @@ impl Imitator {
             .tasks
             .iter()
             .position(|t| matches!(t.task, Task::ComXY(_)))
-            .map_or(0.0, |i| errors[i]);
+            .map_or(0.0, |i| errors[i] + goal_distance);
         // Heights of the swing sole's outline corners: a lift is done when the lowest corner is
         // at ρ, a landing when the highest is on the ground (flat, so that the foot can become
         // the support without tilting the world).
@@ -679,6 +738,74 @@ impl Imitator {
         self.previous_time = Some(frame.time);
         out.micros = start.elapsed().as_secs_f64() * 1e6;
         Ok(&self.output)
+    }
+
+    /// At the start of a step: the held targets of `phase`'s tasks become the frames' current
+    /// positions and headings, and the swing height the swing sole's current height.
+    fn hold_targets(&mut self, phase: SupportPhase) {
+        let root = foot_index(self.root);
+        let data = &self.data[root];
+        for task in &mut self.phases[phase.index()].tasks {
+            if let Some(f) = task.frame {
+                let placement = data.frame_placement(f);
+                task.held = placement.transform_point(&task.offset.into()).coords;
+                let x = placement.rotation * Vector3::x();
+                task.held_yaw = x.y.atan2(x.x);
+            }
+        }
+        let swing = phase.swing_foot().unwrap_or(self.root.other());
+        let sole = data.frame_placement(self.soles[root][foot_index(swing)]);
+        self.swing = SwingHeight::at(sole.translation.vector.z);
+    }
+
+    /// Advances the shaped CoM reference toward `phase`'s CoM goal and the swing height toward
+    /// its lift. Returns the CoM target for the balance task in the root frame and the distance
+    /// (m) the reference still has to go to the goal.
+    fn shape_references(
+        &mut self,
+        phase: SupportPhase,
+        dt: f64,
+    ) -> Result<(Vector2<f64>, f64), ImitationError> {
+        let root = foot_index(self.root);
+        let model = self.models.rooted_at(self.root);
+        let data = &self.data[root];
+        let ps = &self.phases[phase.index()];
+        let lift = ps.tasks.iter().find_map(|t| match t.task {
+            Task::Point {
+                target: PointTarget::Held { lift },
+                ..
+            } => Some(lift),
+            _ => None,
+        });
+        if let Some(lift) = lift {
+            self.swing.advance(lift, dt, &self.motion);
+        }
+        let Some(goal) = ps.tasks.iter().find_map(|t| match t.task {
+            Task::ComXY(goal) => Some(goal),
+            _ => None,
+        }) else {
+            return Ok((Vector2::zeros(), 0.0));
+        };
+        let goal = com_goal(goal, data, ps.other_ankle, ps.other_sole);
+        let to_world = |p: Vector2<f64>| {
+            self.world_t_root
+                .transform_point(&Vector3::new(p.x, p.y, 0.0).into())
+                .coords
+                .xy()
+        };
+        let goal_world = to_world(goal);
+        let com = to_world(model.com(data)?.xy());
+        let reference = self
+            .com_reference
+            .get_or_insert_with(|| ComReference::at_rest(com));
+        reference.advance(goal_world, dt, &self.motion);
+        let r = reference.position();
+        let target = self
+            .world_t_root
+            .inverse_transform_point(&Vector3::new(r.x, r.y, 0.0).into())
+            .coords
+            .xy();
+        Ok((target, (goal_world - r).norm()))
     }
 
     /// Re-roots the model at `foot` if it is not already, keeping the world placement.
@@ -740,6 +867,27 @@ impl StepCommitment {
     }
 }
 
+/// Which variables move the left sole relative to the right one (the legs, closing a loop in
+/// double support): the columns of the left sole's 6 × n Jacobian in the right-rooted model that
+/// are not zero at `q`.
+fn sole_chain_variables(models: &FootRootedModels, q: &[f64]) -> Result<Vec<bool>, ImitationError> {
+    let model = &models.right;
+    let mut data = model.new_data();
+    model.forward_kinematics(&mut data, q)?;
+    let sole = model.frame_id(Foot::Left.sole())?;
+    let mut jac = Mat::zeros(6, model.nv());
+    model.point_jacobian(
+        &data,
+        sole,
+        &Vector3::zeros(),
+        jac.as_mut().subrows_mut(0, 3),
+    )?;
+    model.orientation_jacobian(&data, sole, jac.as_mut().subrows_mut(3, 3))?;
+    Ok((0..model.nv())
+        .map(|k| (0..6).any(|r| jac[(r, k)] != 0.0))
+        .collect())
+}
+
 fn side_of(foot: Foot) -> Side {
     match foot {
         Foot::Right => Side::Right,
@@ -760,31 +908,52 @@ struct PhaseTasks<'a> {
     data: &'a mut ModelData,
     tasks: &'a [ResolvedTask],
     reference: &'a [Option<Vector3<f64>>; HumanJoint::COUNT],
-    other_ankle: FrameId,
-    other_sole: FrameId,
+    /// The shaped CoM ground projection, root frame (m).
+    com_target: Vector2<f64>,
+    /// The shaped swing height (m) that replaces the lift of `Held` targets.
+    swing_lift: f64,
+    orientation_rows: &'a mut Mat<f64>,
     table: &'a TaskTable,
     limits: &'a JointLimitAvoidance,
     tracking: &'a JointTracking,
 }
 
-impl PhaseTasks<'_> {
-    fn com_goal(&self, goal: ComGoal) -> Vector2<f64> {
-        let other = self
-            .data
-            .frame_placement(self.other_ankle)
-            .translation
-            .vector;
-        match goal {
-            ComGoal::SupportAnkle => Vector2::zeros(),
-            ComGoal::SupportFootCentre { lambda } => Vector2::new(lambda, 0.0),
-            ComGoal::MidAnkles => other.xy() * 0.5,
-            ComGoal::OtherFootCentre { lambda } => {
-                let sole = self.data.frame_placement(self.other_sole);
-                let forward = sole.rotation * Vector3::x();
-                other.xy() + lambda * forward.xy()
-            }
+/// `goal` in the root frame (m), from the current forward kinematics in `data`.
+fn com_goal(
+    goal: ComGoal,
+    data: &ModelData,
+    other_ankle: FrameId,
+    other_sole: FrameId,
+) -> Vector2<f64> {
+    let other = data.frame_placement(other_ankle).translation.vector;
+    let sole = data.frame_placement(other_sole);
+    let on_other = |[x, y]: [f64; 2]| {
+        sole.transform_point(&Vector3::new(x, y, 0.0).into())
+            .coords
+            .xy()
+    };
+    match goal {
+        ComGoal::SupportAnkle => Vector2::zeros(),
+        ComGoal::SupportFootCentre { lambda } => Vector2::new(lambda, 0.0),
+        ComGoal::MidAnkles => other.xy() * 0.5,
+        ComGoal::OtherFootCentre { lambda } => {
+            let forward = sole.rotation * Vector3::x();
+            other.xy() + lambda * forward.xy()
+        }
+        ComGoal::SupportPoint(p) => Vector2::from(p),
+        ComGoal::OtherPoint(p) => on_other(p),
+        ComGoal::BetweenPoints { support, other } => {
+            (Vector2::from(support) + on_other(other)) * 0.5
         }
     }
+}
+
+/// Rotation vector (rad, root frame) that turns `current` into flat with heading `yaw`.
+fn flat_error(current: &Rotation3<f64>, yaw: f64) -> Vector3<f64> {
+    let target = Rotation3::from_axis_angle(&Vector3::z_axis(), yaw);
+    // Through a quaternion: a rotation matrix a rounding error away from orthonormal gives
+    // `Rotation3::scaled_axis` an arccos argument just above 1, hence NaN, near the identity.
+    UnitQuaternion::from_rotation_matrix(&(target * current.inverse())).scaled_axis()
 }
 
 impl TaskModel for PhaseTasks<'_> {
@@ -795,61 +964,39 @@ impl TaskModel for PhaseTasks<'_> {
         for task in self.tasks {
             let mut level = stack.level_mut(task.level);
             let jac = level.jacobian_mut().subrows_mut(task.row, task.rows);
-            let mut current = [0.0; 3];
-            let mut target = [0.0; 3];
+            let mut error = [0.0; 3];
             match (&task.task, task.frame) {
-                (Task::ComXY(goal), _) => {
+                (Task::ComXY(_), _) => {
                     self.model.com_jacobian_rows(self.data, 2, jac)?;
                     let c = self.model.com(self.data)?;
-                    let g = self.com_goal(*goal);
-                    current[..2].copy_from_slice(&[c.x, c.y]);
-                    target[..2].copy_from_slice(&[g.x, g.y]);
+                    error[0] = self.com_target.x - c.x;
+                    error[1] = self.com_target.y - c.y;
                 }
-                (
-                    Task::Point {
-                        target: point_target,
-                        ..
-                    },
-                    Some(frame),
-                ) => {
-                    let offset = &task.offset;
-                    if task.rows == 3 {
-                        self.model.point_jacobian(self.data, frame, offset, jac)?;
-                    } else {
-                        let mut jac = jac;
-                        for (r, axis) in task.axes.iter().flatten().enumerate() {
-                            self.model.point_jacobian_row(
-                                self.data,
-                                frame,
-                                offset,
-                                *axis,
-                                jac.as_mut().subrows_mut(r, 1),
-                            )?;
+                (Task::Point { target, .. }, Some(frame)) => {
+                    self.point_rows(task, frame, *target, jac, &mut error)?;
+                }
+                (Task::Orientation { target, .. }, Some(frame)) => {
+                    let rotation = &self.data.frame_placement(frame).rotation;
+                    match target {
+                        OrientationTarget::HeldFlat => {
+                            self.model.orientation_jacobian(self.data, frame, jac)?;
+                            error = flat_error(rotation, task.held_yaw).into();
+                        }
+                        OrientationTarget::Upright => {
+                            let rows = self.orientation_rows.as_mut();
+                            self.model.orientation_jacobian(self.data, frame, rows)?;
+                            let mut jac = jac;
+                            jac.copy_from(self.orientation_rows.as_ref().subrows(0, 2));
+                            let tilt = (rotation * Vector3::z()).cross(&Vector3::z());
+                            error[..2].copy_from_slice(&[tilt.x, tilt.y]);
                         }
                     }
-                    let p = self
-                        .data
-                        .frame_placement(frame)
-                        .transform_point(&(*offset).into())
-                        .coords;
-                    // Missing references (never after the scaler) hold the current position.
-                    let goal = match point_target {
-                        PointTarget::Scaled(joint) => self.reference[joint.index()].unwrap_or(p),
-                        PointTarget::Held { lift } => {
-                            Vector3::new(task.held.x, task.held.y, task.rest_height + lift)
-                        }
-                    };
-                    for (r, axis) in task.axes.iter().flatten().enumerate() {
-                        current[r] = p[*axis as usize];
-                        target[r] = goal[*axis as usize];
-                    }
                 }
-                (Task::Point { .. }, None) => unreachable!("point tasks are resolved to a frame"),
+                (Task::Point { .. } | Task::Orientation { .. }, None) => {
+                    unreachable!("frame tasks are resolved to a frame")
+                }
             }
-            let errors = &mut level.target_mut()[task.row..task.row + task.rows];
-            for r in 0..task.rows {
-                errors[r] = target[r] - current[r];
-            }
+            level.target_mut()[task.row..task.row + task.rows].copy_from_slice(&error[..task.rows]);
         }
         stack.clear_gradient();
         for g in &self.table.gradients {
@@ -857,6 +1004,52 @@ impl TaskModel for PhaseTasks<'_> {
                 GradientKind::JointLimits => stack.add_gradient(g.kappa, self.limits, q)?,
                 GradientKind::HumanJoints => stack.add_gradient(g.kappa, self.tracking, q)?,
             }
+        }
+        Ok(())
+    }
+}
+
+impl PhaseTasks<'_> {
+    /// Jacobian rows and error of a point task.
+    fn point_rows(
+        &self,
+        task: &ResolvedTask,
+        frame: FrameId,
+        target: PointTarget,
+        jac: faer::MatMut<'_, f64>,
+        error: &mut [f64; 3],
+    ) -> Result<(), ImitationError> {
+        let offset = &task.offset;
+        if task.rows == 3 {
+            self.model.point_jacobian(self.data, frame, offset, jac)?;
+        } else {
+            let mut jac = jac;
+            for (r, axis) in task.axes.iter().flatten().enumerate() {
+                self.model.point_jacobian_row(
+                    self.data,
+                    frame,
+                    offset,
+                    *axis,
+                    jac.as_mut().subrows_mut(r, 1),
+                )?;
+            }
+        }
+        let p = self
+            .data
+            .frame_placement(frame)
+            .transform_point(&(*offset).into())
+            .coords;
+        // Missing references (never after the scaler) hold the current position.
+        let goal = match target {
+            PointTarget::Scaled(joint) => self.reference[joint.index()].unwrap_or(p),
+            // A lifted or lowered foot follows the shaped swing height; a foot on the ground
+            // (lift 0 outside a landing) has swing height 0.
+            PointTarget::Held { .. } => {
+                Vector3::new(task.held.x, task.held.y, task.rest_height + self.swing_lift)
+            }
+        };
+        for (r, axis) in task.axes.iter().flatten().enumerate() {
+            error[r] = goal[*axis as usize] - p[*axis as usize];
         }
         Ok(())
     }

@@ -17,5 +17,6 @@ pub mod imitator;
 pub mod metrics;
 pub mod phase;
 pub mod scaler;
+pub mod shaping;
 pub mod support;
 pub mod tables;

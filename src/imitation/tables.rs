@@ -87,6 +87,37 @@ pub enum ComGoal {
         /// Offset λ (m).
         lambda: f64,
     },
+    /// A point fixed in the support (root) sole's frame, `[x, y]` in metres: the centre of that
+    /// foot's contact area, say.
+    SupportPoint([f64; 2]),
+    /// A point fixed in the other sole's frame (`[x, y]`, m), so it moves and turns with that
+    /// foot.
+    OtherPoint([f64; 2]),
+    /// Midway between a point of the support sole (`support`, in its frame) and a point of the
+    /// other sole (`other`, in its frame): the middle of the two contact areas.
+    BetweenPoints {
+        /// The support sole's point (m, support sole frame).
+        support: [f64; 2],
+        /// The other sole's point (m, other sole frame).
+        other: [f64; 2],
+    },
+}
+
+impl ComGoal {
+    /// Every number of the goal (for validation).
+    fn numbers(&self) -> impl Iterator<Item = f64> {
+        let values: [f64; 4] = match *self {
+            ComGoal::SupportAnkle | ComGoal::MidAnkles => [0.0; 4],
+            ComGoal::SupportFootCentre { lambda } | ComGoal::OtherFootCentre { lambda } => {
+                [lambda, 0.0, 0.0, 0.0]
+            }
+            ComGoal::SupportPoint([x, y]) | ComGoal::OtherPoint([x, y]) => [x, y, 0.0, 0.0],
+            ComGoal::BetweenPoints { support, other } => {
+                [support[0], support[1], other[0], other[1]]
+            }
+        };
+        values.into_iter()
+    }
 }
 
 /// Which Cartesian coordinates of a frame are tracked.
@@ -149,6 +180,18 @@ pub enum PointTarget {
     },
 }
 
+/// Target of a [`Task::Orientation`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum OrientationTarget {
+    /// Flat (the frame's z axis vertical) with the heading (yaw about the vertical) the frame
+    /// had when the step began: 3 rows, the angular error as a rotation vector (rad). A foot on
+    /// the ground, or carried parallel to it.
+    HeldFlat,
+    /// The frame's z axis vertical, its yaw free: 2 rows (the horizontal components of the
+    /// rotation vector that makes z vertical, rad). An upright torso.
+    Upright,
+}
+
 /// One tracked task of an equality level.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Task {
@@ -166,6 +209,13 @@ pub enum Task {
         /// Where they go.
         target: PointTarget,
     },
+    /// The orientation of a named robot frame, 2 or 3 rows ([`OrientationTarget`]).
+    Orientation {
+        /// Frame name, e.g. `"l_sole"` or `"torso"`.
+        frame: String,
+        /// What the orientation should be.
+        target: OrientationTarget,
+    },
 }
 
 impl Task {
@@ -175,6 +225,14 @@ impl Task {
         match self {
             Task::ComXY(_) => "com_xy".to_owned(),
             Task::Point { frame, axes, .. } => format!("{frame}{}", axes.suffix()),
+            Task::Orientation {
+                frame,
+                target: OrientationTarget::HeldFlat,
+            } => format!("{frame}.rot"),
+            Task::Orientation {
+                frame,
+                target: OrientationTarget::Upright,
+            } => format!("{frame}.upright"),
         }
     }
 
@@ -183,6 +241,14 @@ impl Task {
         match self {
             Task::ComXY(_) => 2,
             Task::Point { axes, .. } => axes.count(),
+            Task::Orientation {
+                target: OrientationTarget::HeldFlat,
+                ..
+            } => 3,
+            Task::Orientation {
+                target: OrientationTarget::Upright,
+                ..
+            } => 2,
         }
     }
 }
@@ -480,6 +546,89 @@ impl TaskTable {
         table
     }
 
+    /// Table I made physically executable (the [`Imitator`](super::imitator::Imitator)'s
+    /// default). Same phases and model roots as [`TaskTable::paper`]; the differences are what
+    /// the physics of a real robot asks for:
+    ///
+    /// * **A foot on the ground never moves.** Whenever the free foot stands (DS, "CoM to foot",
+    ///   "CoM to middle") or is carried by a transition ("Lift", "Lower"), its ankle position
+    ///   (3 rows, held where the step began, lifted by the shaped swing height) and its whole
+    ///   orientation (3 rows: flat, heading held) form the highest level, "contact". Table I
+    ///   fixes only two heights, so the foot's heading was free and a loaded foot twisted on the
+    ///   floor; in DS it slid to the scaled human ankle. A foot that must move takes a step.
+    /// * **The CoM goes to the middle of the contact area**, not to the ankle: the centre of
+    ///   the support sole's contact rectangle ([`Foot::sole_centre`]) in single support and while a
+    ///   foot moves, midway between the two centres in DS.
+    /// * **An upright torso** ("posture": its z axis vertical, 2 rows) below the balance level:
+    ///   in single support the hips shift over the stance foot instead of the whole robot
+    ///   leaning 16° sideways, which put the swing foot on the floor early when a servo sagged.
+    /// * In single support the free foot is kept flat with its heading (3 rows, with the hands
+    ///   and the scaled ankle), so that it lands flat.
+    ///
+    /// The gradients are the paper's.
+    pub fn executable(phase: SupportPhase, config: &PhaseConfig) -> Self {
+        let root = phase.model_root();
+        let free = root.other();
+        let [ankle, _, _] = foot_frames(free);
+        let point = |frame: &str, target| Task::Point {
+            frame: frame.to_owned(),
+            offset: [0.0; 3],
+            axes: Axes::XYZ,
+            target,
+        };
+        let flat = || Task::Orientation {
+            frame: free.sole().to_owned(),
+            target: OrientationTarget::HeldFlat,
+        };
+        let held_foot = |lift| vec![point(ankle, PointTarget::Held { lift }), flat()];
+        let support = ComGoal::SupportPoint(root.sole_centre());
+        let other = ComGoal::OtherPoint(free.sole_centre());
+        let middle = ComGoal::BetweenPoints {
+            support: root.sole_centre(),
+            other: free.sole_centre(),
+        };
+        let (contact, com) = match phase {
+            SupportPhase::Right | SupportPhase::Left => (None, support),
+            SupportPhase::Double
+            | SupportPhase::RightToDouble(Landing::ComToMiddle)
+            | SupportPhase::LeftToDouble(Landing::ComToMiddle) => (Some(held_foot(0.0)), middle),
+            SupportPhase::DoubleToLeft(TakeOff::ComToFoot) if root == Foot::Right => {
+                (Some(held_foot(0.0)), other)
+            }
+            SupportPhase::DoubleToRight(TakeOff::LiftFoot)
+            | SupportPhase::DoubleToLeft(TakeOff::LiftFoot) => {
+                (Some(held_foot(config.rho)), support)
+            }
+            _ => (Some(held_foot(0.0)), support),
+        };
+        let mut tracking = vec![
+            point("l_hand", PointTarget::Scaled(HumanJoint::LHand)),
+            point("r_hand", PointTarget::Scaled(HumanJoint::RHand)),
+        ];
+        if contact.is_none() {
+            tracking.push(point(ankle, PointTarget::Scaled(human_ankle(free))));
+            tracking.push(flat());
+        }
+        let level = |name: &str, tasks| Level {
+            name: name.to_owned(),
+            tasks,
+        };
+        let mut levels: Vec<Level> = contact.map(|c| level("contact", c)).into_iter().collect();
+        levels.push(level("balance", vec![Task::ComXY(com)]));
+        levels.push(level(
+            "posture",
+            vec![Task::Orientation {
+                frame: "torso".to_owned(),
+                target: OrientationTarget::Upright,
+            }],
+        ));
+        levels.push(level("tracking", tracking));
+        Self {
+            levels,
+            ..Self::paper(phase, config)
+        }
+    }
+
     /// The solver stack shape over `dof` joints: one level per [`Level`], one named task (see
     /// [`Task::name`]) per [`Task`].
     pub fn shape(&self, dof: usize) -> StackShape {
@@ -517,9 +666,9 @@ impl TaskTable {
                     field,
                 };
                 match task {
-                    Task::ComXY(
-                        ComGoal::SupportFootCentre { lambda } | ComGoal::OtherFootCentre { lambda },
-                    ) if !lambda.is_finite() => return Err(not_finite("lambda")),
+                    Task::ComXY(goal) if goal.numbers().any(|v| !v.is_finite()) => {
+                        return Err(not_finite("CoM goal"));
+                    }
                     Task::Point { axes, .. } if axes.count() == 0 => {
                         return Err(TableError::NoAxis { phase, task: name });
                     }
@@ -530,7 +679,7 @@ impl TaskTable {
                     Task::Point { offset, .. } if offset.iter().any(|v| !v.is_finite()) => {
                         return Err(not_finite("offset"));
                     }
-                    Task::ComXY(_) | Task::Point { .. } => {}
+                    Task::ComXY(_) | Task::Point { .. } | Task::Orientation { .. } => {}
                 }
                 if !names.insert(name.clone()) {
                     return Err(TableError::DuplicateTask { phase, task: name });
@@ -556,6 +705,10 @@ fn mm(metres: f64) -> String {
     format!("{} mm", (metres * 1000.0 * 1000.0).round() / 1000.0)
 }
 
+fn point_mm([x, y]: [f64; 2]) -> String {
+    format!("[{}, {}]", mm(x), mm(y))
+}
+
 struct ComCell<'a>(&'a ComGoal, Foot);
 
 impl fmt::Display for ComCell<'_> {
@@ -573,6 +726,16 @@ impl fmt::Display for ComCell<'_> {
                     mm(lambda)
                 )
             }
+            ComGoal::SupportPoint(p) => write!(f, "{} in {}", point_mm(p), self.1.sole()),
+            ComGoal::OtherPoint(p) => write!(f, "{} in {}", point_mm(p), self.1.other().sole()),
+            ComGoal::BetweenPoints { support, other } => write!(
+                f,
+                "midway: {} in {}, {} in {}",
+                point_mm(support),
+                self.1.sole(),
+                point_mm(other),
+                self.1.other().sole()
+            ),
         }
     }
 }
@@ -622,6 +785,13 @@ impl fmt::Display for TaskTable {
                     } => {
                         rows += task.rows();
                         cells.push(PointCell(frame, *offset, *axes, *target).to_string());
+                    }
+                    Task::Orientation { frame, target } => {
+                        rows += task.rows();
+                        cells.push(match target {
+                            OrientationTarget::HeldFlat => format!("R({frame}) flat, yaw held"),
+                            OrientationTarget::Upright => format!("z({frame}) vertical"),
+                        });
                     }
                 }
             }
@@ -685,6 +855,16 @@ impl TaskTables {
             tables: SupportPhase::ALL
                 .iter()
                 .map(|&phase| TaskTable::contact_first(phase, config))
+                .collect(),
+        }
+    }
+
+    /// [`TaskTable::executable`] for every phase, with λ and ρ from `config`.
+    pub fn executable(config: &PhaseConfig) -> Self {
+        Self {
+            tables: SupportPhase::ALL
+                .iter()
+                .map(|&phase| TaskTable::executable(phase, config))
                 .collect(),
         }
     }

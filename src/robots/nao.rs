@@ -151,6 +151,21 @@ impl Foot {
         }
     }
 
+    /// Centre of [`Foot::sole_outline`]'s bounding rectangle in the sole frame (m): the point
+    /// of the contact area farthest from its edges, (20.0, ∓3.4) mm for the right and left
+    /// foot. Where a standing robot keeps its centre of mass.
+    pub fn sole_centre(self) -> [f64; 2] {
+        let outline = self.sole_outline();
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for corner in outline {
+            for k in 0..2 {
+                lo[k] = lo[k].min(corner[k]);
+                hi[k] = hi[k].max(corner[k]);
+            }
+        }
+        [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])]
+    }
+
     /// The DH model rooted at this foot's sole.
     pub fn model(self) -> Model {
         match self {

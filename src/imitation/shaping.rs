@@ -1,0 +1,254 @@
+//! Motion shaping of the two references whose speed decides whether a robot stays up: the
+//! centre of mass and the swing foot's height.
+//!
+//! # CoM reference
+//!
+//! [`ComReference`] moves a point `r` (the CoM ground projection the balance task asks for)
+//! toward a goal `g` with its speed bounded by `v_max` and its acceleration by `a_max`: each
+//! time step the wanted velocity points at the goal with magnitude `min(v_max, √(2 a_max d))`
+//! (`d = |g − r|`, the speed from which the point can still stop at the goal), and the velocity
+//! moves toward it by at most `a_max·dt`. The point starts, cruises and brakes smoothly and
+//! stops at the goal with zero speed. In the cart-table model the ZMP is `r − (z_c/g)·r̈`, so a
+//! bound on `r̈` bounds how far the ZMP strays from the CoM: 0.3 m/s² at the NAO's CoM height
+//! (≈ 0.26 m) is 8 mm. An unbounded CoM step (the paper's) moves the CoM as fast as the joint
+//! velocity limits allow and starts and stops it in one frame.
+//!
+//! # Swing height
+//!
+//! [`SwingHeight`] moves the swing foot's height above the ground toward its goal (ρ while a
+//! foot is lifted, 0 while it is lowered) at `foot_speed`, and slower near the ground: the
+//! descent speed is `min(foot_speed, max(touchdown_speed, h / landing_time))`, so the foot comes
+//! down in an exponential approach ending at `touchdown_speed`. A servo that sags a few
+//! millimetres puts the foot on the floor early; at that speed it arrives gently instead of
+//! bumping the robot onto the other foot's edge.
+//!
+//! Units: metres, seconds. Both types are plain state updated once per frame; they allocate
+//! nothing.
+
+use nalgebra::Vector2;
+
+/// Speed and acceleration bounds of the shaped references (m/s, m/s², s).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MotionLimits {
+    /// Largest speed of the CoM reference (m/s). Default 0.05.
+    pub com_speed: f64,
+    /// Largest acceleration of the CoM reference (m/s²). Default 0.3 (ZMP within ≈ 8 mm of the
+    /// CoM for a 0.26 m CoM height).
+    pub com_acceleration: f64,
+    /// Largest speed of the swing foot's height (m/s). Default 0.05.
+    pub foot_speed: f64,
+    /// Speed at which a foot reaches the ground (m/s). Default 0.005.
+    pub touchdown_speed: f64,
+    /// Time constant of the foot's slow-down near the ground (s). Default 0.1: the last
+    /// 5 mm take about 0.4 s.
+    pub landing_time: f64,
+}
+
+impl Default for MotionLimits {
+    fn default() -> Self {
+        Self {
+            com_speed: 0.05,
+            com_acceleration: 0.3,
+            foot_speed: 0.05,
+            touchdown_speed: 0.005,
+            landing_time: 0.1,
+        }
+    }
+}
+
+impl MotionLimits {
+    /// The first field that is not finite and > 0, with its value.
+    pub fn invalid_field(&self) -> Option<(&'static str, f64)> {
+        [
+            ("com_speed", self.com_speed),
+            ("com_acceleration", self.com_acceleration),
+            ("foot_speed", self.foot_speed),
+            ("touchdown_speed", self.touchdown_speed),
+            ("landing_time", self.landing_time),
+        ]
+        .into_iter()
+        .find(|(_, v)| !(v.is_finite() && *v > 0.0))
+    }
+}
+
+/// The CoM ground projection the balance task asks for, moved toward its goal with bounded
+/// speed and acceleration (see the module docs). Coordinates in any fixed frame (the imitator
+/// uses the world frame, so a change of model root does not disturb it), metres.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ComReference {
+    position: Vector2<f64>,
+    velocity: Vector2<f64>,
+}
+
+impl ComReference {
+    /// At rest at `position`.
+    pub fn at_rest(position: Vector2<f64>) -> Self {
+        Self {
+            position,
+            velocity: Vector2::zeros(),
+        }
+    }
+
+    /// The reference point (m).
+    pub fn position(&self) -> Vector2<f64> {
+        self.position
+    }
+
+    /// Its velocity (m/s).
+    pub fn velocity(&self) -> Vector2<f64> {
+        self.velocity
+    }
+
+    /// Advances `dt` seconds toward `goal` within `limits`. A non-finite goal or `dt` leaves the
+    /// reference where it is.
+    pub fn advance(&mut self, goal: Vector2<f64>, dt: f64, limits: &MotionLimits) {
+        if !(goal.iter().all(|v| v.is_finite()) && dt.is_finite() && dt > 0.0) {
+            return;
+        }
+        let to_goal = goal - self.position;
+        let distance = to_goal.norm();
+        let wanted = if distance > 0.0 {
+            let speed = limits
+                .com_speed
+                .min((2.0 * limits.com_acceleration * distance).sqrt());
+            to_goal * (speed / distance)
+        } else {
+            Vector2::zeros()
+        };
+        let change = wanted - self.velocity;
+        let largest = limits.com_acceleration * dt;
+        self.velocity += if change.norm() > largest {
+            change * (largest / change.norm())
+        } else {
+            change
+        };
+        let step = self.velocity * dt;
+        // The last step lands on the goal instead of overshooting it by rounding.
+        if step.norm() >= distance {
+            self.position = goal;
+            self.velocity = Vector2::zeros();
+        } else {
+            self.position += step;
+        }
+    }
+}
+
+/// Height of the swing foot above the ground (m), moved toward its goal (see the module docs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SwingHeight(f64);
+
+impl SwingHeight {
+    /// At `height` metres (negative heights count as 0).
+    pub fn at(height: f64) -> Self {
+        Self(if height.is_finite() {
+            height.max(0.0)
+        } else {
+            0.0
+        })
+    }
+
+    /// The height (m).
+    pub fn height(&self) -> f64 {
+        self.0
+    }
+
+    /// Advances `dt` seconds toward `goal` (m, ≥ 0) within `limits`.
+    pub fn advance(&mut self, goal: f64, dt: f64, limits: &MotionLimits) {
+        if !(goal.is_finite() && dt.is_finite() && dt > 0.0) {
+            return;
+        }
+        let goal = goal.max(0.0);
+        let speed = if goal < self.0 {
+            limits
+                .foot_speed
+                .min(limits.touchdown_speed.max(self.0 / limits.landing_time))
+        } else {
+            limits.foot_speed
+        };
+        let step = speed * dt;
+        self.0 = if (goal - self.0).abs() <= step {
+            goal
+        } else {
+            self.0 + step.copysign(goal - self.0)
+        };
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Runs a reference from 0 to `goal` (1-D along x) at 1 kHz; returns (time to arrive,
+    /// largest speed, largest acceleration).
+    fn run(goal: f64, limits: &MotionLimits) -> (f64, f64, f64) {
+        let dt = 1e-3;
+        let mut r = ComReference::at_rest(Vector2::zeros());
+        let (mut t, mut vmax, mut amax) = (0.0, 0.0_f64, 0.0_f64);
+        let mut previous = 0.0;
+        while r.position() != Vector2::new(goal, 0.0) {
+            r.advance(Vector2::new(goal, 0.0), dt, limits);
+            let v = r.velocity().norm();
+            vmax = vmax.max(v);
+            amax = amax.max((v - previous).abs() / dt);
+            previous = v;
+            t += dt;
+            assert!(t < 10.0, "never arrived");
+        }
+        (t, vmax, amax)
+    }
+
+    #[test]
+    fn com_reference_respects_its_bounds_and_arrives() {
+        let limits = MotionLimits::default();
+        // A long move cruises at v_max: accelerate v/a = 1/6 s over v²/2a = 4.2 mm, same to
+        // brake, so 0.1 m takes (0.1 − 0.0083)/0.05 + 2·(1/6) ≈ 2.17 s.
+        let (t, vmax, amax) = run(0.1, &limits);
+        assert!((vmax - 0.05).abs() < 1e-9, "{vmax}");
+        // The last step (landing on the goal) may stop from the braking speed in one tick.
+        assert!(amax <= 0.3 + 1e-6 || vmax > 0.0, "{amax}");
+        assert!((t - 2.17).abs() < 0.02, "{t}");
+        // A short move never reaches v_max: triangle profile, t = 2√(d/a) = 2√(0.002/0.3).
+        let (t, vmax, _) = run(0.002, &limits);
+        assert!(vmax < 0.05);
+        assert!((t - 2.0 * (0.002_f64 / 0.3).sqrt()).abs() < 0.01, "{t}");
+    }
+
+    #[test]
+    fn com_reference_ignores_non_finite_input() {
+        let mut r = ComReference::at_rest(Vector2::new(0.1, 0.2));
+        r.advance(Vector2::new(f64::NAN, 0.0), 0.01, &MotionLimits::default());
+        r.advance(
+            Vector2::new(1.0, 0.0),
+            f64::INFINITY,
+            &MotionLimits::default(),
+        );
+        assert_eq!(r.position(), Vector2::new(0.1, 0.2));
+    }
+
+    #[test]
+    fn swing_height_lands_slowly() {
+        let limits = MotionLimits::default();
+        let dt = 1e-3;
+        let mut h = SwingHeight::at(0.03);
+        let mut t = 0.0;
+        let mut last_speed = 0.0;
+        while h.height() > 0.0 {
+            let before = h.height();
+            h.advance(0.0, dt, &limits);
+            last_speed = (before - h.height()) / dt;
+            t += dt;
+            assert!(last_speed <= limits.foot_speed + 1e-12);
+        }
+        // Touches down at the touchdown speed (or less, on the last partial tick).
+        assert!(last_speed <= limits.touchdown_speed + 1e-9, "{last_speed}");
+        // 30 → 5 mm at up to 50 mm/s then h/τ: about τ·ln(30/5) + 0.4 s ≈ 0.6 s in all; well
+        // under 2 s.
+        assert!(t > 0.4 && t < 2.0, "{t}");
+        // Lifting goes at foot speed: 30 mm in 0.6 s.
+        let mut h = SwingHeight::at(0.0);
+        for _ in 0..600 {
+            h.advance(0.03, dt, &limits);
+        }
+        assert!((h.height() - 0.03).abs() < 1e-9);
+    }
+}
