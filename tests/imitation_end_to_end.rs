@@ -12,6 +12,7 @@ use taskstack::imitation::human::HumanFrame;
 use taskstack::imitation::imitator::{FootRootedModels, Imitator, ImitatorConfig};
 use taskstack::imitation::metrics::{ImitationMetrics, MetricsRecorder};
 use taskstack::imitation::phase::SupportPhase;
+use taskstack::imitation::shaping::MotionLimits;
 use taskstack::io::clip::Clip;
 
 const SETTLE_SECONDS: f64 = 5.0;
@@ -23,10 +24,22 @@ fn clip_path(name: &str) -> String {
 /// Runs a clip (plus the settling hold) and checks the per-frame invariants; returns the metrics
 /// and the robot phase of every frame.
 fn run(name: &str) -> (ImitationMetrics, Vec<SupportPhase>) {
-    run_with(name, ImitatorConfig::default())
+    run_with(name, ImitatorConfig::default(), HELD_FOOT_TOLERANCE)
 }
 
-fn run_with(name: &str, config: ImitatorConfig) -> (ImitationMetrics, Vec<SupportPhase>) {
+/// How far (m, rad) a standing foot may move in the plan. The support foot (the model root) is
+/// still by construction; the other standing foot is held by the IK's top level, one
+/// Gauss–Newton step per frame, so it is off by that step's second-order term: about
+/// `L·Δq²` with `L` ≈ 0.2 m and `Δq` ≈ 3.5 mrad (10 % of a leg joint's rated speed over
+/// 1/120 s), 2.5 µm, corrected at the next frame. A foot that has been held and becomes the
+/// support carries that offset.
+const HELD_FOOT_TOLERANCE: f64 = 2e-6;
+
+fn run_with(
+    name: &str,
+    config: ImitatorConfig,
+    slip_tolerance: f64,
+) -> (ImitationMetrics, Vec<SupportPhase>) {
     let mut clip = Clip::open(clip_path(name)).unwrap();
     let config = ImitatorConfig {
         support: clip.support_config(),
@@ -83,16 +96,14 @@ fn run_with(name: &str, config: ImitatorConfig) -> (ImitationMetrics, Vec<Suppor
         "{name}: CoM margin {}",
         m.min_com_margin
     );
-    assert!(
-        m.max_support_slip <= 1e-9,
-        "{name}: support foot slip {} m",
-        m.max_support_slip
-    );
-    assert!(
-        m.max_support_turn <= 1e-9,
-        "{name}: support foot turn {} rad",
-        m.max_support_turn
-    );
+    for (what, value) in [
+        ("support foot slip (m)", m.max_support_slip),
+        ("support foot turn (rad)", m.max_support_turn),
+        ("held foot slip (m)", m.max_held_foot_slip),
+        ("held foot turn (rad)", m.max_held_foot_turn),
+    ] {
+        assert!(value <= slip_tolerance, "{name}: {what} {value}");
+    }
     (m, phases)
 }
 
@@ -158,20 +169,34 @@ fn other_clips_keep_the_invariants() {
     }
 }
 
-/// At the full rated joint speeds (two IK steps per frame, tasks up to 1 m/s) a walk makes about
-/// fifty support changes; landings end flat, so no tilt of the world builds up over them, and
-/// the invariants still hold on every frame.
+/// At the full rated joint speeds (two IK steps per frame, tasks up to 1 m/s, the CoM and the
+/// swing foot shaped twice as fast as by default) the robot takes several steps of a 21 s walk;
+/// landings end flat, so no tilt of the world builds up over them, and the invariants still
+/// hold on every frame.
 #[test]
 fn a_walk_at_full_speed_keeps_the_invariants() {
     let config = ImitatorConfig {
         velocity_fraction: 1.0,
+        upper_body_velocity_fraction: None,
         max_task_speed: 1.0,
         iterations_per_frame: 2,
+        motion: MotionLimits {
+            com_speed: 0.1,
+            com_acceleration: 0.6,
+            foot_speed: 0.1,
+            ..MotionLimits::default()
+        },
         ..ImitatorConfig::default()
     };
-    let (m, _) = run_with("cmu_09_12_walk_forward_backward_sideways.bvh", config);
+    // Steps five times larger than by default: the held foot's second-order error grows with
+    // their square.
+    let (m, _) = run_with(
+        "cmu_09_12_walk_forward_backward_sideways.bvh",
+        config,
+        25.0 * HELD_FOOT_TOLERANCE,
+    );
     assert!(
-        m.robot_support_changes >= 20,
+        m.robot_support_changes >= 6,
         "{:?}",
         m.robot_support_sequence
     );

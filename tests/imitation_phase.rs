@@ -215,6 +215,13 @@ fn bad_config_is_rejected_naming_the_field() {
             },
             "foot_height_tolerance",
         ),
+        (
+            PhaseConfig {
+                support_margin: f64::INFINITY,
+                ..PhaseConfig::default()
+            },
+            "support_margin",
+        ),
         // ρ = 4 mm ≤ 2 × 2 mm: a foot could be "lifted" and "on the ground" at once.
         (
             PhaseConfig {

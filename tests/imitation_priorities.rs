@@ -1,4 +1,5 @@
-//! Priority preservation on the real imitation stacks: for every phase's task table on the NAO,
+//! Priority preservation on the real imitation stacks: for every phase's task table on the NAO
+//! (the executable tables the imitator uses and the contact-first variant of Table I),
 //! at random configurations within the limits and random task velocities, the residual of each
 //! level is the same (to 1e-9 relative) whether or not the levels below it and the gradient tasks
 //! are present. Jacobians come from the DH NAO rooted at the table's sole.
@@ -68,6 +69,14 @@ fn filled(
                             .unwrap();
                     }
                 }
+                Task::Orientation { frame, .. } => {
+                    // Held-flat tasks use all three angular-velocity rows, upright ones the
+                    // first two.
+                    let id = model.frame_id(frame).unwrap();
+                    let mut all = faer::Mat::zeros(3, model.nv());
+                    model.orientation_jacobian(&data, id, all.as_mut()).unwrap();
+                    jac.copy_from(all.as_ref().subrows(0, rows));
+                }
             }
             row += rows;
         }
@@ -98,11 +107,17 @@ proptest! {
     #[test]
     fn levels_are_not_disturbed_by_lower_levels_or_gradients(
         phase in 0usize..SupportPhase::COUNT,
+        executable in any::<bool>(),
         unit in prop::collection::vec(0.0f64..1.0, 23),
-        targets in prop::collection::vec(-0.2f64..0.2, 16),
+        targets in prop::collection::vec(-0.2f64..0.2, 20),
         gradient in prop::collection::vec(-1.0f64..1.0, 23),
     ) {
-        let tables = TaskTables::contact_first(&PhaseConfig::default());
+        let config = PhaseConfig::default();
+        let tables = if executable {
+            TaskTables::executable(&config)
+        } else {
+            TaskTables::contact_first(&config)
+        };
         let table = tables.table(SupportPhase::ALL[phase]);
         let model = model(table.model_root);
         let q: Vec<f64> = model.variables().iter().zip(&unit).map(|(v, u)| v.lower + u * (v.upper - v.lower)).collect();

@@ -238,3 +238,18 @@ fn hip_yaw_pitch_is_one_variable_driving_both_legs() {
     assert_eq!(driven.len(), 2, "{driven:?}");
     assert!(model.variable_index("RHipYawPitch").is_err());
 }
+
+/// The stance point by hand: the left FSR rectangle spans x −30.25 … 70.25 mm and y −23.1 …
+/// 29.9 mm, so its centre is (20.0, 3.4) mm; 15 mm from the inner edge (y = −23.1 mm) is
+/// y = −8.1 mm; a margin past the centre gives the centre. The right foot is the mirror image.
+#[test]
+fn stance_point_keeps_the_margin_from_the_inner_edge() {
+    let close =
+        |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).abs() < 1e-12 && (a[1] - b[1]).abs() < 1e-12;
+    assert!(close(Foot::Left.sole_centre(), [0.020, 0.0034]));
+    assert!(close(Foot::Right.sole_centre(), [0.020, -0.0034]));
+    assert!(close(Foot::Left.stance_point(0.015), [0.020, -0.0081]));
+    assert!(close(Foot::Right.stance_point(0.015), [0.020, 0.0081]));
+    assert!(close(Foot::Left.stance_point(0.04), [0.020, 0.0034]));
+    assert!(close(Foot::Right.stance_point(0.04), [0.020, -0.0034]));
+}

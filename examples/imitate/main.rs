@@ -111,6 +111,9 @@ fn run(
         } else {
             // The clip is over: the human holds the last pose while the robot finishes.
             let Some(held) = last.as_mut() else { break };
+            if end.is_infinite() {
+                recorder.mark_clip_end();
+            }
             end = end.min(held.time + hold);
             held.time += 1.0 / 120.0;
             if held.time > end {
@@ -190,7 +193,7 @@ fn run(
 
 fn print_summary(m: &ImitationMetrics, clip: &Path, out: &Path) {
     println!(
-        "clip {}: {} frames, {:.2} s",
+        "clip {}: {} frames, {:.2} s (clip and hold; tracking below over the clip's frames)",
         clip.display(),
         m.frames,
         m.duration
@@ -206,7 +209,7 @@ fn print_summary(m: &ImitationMetrics, clip: &Path, out: &Path) {
         "transitions: {} (min {:.2} s, median {:.2} s, max {:.2} s)",
         t.count, t.min, t.median, t.max
     );
-    for e in &m.effectors {
+    for e in &m.effectors_clip {
         println!(
             "tracking {:8}: single support mean {:.4} m max {:.4} m ({} frames); double support mean {:.4} m max {:.4} m ({} frames)",
             e.name,
@@ -225,9 +228,27 @@ fn print_summary(m: &ImitationMetrics, clip: &Path, out: &Path) {
         m.joint_limit_violations,
         m.velocity_limit_violations
     );
+    for e in &m.hands_clip_lag_removed {
+        println!(
+            "tracking {:8} with the lag of {:.2} s removed: single support mean {:.4} m; double support mean {:.4} m",
+            e.name, m.hand_lag_s, e.single_support.mean, e.double_support.mean
+        );
+    }
     println!(
-        "support foot slip: {:.2e} m, {:.2e} rad",
-        m.max_support_slip, m.max_support_turn
+        "standing feet: support foot slip {:.2e} m, {:.2e} rad; other foot slip {:.2e} m, {:.2e} rad",
+        m.max_support_slip, m.max_support_turn, m.max_held_foot_slip, m.max_held_foot_turn
+    );
+    let t = &m.travel;
+    println!(
+        "travel: scaled human {:.3} m, robot {:.3} m, heading error {:.3} rad; steps: human {}, robot {}, queued at the end {}; catch-up after the clip: {}",
+        t.scaled_human_m,
+        t.robot_m,
+        t.heading_error_rad,
+        m.human_steps,
+        m.robot_steps,
+        m.queued_steps_at_end,
+        m.catch_up_s
+            .map_or("never".to_owned(), |s| format!("{s:.2} s"))
     );
     let s = &m.solve_time_us;
     println!(

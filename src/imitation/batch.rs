@@ -27,7 +27,7 @@ use thiserror::Error;
 
 use super::human::HumanFrame;
 use super::imitator::{FootRootedModels, ImitationError, Imitator, ImitatorConfig};
-use super::metrics::{ImitationMetrics, MeanMax, MetricsRecorder, Spread};
+use super::metrics::{EffectorError, ImitationMetrics, MeanMax, MetricsRecorder, Spread};
 use crate::io::clip::{Clip, ClipError};
 use crate::model::ModelError;
 
@@ -370,17 +370,19 @@ pub fn retarget_clip(
 pub fn metrics_json(m: &ImitationMetrics, clip: &Path) -> String {
     let mean_max = |m: &MeanMax| json!({ "mean": m.mean, "max": m.max, "frames": m.count });
     let spread = |s: &Spread| json!({ "min": s.min, "median": s.median, "p99": s.p99, "max": s.max, "count": s.count });
-    let effectors: serde_json::Map<String, Value> = m
-        .effectors
-        .iter()
-        .map(|e| {
-            let value = json!({
-                "single_support_m": mean_max(&e.single_support),
-                "double_support_m": mean_max(&e.double_support),
-            });
-            (e.name.to_string(), value)
-        })
-        .collect();
+    let effector_map = |effectors: &[EffectorError]| -> serde_json::Map<String, Value> {
+        effectors
+            .iter()
+            .map(|e| {
+                let value = json!({
+                    "single_support_m": mean_max(&e.single_support),
+                    "double_support_m": mean_max(&e.double_support),
+                });
+                (e.name.to_string(), value)
+            })
+            .collect()
+    };
+    let effectors = effector_map(&m.effectors);
     let value = json!({
         "clip": clip.file_name().map(|f| f.to_string_lossy().into_owned()),
         "frames": m.frames,
@@ -396,7 +398,23 @@ pub fn metrics_json(m: &ImitationMetrics, clip: &Path) -> String {
         "velocity_limit_violations": m.velocity_limit_violations,
         "max_support_foot_slip_m": m.max_support_slip,
         "max_support_foot_turn_rad": m.max_support_turn,
+        "max_held_foot_slip_m": m.max_held_foot_slip,
+        "max_held_foot_turn_rad": m.max_held_foot_turn,
         "solve_time_us": spread(&m.solve_time_us),
+        "tracking_error_clip": effector_map(&m.effectors_clip),
+        "tracking_error_clip_lag_removed": effector_map(&m.hands_clip_lag_removed),
+        "hand_lag_s": m.hand_lag_s,
+        "travel": {
+            "scaled_human_m": m.travel.scaled_human_m,
+            "robot_m": m.travel.robot_m,
+            "heading_error_rad": m.travel.heading_error_rad,
+        },
+        "steps": {
+            "human": m.human_steps,
+            "robot": m.robot_steps,
+            "queued_at_end": m.queued_steps_at_end,
+        },
+        "catch_up_s": m.catch_up_s,
     });
     // A `Value` built by `json!` always serialises.
     serde_json::to_string_pretty(&value).unwrap_or_default() + "\n"

@@ -233,6 +233,12 @@ pub struct RobotFrame {
     pub world_t_root: IsometryMatrix3<f64>,
     /// Wall time of the step (µs): detection, scaling, IK.
     pub micros: f64,
+    /// Where the human stands: the midpoint of the ankles on the ground plane (human world
+    /// frame, m) and the heading of the hips (rad about z, 0 facing +x); `None` when the frame
+    /// lacks the ankles or hips. Not scaled: see `leg_ratio`.
+    pub human_stance: Option<(Vector2<f64>, f64)>,
+    /// Robot leg length / human leg length, the scale from the human's world to the robot's.
+    pub leg_ratio: f64,
 }
 
 /// A task of a table, resolved against a model: frame id, axes, where its rows are.
@@ -248,6 +254,8 @@ struct ResolvedTask {
     row: usize,
     /// Height of the frame above the ground when its foot is flat (q = 0), m.
     rest_height: f64,
+    /// Position of the point in the initial posture, root frame (m).
+    standing: Vector3<f64>,
     /// Held target (frame position when the step began), m, root frame.
     held: Vector3<f64>,
     /// Held heading (yaw of the frame's x axis when the step began), rad, root frame.
@@ -283,6 +291,9 @@ pub struct Imitator {
     limits: JointLimitAvoidance,
     tracking: JointTracking,
     human_q: Vec<f64>,
+    /// The standing posture of each leg joint (`None` off the legs): the joint-tracking
+    /// reference of the legs.
+    stance: Vec<Option<f64>>,
     q: Vec<f64>,
     root: Foot,
     world_t_root: IsometryMatrix3<f64>,
@@ -325,12 +336,15 @@ impl PhaseSolver {
     fn new(
         table: &TaskTable,
         models: &FootRootedModels,
+        initial_q: &[f64],
         settings: Settings,
     ) -> Result<Self, ImitationError> {
         table.validate()?;
         let model = models.rooted_at(table.model_root);
         let mut rest = model.new_data();
         model.forward_kinematics(&mut rest, &vec![0.0; model.nv()])?;
+        let mut initial = model.new_data();
+        model.forward_kinematics(&mut initial, initial_q)?;
         let mut tasks = Vec::new();
         for (level, l) in table.levels.iter().enumerate() {
             let mut row = 0;
@@ -344,9 +358,12 @@ impl PhaseSolver {
                         (Some(model.frame_id(frame)?), Vector3::zeros())
                     }
                 };
-                let rest_height = match frame {
-                    Some(f) => model.point_position(&rest, f, &offset)?.z,
-                    None => 0.0,
+                let (rest_height, standing) = match frame {
+                    Some(f) => (
+                        model.point_position(&rest, f, &offset)?.z,
+                        model.point_position(&initial, f, &offset)?,
+                    ),
+                    None => (0.0, Vector3::zeros()),
                 };
                 tasks.push(ResolvedTask {
                     axes: axes_of(task),
@@ -357,6 +374,7 @@ impl PhaseSolver {
                     level,
                     row,
                     rest_height,
+                    standing,
                     held: Vector3::zeros(),
                     held_yaw: 0.0,
                 });
@@ -467,11 +485,13 @@ impl Imitator {
             })
             .collect();
         let bounds = JointBounds::with_velocity(&lower, &upper, &velocity)?;
-        // The legs' posture follows from the feet, the CoM and the torso; the human's leg angles
-        // would only drive the closed chain of double support against itself.
-        let tracking_weight: Vec<f64> = legs
+        // The legs are pulled toward the standing posture, not the human's leg angles: those
+        // would only drive the closed chain of double support against itself, and with no pull
+        // at all the free height of the pelvis drifts until the knees are straight (singular).
+        let stance: Vec<Option<f64>> = legs
             .iter()
-            .map(|&leg| if leg { 0.0 } else { 1.0 })
+            .zip(&q)
+            .map(|(&leg, &v)| leg.then_some(v))
             .collect();
         let phases = SupportPhase::ALL
             .iter()
@@ -480,7 +500,7 @@ impl Imitator {
                     scale_to_fit: true,
                     ..config.solver
                 };
-                PhaseSolver::new(config.tables.table(phase), &models, settings)
+                PhaseSolver::new(config.tables.table(phase), &models, &q, settings)
             })
             .collect::<Result<Vec<_>, _>>()?;
         let max_tasks = phases.iter().map(|p| p.tasks.len()).max().unwrap_or(0);
@@ -520,6 +540,8 @@ impl Imitator {
             reference: [None; HumanJoint::COUNT],
             world_t_root: IsometryMatrix3::identity(),
             micros: 0.0,
+            human_stance: None,
+            leg_ratio: 1.0,
         };
         Ok(Self {
             detector: SupportDetector::new(config.support)?,
@@ -527,7 +549,8 @@ impl Imitator {
             angles,
             machine: PhaseMachine::new(config.phase)?,
             limits: JointLimitAvoidance::new(&position_bounds),
-            tracking: JointTracking::weighted(&q, &tracking_weight)?,
+            tracking: JointTracking::new(&q)?,
+            stance,
             human_q: q.clone(),
             bounds,
             velocity_fraction: fraction,
@@ -599,6 +622,12 @@ impl Imitator {
         &self.bounds
     }
 
+    /// Human steps the robot has committed to and not reached yet (0 or 1: the robot takes one
+    /// step at a time).
+    pub fn pending_steps(&self) -> usize {
+        usize::from(self.commitment.pending.is_some())
+    }
+
     /// The velocity fraction in use.
     pub fn velocity_fraction(&self) -> f64 {
         self.velocity_fraction
@@ -632,6 +661,11 @@ impl Imitator {
 
         let scaled = *self.scaler.scale(frame, human)?;
         self.angles.compute(&scaled, &mut self.human_q)?;
+        for (human, stance) in self.human_q.iter_mut().zip(&self.stance) {
+            if let Some(stance) = stance {
+                *human = *stance;
+            }
+        }
         self.tracking.set_reference(&self.human_q)?;
         // The scaler's output frame is the sole of its stance; the model's is the root sole.
         let root_t_base = if scaled.base() == side_of(self.root) {
@@ -731,6 +765,8 @@ impl Imitator {
         out.time = frame.time;
         out.q.copy_from_slice(&self.q);
         out.human_support = human;
+        out.human_stance = human_stance(frame);
+        out.leg_ratio = self.scaler.leg_ratio();
         out.phase = phase;
         out.root = self.root;
         out.world_t_root = world_t_root;
@@ -888,6 +924,16 @@ fn sole_chain_variables(models: &FootRootedModels, q: &[f64]) -> Result<Vec<bool
         .collect())
 }
 
+/// The human's mid-ankle ground point (xy, m) and hip heading (rad) in `frame`.
+fn human_stance(frame: &HumanFrame) -> Option<(Vector2<f64>, f64)> {
+    let (l, r) = (
+        frame.get(HumanJoint::LAnkle)?,
+        frame.get(HumanJoint::RAnkle)?,
+    );
+    let left = frame.get(HumanJoint::LHip)? - frame.get(HumanJoint::RHip)?;
+    Some(((l + r).xy() * 0.5, (-left.x).atan2(left.y)))
+}
+
 fn side_of(foot: Foot) -> Side {
     match foot {
         Foot::Right => Side::Right,
@@ -982,12 +1028,14 @@ impl TaskModel for PhaseTasks<'_> {
                             self.model.orientation_jacobian(self.data, frame, jac)?;
                             error = flat_error(rotation, task.held_yaw).into();
                         }
-                        OrientationTarget::Upright => {
+                        OrientationTarget::Upright { lean } => {
                             let rows = self.orientation_rows.as_mut();
                             self.model.orientation_jacobian(self.data, frame, rows)?;
                             let mut jac = jac;
                             jac.copy_from(self.orientation_rows.as_ref().subrows(0, 2));
-                            let tilt = (rotation * Vector3::z()).cross(&Vector3::z());
+                            // z rotated by `lean` about x leans toward +y for lean > 0.
+                            let up = Vector3::new(0.0, lean.sin(), lean.cos());
+                            let tilt = (rotation * Vector3::z()).cross(&up);
                             error[..2].copy_from_slice(&[tilt.x, tilt.y]);
                         }
                     }
@@ -1047,6 +1095,7 @@ impl PhaseTasks<'_> {
             PointTarget::Held { .. } => {
                 Vector3::new(task.held.x, task.held.y, task.rest_height + self.swing_lift)
             }
+            PointTarget::Standing { lower } => task.standing - Vector3::z() * lower,
         };
         for (r, axis) in task.axes.iter().flatten().enumerate() {
             error[r] = goal[*axis as usize] - p[*axis as usize];

@@ -8,9 +8,13 @@
 //!   outline points are within [`CONTACT_HEIGHT`] of the floor.
 //! * **Executability**: joint-limit violations, and velocity-limit violations
 //!   (`|Δq|/Δt > fraction · v_max`), counted per joint and frame.
-//! * **Foot slip**: how far the support foot (the model root) moved in the world between two
-//!   frames in which it was on the ground, model switches included (m, and rad for its
-//!   orientation).
+//! * **Foot slip**: how far a standing foot moved in the world from where it stood at the start
+//!   of its stance, model switches included (m, and rad for its orientation). A foot stands
+//!   when it is the model root or when the phase keeps it on the ground (both feet in DS and in
+//!   the CoM steps of the transitions).
+//! * **Locomotion and timing** ([`super::travel`]): travel of the scaled human and of the robot,
+//!   steps of both, catch-up time after the clip, the hands' lag; tracking errors over the clip's
+//!   own frames apart from the hold that follows it ([`MetricsRecorder::mark_clip_end`]).
 //! * **Support changes and transitions**: changes of the human's support and of the robot's
 //!   continuous phase (DS, RS, LS); the time from leaving one continuous phase to reaching the
 //!   next (s). **Solve time** per frame (µs).
@@ -21,6 +25,7 @@ use super::human::HumanJoint;
 use super::imitator::{Imitator, RobotFrame};
 use super::phase::SupportPhase;
 use super::support::HumanSupport;
+use super::travel::{HandTrace, Stance, StepCounter, Travel, TravelRecorder, robot_stance};
 use crate::model::{ModelData, ModelError};
 use crate::robots::nao::Foot;
 
@@ -142,12 +147,38 @@ pub struct ImitationMetrics {
     pub joint_limit_violations: usize,
     /// Joint velocities above the allowed fraction of the rated velocity (joint × frame).
     pub velocity_limit_violations: usize,
-    /// Largest move of the support foot between frames it stood on (m).
+    /// Largest move of the support foot (the model root) from where its stance began (m); zero
+    /// up to rounding, by construction of the model switches.
     pub max_support_slip: f64,
-    /// Largest turn of the support foot between frames it stood on (rad).
+    /// Largest turn of the support foot from its heading when its stance began (rad).
     pub max_support_turn: f64,
+    /// Largest move of the other foot while it stands (DS and the CoM steps), from where its
+    /// stance began (m): held there by the IK's contact level, so up to the one-step
+    /// linearisation error.
+    pub max_held_foot_slip: f64,
+    /// Largest turn of the other foot while it stands (rad).
+    pub max_held_foot_turn: f64,
     /// Wall time per frame (µs).
     pub solve_time_us: Spread,
+    /// Tracking error per effector over the clip's frames only (before
+    /// [`MetricsRecorder::mark_clip_end`]; all frames if it was never called).
+    pub effectors_clip: Vec<EffectorError>,
+    /// Hand errors over the clip's frames once the best time shift is removed (`l_hand`,
+    /// `r_hand`).
+    pub hands_clip_lag_removed: Vec<EffectorError>,
+    /// The time shift (s) that best aligns the robot's hands with the scaled reference.
+    pub hand_lag_s: f64,
+    /// Travel of the scaled human and of the robot.
+    pub travel: Travel,
+    /// Steps (a foot off the floor ≥ 0.2 s) of the human and of the robot.
+    pub human_steps: usize,
+    /// See `human_steps`.
+    pub robot_steps: usize,
+    /// Human steps the robot had committed to and not taken at the last frame.
+    pub queued_steps_at_end: usize,
+    /// Seconds after the clip's end until the robot stood where the scaled human stands, or
+    /// `None` if it never did (or the clip's end was not marked).
+    pub catch_up_s: Option<f64>,
 }
 
 /// Accumulates [`ImitationMetrics`] frame by frame.
@@ -168,12 +199,20 @@ pub struct MetricsRecorder {
     outside: usize,
     joint_violations: usize,
     velocity_violations: usize,
-    /// The previous frame's sole placements (right, left) and which were on the ground.
-    last_feet: Option<[IsometryMatrix3<f64>; 2]>,
-    last_grounded: [bool; 2],
+    /// Where each foot's current stance began (right, left), `None` while it does not stand.
+    anchors: [Option<IsometryMatrix3<f64>>; 2],
     slip: f64,
     turn: f64,
+    held_slip: f64,
+    held_turn: f64,
     times: Vec<f64>,
+    single_clip: Vec<Series>,
+    double_clip: Vec<Series>,
+    hands: HandTrace,
+    travel: TravelRecorder,
+    human_steps: StepCounter,
+    robot_steps: StepCounter,
+    pending: usize,
 }
 
 fn continuous_name(phase: SupportPhase) -> Option<&'static str> {
@@ -182,6 +221,25 @@ fn continuous_name(phase: SupportPhase) -> Option<&'static str> {
         SupportPhase::Right => Some("RS"),
         SupportPhase::Left => Some("LS"),
         _ => None,
+    }
+}
+
+/// Which feet (right, left) stand on the floor in `phase`: the support, and both while the free
+/// foot is on the ground (DS and the CoM steps of the transitions).
+fn standing_feet(phase: SupportPhase) -> [bool; 2] {
+    use super::phase::{Landing, TakeOff};
+    match phase {
+        SupportPhase::Double
+        | SupportPhase::DoubleToRight(TakeOff::ComToFoot)
+        | SupportPhase::DoubleToLeft(TakeOff::ComToFoot)
+        | SupportPhase::RightToDouble(Landing::ComToMiddle)
+        | SupportPhase::LeftToDouble(Landing::ComToMiddle) => [true, true],
+        SupportPhase::Right
+        | SupportPhase::DoubleToRight(TakeOff::LiftFoot)
+        | SupportPhase::RightToDouble(Landing::LowerFoot) => [true, false],
+        SupportPhase::Left
+        | SupportPhase::DoubleToLeft(TakeOff::LiftFoot)
+        | SupportPhase::LeftToDouble(Landing::LowerFoot) => [false, true],
     }
 }
 
@@ -263,12 +321,26 @@ impl MetricsRecorder {
             outside: 0,
             joint_violations: 0,
             velocity_violations: 0,
-            last_feet: None,
-            last_grounded: [false; 2],
+            anchors: [None; 2],
             slip: 0.0,
             turn: 0.0,
+            held_slip: 0.0,
+            held_turn: 0.0,
             times: Vec::new(),
+            single_clip: vec![Series::default(); EFFECTORS.len()],
+            double_clip: vec![Series::default(); EFFECTORS.len()],
+            hands: HandTrace::default(),
+            travel: TravelRecorder::default(),
+            human_steps: StepCounter::default(),
+            robot_steps: StepCounter::default(),
+            pending: 0,
         }
+    }
+
+    /// The clip's last frame has been recorded; the frames that follow are a hold (the human's
+    /// last pose repeated) and count for the catch-up time, not for the clip's tracking errors.
+    pub fn mark_clip_end(&mut self) {
+        self.travel.mark_clip_end(self.last_time);
     }
 
     /// Records one frame, as returned by [`Imitator::step`].
@@ -295,18 +367,25 @@ impl MetricsRecorder {
                 continue;
             };
             let error = (data.frame_placement(id).translation.vector - reference).norm();
-            if single {
-                self.single[e].push(error);
+            let in_clip = !self.travel.clip_ended();
+            let (all, clip) = if single {
+                (&mut self.single, &mut self.single_clip)
             } else {
-                self.double[e].push(error);
+                (&mut self.double, &mut self.double_clip)
+            };
+            all[e].push(error);
+            if in_clip {
+                clip[e].push(error);
             }
+        }
+        if !self.travel.clip_ended() {
+            self.trace_hands(root_model, frame)?;
         }
 
         // Support polygon from the feet on the ground (world frame = root frame moved by
         // world_t_root; heights are the same since the root sole is on the floor).
         let mut points = [Vector2::zeros(); 8];
         let mut count = 0;
-        let mut on_ground = [false; 2];
         for foot in [Foot::Right, Foot::Left] {
             let sole = if foot == Foot::Right {
                 &frame.right_sole
@@ -317,7 +396,6 @@ impl MetricsRecorder {
                 .sole_outline()
                 .map(|[x, y]| sole.transform_point(&Vector3::new(x, y, 0.0).into()));
             let grounded = outline.iter().all(|p| p.z.abs() <= CONTACT_HEIGHT);
-            on_ground[foot_index(foot)] = grounded;
             if grounded {
                 for p in outline {
                     points[count] = p.xy().coords;
@@ -348,20 +426,40 @@ impl MetricsRecorder {
             }
         }
 
-        // Slip of the support foot: where it was at the previous frame, if it stood then.
-        let root = foot_index(frame.root);
+        // Slip of the standing feet: how far each moved since its stance began.
         let placement = [frame.right_sole, frame.left_sole];
-        if let Some(before) = self.last_feet.filter(|_| self.last_grounded[root]) {
-            let (now, then) = (placement[root], before[root]);
-            self.slip = self
-                .slip
-                .max((now.translation.vector - then.translation.vector).norm());
-            self.turn = self
-                .turn
-                .max(rotation_angle(&(then.rotation.inverse() * now.rotation)));
+        let standing = standing_feet(frame.phase);
+        for foot in 0..2 {
+            if !standing[foot] {
+                self.anchors[foot] = None;
+                continue;
+            }
+            let then = *self.anchors[foot].get_or_insert(placement[foot]);
+            let now = placement[foot];
+            let slip = (now.translation.vector - then.translation.vector).norm();
+            let turn = rotation_angle(&(then.rotation.inverse() * now.rotation));
+            let (max_slip, max_turn) = if foot == foot_index(frame.root) {
+                (&mut self.slip, &mut self.turn)
+            } else {
+                (&mut self.held_slip, &mut self.held_turn)
+            };
+            *max_slip = max_slip.max(slip);
+            *max_turn = max_turn.max(turn);
         }
-        self.last_feet = Some(placement);
-        self.last_grounded = on_ground;
+
+        // Travel and steps.
+        let human = frame
+            .human_stance
+            .map(|(point, heading)| Stance { point, heading });
+        let robot = robot_stance(&frame.right_sole, &frame.left_sole);
+        let double = frame.phase == SupportPhase::Double;
+        self.travel
+            .record(human, frame.leg_ratio, robot, double, frame.time);
+        let human_off = frame.human_support != HumanSupport::Double;
+        self.human_steps.record(human_off, frame.time);
+        self.robot_steps
+            .record(!(standing[0] && standing[1]), frame.time);
+        self.pending = imitator.pending_steps();
 
         // Support changes and transitions.
         if frame.human_support != HumanSupport::Airborne {
@@ -405,6 +503,34 @@ impl MetricsRecorder {
         Ok(())
     }
 
+    /// Adds this frame's hands and their references (world frame) to the lag trace.
+    fn trace_hands(
+        &mut self,
+        model: &crate::model::Model,
+        frame: &RobotFrame,
+    ) -> Result<(), ModelError> {
+        let data = &self.data[foot_index(frame.root)];
+        let mut robot = [Vector3::zeros(); 2];
+        let mut reference = [None; 2];
+        for (h, (name, joint)) in EFFECTORS[..2].iter().enumerate() {
+            let placement = data.frame_placement(model.frame_id(name)?);
+            robot[h] = frame
+                .world_t_root
+                .transform_point(&placement.translation.vector.into())
+                .coords;
+            reference[h] = frame.reference[joint.index()]
+                .map(|p| frame.world_t_root.transform_point(&p.into()).coords);
+        }
+        let kind = match frame.phase {
+            SupportPhase::Right | SupportPhase::Left => 1,
+            SupportPhase::Double => 2,
+            _ => 0,
+        };
+        self.hands.times.push(frame.time);
+        self.hands.samples.push((robot, reference, kind));
+        Ok(())
+    }
+
     /// The metrics of the frames recorded so far.
     pub fn finish(&self) -> ImitationMetrics {
         let mut times = self.times.clone();
@@ -431,7 +557,37 @@ impl MetricsRecorder {
             velocity_limit_violations: self.velocity_violations,
             max_support_slip: self.slip,
             max_support_turn: self.turn,
+            max_held_foot_slip: self.held_slip,
+            max_held_foot_turn: self.held_turn,
             solve_time_us: Spread::of(&mut times),
+            effectors_clip: EFFECTORS
+                .iter()
+                .enumerate()
+                .map(|(e, (name, _))| EffectorError {
+                    name,
+                    single_support: self.single_clip[e].summary(),
+                    double_support: self.double_clip[e].summary(),
+                })
+                .collect(),
+            hands_clip_lag_removed: {
+                let (errors, _) = self.hands.lag_removed();
+                let cell = |(mean, max, count): (f64, f64, usize)| MeanMax { mean, max, count };
+                EFFECTORS[..2]
+                    .iter()
+                    .zip(errors)
+                    .map(|((name, _), [single, double])| EffectorError {
+                        name,
+                        single_support: cell(single),
+                        double_support: cell(double),
+                    })
+                    .collect()
+            },
+            hand_lag_s: self.hands.lag_removed().1,
+            travel: self.travel.travel(),
+            human_steps: self.human_steps.steps(),
+            robot_steps: self.robot_steps.steps(),
+            queued_steps_at_end: self.pending,
+            catch_up_s: self.travel.catch_up(),
         }
     }
 }

@@ -20,3 +20,4 @@ pub mod scaler;
 pub mod shaping;
 pub mod support;
 pub mod tables;
+pub mod travel;

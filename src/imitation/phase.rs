@@ -236,16 +236,24 @@ pub struct PhaseConfig {
     /// full speed tilted the world enough to lift the soles off the floor by millimetres). The
     /// IK closes the last millimetres in a few frames.
     pub foot_height_tolerance: f64,
+    /// Distance (m) between the CoM goal of a single support and the inner edge of the support
+    /// foot's contact area, where the contact area is narrower than twice this, its middle. The
+    /// least lateral shift that keeps this margin: the stance hip's roll torque grows with how
+    /// far the CoM goes past the hip, and at the sole's centre a NAO's hip roll servo works at
+    /// 88 % of its rated torque (Poubel's [0, 0] under the ankle is worse). Default 15 mm.
+    pub support_margin: f64,
 }
 
 impl Default for PhaseConfig {
-    /// The paper's λ = 15 mm and ρ = 30 mm, with a 5 mm CoM and a 1 µm foot height tolerance.
+    /// The paper's λ = 15 mm and ρ = 30 mm, with a 5 mm CoM and a 1 µm foot height tolerance
+    /// and a 15 mm support margin.
     fn default() -> Self {
         Self {
             com_tolerance: 0.005,
             lambda: 0.015,
             rho: 0.030,
             foot_height_tolerance: 0.000001,
+            support_margin: 0.015,
         }
     }
 }
@@ -263,6 +271,12 @@ impl PhaseConfig {
         }
         if !(self.lambda.is_finite() && self.lambda >= 0.0) {
             return Err(PhaseError::Config("lambda", "must be finite and ≥ 0"));
+        }
+        if !(self.support_margin.is_finite() && self.support_margin >= 0.0) {
+            return Err(PhaseError::Config(
+                "support_margin",
+                "must be finite and ≥ 0",
+            ));
         }
         if !positive(self.foot_height_tolerance) {
             return Err(PhaseError::Config(

@@ -647,6 +647,11 @@ impl Scaler {
         &self.skeleton
     }
 
+    /// Robot leg length / human leg length (1 until a frame with both legs has been seen).
+    pub fn leg_ratio(&self) -> f64 {
+        self.ratio
+    }
+
     /// The configuration.
     pub fn config(&self) -> &ScaleConfig {
         &self.config

@@ -178,18 +178,31 @@ pub enum PointTarget {
         /// Height above the rest height (m): 0 on the ground, ρ for a lifted foot.
         lift: f64,
     },
+    /// Where the frame is in the imitator's initial posture (both feet flat), in the model
+    /// root's frame, lowered by `lower` metres: with [`Axes::Z`], a torso kept at its standing
+    /// height or a little below it, so that the legs stay bent when the hips shift over one
+    /// foot.
+    Standing {
+        /// How far below the initial posture (m).
+        lower: f64,
+    },
 }
 
 /// Target of a [`Task::Orientation`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum OrientationTarget {
     /// Flat (the frame's z axis vertical) with the heading (yaw about the vertical) the frame
     /// had when the step began: 3 rows, the angular error as a rotation vector (rad). A foot on
     /// the ground, or carried parallel to it.
     HeldFlat,
-    /// The frame's z axis vertical, its yaw free: 2 rows (the horizontal components of the
-    /// rotation vector that makes z vertical, rad). An upright torso.
-    Upright,
+    /// The frame's z axis vertical, or leaning `lean` rad sideways (about the root sole's x
+    /// axis, positive toward the root frame's +y), its yaw free: 2 rows (the horizontal
+    /// components of the rotation vector that turns z onto its target, rad). An upright torso,
+    /// or one leaning a little over the foot the robot stands or is about to stand on.
+    Upright {
+        /// Sideways lean (rad, about the root sole's x axis; + toward +y).
+        lean: f64,
+    },
 }
 
 /// One tracked task of an equality level.
@@ -231,7 +244,7 @@ impl Task {
             } => format!("{frame}.rot"),
             Task::Orientation {
                 frame,
-                target: OrientationTarget::Upright,
+                target: OrientationTarget::Upright { .. },
             } => format!("{frame}.upright"),
         }
     }
@@ -246,7 +259,7 @@ impl Task {
                 ..
             } => 3,
             Task::Orientation {
-                target: OrientationTarget::Upright,
+                target: OrientationTarget::Upright { .. },
                 ..
             } => 2,
         }
@@ -364,6 +377,39 @@ fn foot_frames(foot: Foot) -> [&'static str; 3] {
 /// first order, and the gradient tasks tilt the foot. 30 mm puts the points at the outer foot
 /// pressure sensors' line ([`Foot::sole_outline`]).
 pub const SOLE_EDGE_OFFSET: f64 = 0.03;
+
+/// How far below its standing height the executable tables keep the torso (m). Shifting the
+/// hips over one foot with the torso upright lengthens the far leg; at the standing height both
+/// knees of a NAO end up straight (a singular posture the swing leg cannot lift from quickly).
+pub const TORSO_LOWERING: f64 = 0.01;
+
+/// Sideways lean of the torso over the foot the robot stands or is about to stand on in the
+/// executable tables (rad). With an upright pelvis the stance hip ends up outside the CoM and
+/// its roll servo holds the whole upper body (88 % of a NAO's rated hip-roll torque); a small
+/// lean brings the upper body over the hip. Large leans (Table I's free torso leant 16°) put
+/// the swing foot on the floor early when a servo sags.
+pub const TORSO_LEAN: f64 = 0.15;
+
+/// The executable tables' torso lean in `phase` (rad about the root sole's x axis, + toward +y):
+/// toward the foot the robot stands on or shifts its weight to, 0 in DS and "CoM to middle".
+fn lean_toward_support(phase: SupportPhase) -> f64 {
+    let support = match phase {
+        SupportPhase::Right
+        | SupportPhase::DoubleToRight(_)
+        | SupportPhase::RightToDouble(Landing::LowerFoot) => Foot::Right,
+        SupportPhase::Left
+        | SupportPhase::DoubleToLeft(_)
+        | SupportPhase::LeftToDouble(Landing::LowerFoot) => Foot::Left,
+        SupportPhase::Double
+        | SupportPhase::RightToDouble(Landing::ComToMiddle)
+        | SupportPhase::LeftToDouble(Landing::ComToMiddle) => return 0.0,
+    };
+    // The right foot is toward −y, the left toward +y, whichever sole is the root.
+    match support {
+        Foot::Right => -TORSO_LEAN,
+        Foot::Left => TORSO_LEAN,
+    }
+}
 
 fn outer_edge(foot: Foot) -> [f64; 3] {
     match foot {
@@ -556,12 +602,15 @@ impl TaskTable {
     ///   orientation (3 rows: flat, heading held) form the highest level, "contact". Table I
     ///   fixes only two heights, so the foot's heading was free and a loaded foot twisted on the
     ///   floor; in DS it slid to the scaled human ankle. A foot that must move takes a step.
-    /// * **The CoM goes to the middle of the contact area**, not to the ankle: the centre of
-    ///   the support sole's contact rectangle ([`Foot::sole_centre`]) in single support and while a
-    ///   foot moves, midway between the two centres in DS.
-    /// * **An upright torso** ("posture": its z axis vertical, 2 rows) below the balance level:
-    ///   in single support the hips shift over the stance foot instead of the whole robot
-    ///   leaning 16° sideways, which put the swing foot on the floor early when a servo sagged.
+    /// * **The CoM goes inside the contact area by a margin**, not to the ankle: in single
+    ///   support and while a foot moves, to [`Foot::stance_point`] (the support sole's contact
+    ///   rectangle, [`PhaseConfig::support_margin`] from its inner edge); in DS midway between
+    ///   the two rectangles' centres ([`Foot::sole_centre`]).
+    /// * **An upright torso at its standing height** ("posture": its z axis vertical, 2 rows, and
+    ///   its height, 1 row) below the balance level: in single support the hips shift over the
+    ///   stance foot instead of the whole robot leaning 16° sideways, which put the swing foot
+    ///   on the floor early when a servo sagged; and a hand out of reach cannot stretch the
+    ///   legs straight (a singular, slow posture to step from).
     /// * In single support the free foot is kept flat with its heading (3 rows, with the hands
     ///   and the scaled ankle), so that it lands flat.
     ///
@@ -581,8 +630,9 @@ impl TaskTable {
             target: OrientationTarget::HeldFlat,
         };
         let held_foot = |lift| vec![point(ankle, PointTarget::Held { lift }), flat()];
-        let support = ComGoal::SupportPoint(root.sole_centre());
-        let other = ComGoal::OtherPoint(free.sole_centre());
+        let margin = config.support_margin;
+        let support = ComGoal::SupportPoint(root.stance_point(margin));
+        let other = ComGoal::OtherPoint(free.stance_point(margin));
         let middle = ComGoal::BetweenPoints {
             support: root.sole_centre(),
             other: free.sole_centre(),
@@ -617,10 +667,22 @@ impl TaskTable {
         levels.push(level("balance", vec![Task::ComXY(com)]));
         levels.push(level(
             "posture",
-            vec![Task::Orientation {
-                frame: "torso".to_owned(),
-                target: OrientationTarget::Upright,
-            }],
+            vec![
+                Task::Orientation {
+                    frame: "torso".to_owned(),
+                    target: OrientationTarget::Upright {
+                        lean: lean_toward_support(phase),
+                    },
+                },
+                Task::Point {
+                    frame: "torso".to_owned(),
+                    offset: [0.0; 3],
+                    axes: Axes::Z,
+                    target: PointTarget::Standing {
+                        lower: TORSO_LOWERING,
+                    },
+                },
+            ],
         ));
         levels.push(level("tracking", tracking));
         Self {
@@ -676,6 +738,14 @@ impl TaskTable {
                         target: PointTarget::Held { lift },
                         ..
                     } if !lift.is_finite() => return Err(not_finite("lift")),
+                    Task::Point {
+                        target: PointTarget::Standing { lower },
+                        ..
+                    } if !lower.is_finite() => return Err(not_finite("lower")),
+                    Task::Orientation {
+                        target: OrientationTarget::Upright { lean },
+                        ..
+                    } if !lean.is_finite() => return Err(not_finite("lean")),
                     Task::Point { offset, .. } if offset.iter().any(|v| !v.is_finite()) => {
                         return Err(not_finite("offset"));
                     }
@@ -761,6 +831,8 @@ impl fmt::Display for PointCell<'_> {
             PointTarget::Held { lift } if axes == Axes::Z => write!(f, "{coords} = {}", mm(lift)),
             PointTarget::Held { lift: 0.0 } => write!(f, "{coords} held"),
             PointTarget::Held { lift } => write!(f, "{coords} held, lifted {}", mm(lift)),
+            PointTarget::Standing { lower: 0.0 } => write!(f, "{coords} as standing"),
+            PointTarget::Standing { lower } => write!(f, "{coords} as standing − {}", mm(lower)),
         }
     }
 }
@@ -790,7 +862,12 @@ impl fmt::Display for TaskTable {
                         rows += task.rows();
                         cells.push(match target {
                             OrientationTarget::HeldFlat => format!("R({frame}) flat, yaw held"),
-                            OrientationTarget::Upright => format!("z({frame}) vertical"),
+                            OrientationTarget::Upright { lean: 0.0 } => {
+                                format!("z({frame}) vertical")
+                            }
+                            OrientationTarget::Upright { lean } => {
+                                format!("z({frame}) leaning {lean:.2} rad about x")
+                            }
                         });
                     }
                 }

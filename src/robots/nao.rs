@@ -166,6 +166,26 @@ impl Foot {
         [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])]
     }
 
+    /// The point of the contact area (sole frame, m) at `margin` from its inner edge, on the
+    /// line through [`Foot::sole_centre`] across the foot: where a robot standing on this foot
+    /// alone keeps its centre of mass. Past the centre (contact area narrower than `2·margin`)
+    /// it is the centre.
+    pub fn stance_point(self, margin: f64) -> [f64; 2] {
+        let [x, y] = self.sole_centre();
+        let ys = self.sole_outline().map(|[_, y]| y);
+        let (inner, toward_centre) = match self {
+            Foot::Left => (ys.iter().copied().fold(f64::INFINITY, f64::min), 1.0),
+            Foot::Right => (ys.iter().copied().fold(f64::NEG_INFINITY, f64::max), -1.0),
+        };
+        let from_edge = inner + toward_centre * margin;
+        let y = if toward_centre * (y - from_edge) > 0.0 {
+            from_edge
+        } else {
+            y
+        };
+        [x, y]
+    }
+
     /// The DH model rooted at this foot's sole.
     pub fn model(self) -> Model {
         match self {

@@ -343,26 +343,29 @@ impl Solver {
             }
             self.fixed_velocity.copy_from_slice(&self.saved_fixed);
             let mut blocked = None;
-            for i in (0..n).filter(|&i| !self.clamped[i]) {
-                let total = self.base_velocity[i]
-                    + (0..parts)
-                        .map(|k| self.contributions[k * n + i])
-                        .sum::<f64>();
+            'joints: for i in (0..n).filter(|&i| !self.clamped[i]) {
                 // A bound tighter than the velocity limit comes from a position limit: a joint
                 // pushed through it is clamped there (the paper's clamping), since slowing the
                 // step would only have it creep toward the limit. Velocity limits are left to the
-                // scales.
+                // scales. The running sums are checked level by level, as the scales add them
+                // up: a joint at its limit that a higher level pushes out and a lower one pulls
+                // back in would otherwise scale the higher level, and every level after it, to
+                // zero, and the robot would stop for good.
                 let (lo, hi, v) = (self.step_lo[i], self.step_hi[i], self.step_vmax[i]);
-                if total > hi && hi < v {
-                    blocked = Some((i, hi, total - hi));
-                } else if total < lo && lo > -v {
-                    blocked = Some((i, lo, lo - total));
-                } else {
-                    continue;
+                let mut sum = self.base_velocity[i];
+                for k in 0..parts {
+                    sum += self.contributions[k * n + i];
+                    if sum > hi && hi < v {
+                        blocked = Some((i, hi));
+                    } else if sum < lo && lo > -v {
+                        blocked = Some((i, lo));
+                    } else {
+                        continue;
+                    }
+                    break 'joints;
                 }
-                break;
             }
-            let Some((i, bound, _)) = blocked else { break };
+            let Some((i, bound)) = blocked else { break };
             self.clamped[i] = true;
             self.fixed_velocity[i] = bound;
             self.report.clamped.push(i);

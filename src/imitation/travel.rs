@@ -1,0 +1,329 @@
+//! Did the robot go where the human went, step when the human stepped, and follow with its
+//! hands in time? The locomotion and timing part of the [metrics](super::metrics).
+//!
+//! * **Travel**: start-to-end displacement of the scaled human's stance (the ankles' midpoint
+//!   times the leg ratio) and of the robot's mid-feet point, and the difference of their heading
+//!   changes (rad, wrapped to ±π).
+//! * **Catch-up**: after the clip's last frame, the time until the robot stands in double
+//!   support where the scaled human stands (within [`CATCH_UP_DISTANCE`] and
+//!   [`CATCH_UP_HEADING`], the human's displacement turned into the robot's world by the initial
+//!   heading difference) and stays there.
+//! * **Steps**: episodes of at least [`MIN_STEP_TIME`] with a foot off the floor, for the human
+//!   (single-support episodes) and for the robot (a swing foot, from the plan's phases).
+//! * **Hand lag**: the time shift (0 … [`MAX_LAG`]) that best aligns the robot's hands with the
+//!   scaled reference over the clip, and the errors once it is removed: a robot that follows
+//!   the right path late has a small lag-removed error and a large lag.
+
+use nalgebra::{IsometryMatrix3, Vector2, Vector3};
+
+/// Largest distance (m) between the robot's and the scaled human's stance at which the robot has
+/// caught up.
+pub const CATCH_UP_DISTANCE: f64 = 0.03;
+/// Largest heading difference (rad) at which the robot has caught up (5°).
+pub const CATCH_UP_HEADING: f64 = 0.087;
+/// Shortest time (s) a foot is off the floor for a step to count.
+pub const MIN_STEP_TIME: f64 = 0.2;
+/// Largest hand lag searched (s).
+pub const MAX_LAG: f64 = 2.0;
+
+/// Start-to-end displacement of the scaled human and of the robot.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Travel {
+    /// The scaled human's stance (m).
+    pub scaled_human_m: f64,
+    /// The robot's mid-feet point (m).
+    pub robot_m: f64,
+    /// Robot heading change minus human heading change at the end (rad, ±π).
+    pub heading_error_rad: f64,
+}
+
+/// Where someone stands: ground point (m) and heading (rad).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Stance {
+    pub(crate) point: Vector2<f64>,
+    pub(crate) heading: f64,
+}
+
+/// The robot's stance from its sole placements: the soles' midpoint and mean heading.
+pub(crate) fn robot_stance(right: &IsometryMatrix3<f64>, left: &IsometryMatrix3<f64>) -> Stance {
+    let x = |s: &IsometryMatrix3<f64>| s.rotation * Vector3::x();
+    let forward = x(right) + x(left);
+    Stance {
+        point: (right.translation.vector + left.translation.vector).xy() * 0.5,
+        heading: forward.y.atan2(forward.x),
+    }
+}
+
+fn wrap(angle: f64) -> f64 {
+    use std::f64::consts::{PI, TAU};
+    (angle + PI).rem_euclid(TAU) - PI
+}
+
+/// Follows the human's and the robot's stances over a run.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct TravelRecorder {
+    start: Option<(Stance, Stance)>,
+    last: Option<(Stance, Stance, f64)>,
+    clip_end: Option<f64>,
+    caught_up_since: Option<f64>,
+}
+
+impl TravelRecorder {
+    /// One frame: the human's stance (unscaled) and leg ratio, the robot's stance, whether the
+    /// robot stands in double support, the frame time.
+    pub(crate) fn record(
+        &mut self,
+        human: Option<Stance>,
+        ratio: f64,
+        robot: Stance,
+        double: bool,
+        time: f64,
+    ) {
+        let Some(human) = human else { return };
+        let (h0, r0) = *self.start.get_or_insert((human, robot));
+        self.last = Some((human, robot, ratio));
+        let Some(end) = self.clip_end else { return };
+        let (offset, heading) = self.errors(h0, r0, human, robot, ratio);
+        let there = double && offset <= CATCH_UP_DISTANCE && heading.abs() <= CATCH_UP_HEADING;
+        self.caught_up_since = match (there, self.caught_up_since) {
+            (true, Some(t)) => Some(t),
+            (true, None) => Some(time.max(end)),
+            (false, _) => None,
+        };
+    }
+
+    /// The robot's distance (m) from where the scaled human stands and the heading error (rad).
+    fn errors(&self, h0: Stance, r0: Stance, h: Stance, r: Stance, ratio: f64) -> (f64, f64) {
+        let turn = nalgebra::Rotation2::new(r0.heading - h0.heading);
+        let human_move = turn * ((h.point - h0.point) * ratio);
+        let offset = (r.point - r0.point - human_move).norm();
+        let heading = wrap((r.heading - r0.heading) - (h.heading - h0.heading));
+        (offset, heading)
+    }
+
+    /// The clip's last frame was at `time`; what follows is the hold.
+    pub(crate) fn mark_clip_end(&mut self, time: f64) {
+        self.clip_end.get_or_insert(time);
+    }
+
+    /// Whether the clip's end has been marked.
+    pub(crate) fn clip_ended(&self) -> bool {
+        self.clip_end.is_some()
+    }
+
+    pub(crate) fn travel(&self) -> Travel {
+        let (Some((h0, r0)), Some((h, r, ratio))) = (self.start, self.last) else {
+            return Travel::default();
+        };
+        Travel {
+            scaled_human_m: ((h.point - h0.point) * ratio).norm(),
+            robot_m: (r.point - r0.point).norm(),
+            heading_error_rad: self.errors(h0, r0, h, r, ratio).1,
+        }
+    }
+
+    /// Seconds after the clip's end until the robot stood where the scaled human stands (and
+    /// stayed), or `None`.
+    pub(crate) fn catch_up(&self) -> Option<f64> {
+        Some(self.caught_up_since? - self.clip_end?)
+    }
+}
+
+/// Counts episodes of at least [`MIN_STEP_TIME`] with a foot off the floor.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct StepCounter {
+    off_since: Option<f64>,
+    steps: usize,
+}
+
+impl StepCounter {
+    /// `off`: some foot is off the floor at `time`.
+    pub(crate) fn record(&mut self, off: bool, time: f64) {
+        match (off, self.off_since) {
+            (true, None) => self.off_since = Some(time),
+            (false, Some(start)) => {
+                if time - start >= MIN_STEP_TIME {
+                    self.steps += 1;
+                }
+                self.off_since = None;
+            }
+            _ => {}
+        }
+    }
+
+    pub(crate) fn steps(&self) -> usize {
+        self.steps
+    }
+}
+
+/// One frame of the hand trace: the robot's hands (left, right), their references, and the
+/// support kind (1 single, 2 double, 0 a transition).
+pub(crate) type HandSample = ([Vector3<f64>; 2], [Option<Vector3<f64>>; 2], u8);
+
+/// Per-frame hand positions and their references (world frame, m), for the lag search.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct HandTrace {
+    pub(crate) times: Vec<f64>,
+    pub(crate) samples: Vec<HandSample>,
+}
+
+/// Mean hand errors (m) once the best lag is removed: `[hand][single, double]` as (mean, max,
+/// count), and the lag (s).
+pub(crate) type LagRemoved = ([[(f64, f64, usize); 2]; 2], f64);
+
+impl HandTrace {
+    /// The lag (s) that minimises the mean hand error, and the errors with it removed.
+    pub(crate) fn lag_removed(&self) -> LagRemoved {
+        let n = self.samples.len();
+        let mut best = (f64::INFINITY, 0);
+        for k in 0..n {
+            if self.times[k] - self.times[0] > MAX_LAG {
+                break;
+            }
+            let (mut sum, mut count) = (0.0, 0);
+            for i in 0..n - k {
+                for h in 0..2 {
+                    if let Some(reference) = self.samples[i].1[h] {
+                        sum += (self.samples[i + k].0[h] - reference).norm();
+                        count += 1;
+                    }
+                }
+            }
+            if count > 0 && sum / (count as f64) < best.0 {
+                best = (sum / count as f64, k);
+            }
+        }
+        let k = best.1;
+        let mut out = [[(0.0, 0.0_f64, 0_usize); 2]; 2];
+        for i in 0..n.saturating_sub(k) {
+            let kind = self.samples[i].2;
+            if kind == 0 {
+                continue;
+            }
+            for h in 0..2 {
+                if let Some(reference) = self.samples[i].1[h] {
+                    let e = (self.samples[i + k].0[h] - reference).norm();
+                    let cell = &mut out[h][usize::from(kind == 2)];
+                    cell.0 += e;
+                    cell.1 = cell.1.max(e);
+                    cell.2 += 1;
+                }
+            }
+        }
+        for cell in out.iter_mut().flatten() {
+            if cell.2 > 0 {
+                cell.0 /= cell.2 as f64;
+            }
+        }
+        let lag = if n > k {
+            self.times[k] - self.times[0]
+        } else {
+            0.0
+        };
+        (out, lag)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::FRAC_PI_2;
+
+    fn stance(x: f64, y: f64, heading: f64) -> Stance {
+        Stance {
+            point: Vector2::new(x, y),
+            heading,
+        }
+    }
+
+    #[test]
+    fn travel_scales_the_human_and_compares_headings() {
+        let mut t = TravelRecorder::default();
+        t.record(
+            Some(stance(1.0, 2.0, 0.0)),
+            0.5,
+            stance(0.0, 0.0, 0.0),
+            true,
+            0.0,
+        );
+        // The human walks 2 m forward and turns 90°; at leg ratio 0.5 that is 1 m.
+        t.record(
+            Some(stance(3.0, 2.0, FRAC_PI_2)),
+            0.5,
+            stance(0.2, 0.0, 0.0),
+            true,
+            1.0,
+        );
+        let travel = t.travel();
+        assert!((travel.scaled_human_m - 1.0).abs() < 1e-12);
+        assert!((travel.robot_m - 0.2).abs() < 1e-12);
+        assert!((travel.heading_error_rad + FRAC_PI_2).abs() < 1e-12);
+        assert_eq!(t.catch_up(), None);
+    }
+
+    #[test]
+    fn catch_up_counts_from_the_clip_end_when_the_robot_arrives() {
+        let mut t = TravelRecorder::default();
+        t.record(
+            Some(stance(0.0, 0.0, 0.0)),
+            0.5,
+            stance(0.0, 0.0, 0.0),
+            true,
+            0.0,
+        );
+        t.mark_clip_end(1.0);
+        t.record(
+            Some(stance(1.0, 0.0, 0.0)),
+            0.5,
+            stance(0.3, 0.0, 0.0),
+            true,
+            1.5,
+        );
+        t.record(
+            Some(stance(1.0, 0.0, 0.0)),
+            0.5,
+            stance(0.49, 0.0, 0.0),
+            false,
+            2.0,
+        );
+        t.record(
+            Some(stance(1.0, 0.0, 0.0)),
+            0.5,
+            stance(0.49, 0.0, 0.0),
+            true,
+            2.5,
+        );
+        assert_eq!(t.catch_up(), Some(1.5));
+    }
+
+    #[test]
+    fn steps_need_the_foot_off_long_enough() {
+        let mut s = StepCounter::default();
+        for (off, t) in [
+            (true, 0.0),
+            (false, 0.1),
+            (true, 1.0),
+            (true, 1.1),
+            (false, 1.25),
+        ] {
+            s.record(off, t);
+        }
+        assert_eq!(s.steps(), 1);
+    }
+
+    #[test]
+    fn lag_is_found_and_removed() {
+        // The robot's hand repeats the reference 0.5 s (5 frames) later.
+        let mut trace = HandTrace::default();
+        let path = |t: f64| Vector3::new(t.sin(), 0.0, 0.0);
+        for i in 0..100 {
+            let t = i as f64 * 0.1;
+            trace.times.push(t);
+            let robot = path(t - 0.5);
+            trace.samples.push(([robot; 2], [Some(path(t)); 2], 2));
+        }
+        let (errors, lag) = trace.lag_removed();
+        assert!((lag - 0.5).abs() < 1e-9, "{lag}");
+        assert!(errors[0][1].0 < 1e-12 && errors[0][1].2 == 95);
+    }
+}
