@@ -69,10 +69,13 @@ fn writes_one_folder_per_clip_and_same_results_with_1_and_2_threads() {
             assert!(r.duration > 0.0 && r.duration < r.frames as f64 / 25.0);
             assert_eq!(r.joint_limit_violations, 0, "{name}");
             assert_eq!(r.velocity_limit_violations, 0, "{name}");
+            // A standing foot stays put up to the one-step linearisation error of the IK's
+            // contact level (see tests/imitation_end_to_end.rs).
             assert!(
-                r.max_support_slip < 1e-9,
-                "{name}: slip {}",
-                r.max_support_slip
+                r.max_support_slip < 1e-5 && r.max_held_foot_slip < 1e-5,
+                "{name}: slip {} / {}",
+                r.max_support_slip,
+                r.max_held_foot_slip
             );
             let csv = std::fs::read_to_string(outcome.output.join("joints.csv")).unwrap();
             let mut lines = csv.lines();

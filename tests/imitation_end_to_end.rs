@@ -8,6 +8,7 @@
 //! a robot moving at 10 % of its rated speed can finish the step it is taking.
 //! `cargo test --release --test imitation_end_to_end -- --nocapture` prints the per-clip metrics.
 
+use taskstack::imitation::footsteps::FootstepConfig;
 use taskstack::imitation::human::HumanFrame;
 use taskstack::imitation::imitator::{FootRootedModels, Imitator, ImitatorConfig};
 use taskstack::imitation::metrics::{ImitationMetrics, MetricsRecorder};
@@ -30,15 +31,26 @@ fn run(name: &str) -> (ImitationMetrics, Vec<SupportPhase>) {
 /// How far (m, rad) a standing foot may move in the plan. The support foot (the model root) is
 /// still by construction; the other standing foot is held by the IK's top level, one
 /// Gauss–Newton step per frame, so it is off by that step's second-order term: about
-/// `L·Δq²` with `L` ≈ 0.2 m and `Δq` ≈ 3.5 mrad (10 % of a leg joint's rated speed over
-/// 1/120 s), 2.5 µm, corrected at the next frame. A foot that has been held and becomes the
-/// support carries that offset.
-const HELD_FOOT_TOLERANCE: f64 = 2e-6;
+/// `L·Δq²` with `L` ≈ 0.2 m and `Δq` the joint step of a frame, corrected at the next frame. At
+/// 120 Hz (optical clips) that is about 1 µm; at 30 Hz (Kinect) a frame's step is four times
+/// larger and the error about sixteen times. A foot that has been held and becomes the support
+/// carries that offset.
+const HELD_FOOT_TOLERANCE: f64 = 1e-5;
 
 fn run_with(
     name: &str,
     config: ImitatorConfig,
     slip_tolerance: f64,
+) -> (ImitationMetrics, Vec<SupportPhase>) {
+    run_held(name, config, slip_tolerance, SETTLE_SECONDS)
+}
+
+/// [`run_with`], holding the human's last pose `settle` seconds after the clip.
+fn run_held(
+    name: &str,
+    config: ImitatorConfig,
+    slip_tolerance: f64,
+    settle: f64,
 ) -> (ImitationMetrics, Vec<SupportPhase>) {
     let mut clip = Clip::open(clip_path(name)).unwrap();
     let config = ImitatorConfig {
@@ -67,7 +79,7 @@ fn run_with(
     }
     let mut hold = last.expect("the clip has frames");
     let end = hold.time;
-    while hold.time < end + SETTLE_SECONDS {
+    while hold.time < end + settle {
         hold.time += 1.0 / 120.0;
         step(&mut imitator, &hold, &mut recorder);
     }
@@ -131,14 +143,24 @@ fn double_support_clip_never_leaves_double_support() {
     assert!(m.effectors[0].double_support.mean < 0.15 && m.effectors[1].double_support.mean < 0.15);
 }
 
+/// Walking (`FootstepConfig::follow`), the robot steps with both feet on the walks and goes the
+/// human's way: it travels at least half the scaled human's distance in the clip and a
+/// 60 s hold.
 #[test]
-fn walks_alternate_single_supports() {
+fn walks_are_walked() {
     for name in [
         "cmu_07_04_slow_walk.bvh",
         "cmu_09_12_walk_forward_backward_sideways.bvh",
         "cmu_131_01_start_walk_stop_maxskel.bvh",
     ] {
-        let (m, _) = run(name);
+        let config = ImitatorConfig {
+            footsteps: FootstepConfig {
+                follow: true,
+                ..FootstepConfig::default()
+            },
+            ..ImitatorConfig::default()
+        };
+        let (m, _) = run_held(name, config, HELD_FOOT_TOLERANCE, 60.0);
         let singles: Vec<&str> = m
             .robot_support_sequence
             .iter()
@@ -150,10 +172,11 @@ fn walks_alternate_single_supports() {
             "{name}: {:?}",
             m.robot_support_sequence
         );
+        assert!(m.robot_steps >= 2, "{name}: {} robot steps", m.robot_steps);
         assert!(
-            singles.windows(2).all(|w| w[0] != w[1]),
+            m.travel.robot_m > m.travel.scaled_human_m / 2.0,
             "{name}: {:?}",
-            m.robot_support_sequence
+            m.travel
         );
     }
 }
@@ -188,12 +211,11 @@ fn a_walk_at_full_speed_keeps_the_invariants() {
         },
         ..ImitatorConfig::default()
     };
-    // Steps five times larger than by default: the held foot's second-order error grows with
-    // their square.
+    // Steps larger than by default: the held foot's second-order error grows with their square.
     let (m, _) = run_with(
         "cmu_09_12_walk_forward_backward_sideways.bvh",
         config,
-        25.0 * HELD_FOOT_TOLERANCE,
+        10.0 * HELD_FOOT_TOLERANCE,
     );
     assert!(
         m.robot_support_changes >= 6,

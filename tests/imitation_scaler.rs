@@ -8,7 +8,7 @@ use nalgebra::{Rotation3, Vector3};
 use proptest::prelude::*;
 use taskstack::imitation::human::{HumanFrame, HumanJoint as J};
 use taskstack::imitation::scaler::{
-    NAO_MAPPING, NaoJointAngles, RobotPoint, RobotSkeleton, ScaleConfig, ScaleError,
+    FootArea, NAO_MAPPING, NaoJointAngles, RobotPoint, RobotSkeleton, ScaleConfig, ScaleError,
     ScaledSkeleton, Scaler, Stance,
 };
 use taskstack::imitation::support::{HumanSupport, Side, SupportConfig, SupportDetector};
@@ -221,7 +221,8 @@ fn double_support_puts_both_soles_on_the_ground() {
     let mut frame = standing();
     // Human feet 1.0 m apart, knees at ±0.45 m: legs (hip→knee→ankle) 0.87 (right) and
     // |(0, .36, −.45)| + |(0, .35, −.42)| = 0.5763 + 0.5467 (left), mean 0.9965; robot leg
-    // 0.2029 → ratio 0.2036, lateral 0.89 · 0.2036 = 0.181, clipped to 0.16 (NAO area).
+    // 0.2029 → ratio 0.2036, lateral 0.89 · 0.2036 = 0.181, clipped to the NAO area's largest
+    // lateral offset.
     frame.set(J::LKnee, Some(Vector3::new(0.0, 0.45, 0.5)));
     frame.set(J::LAnkle, Some(Vector3::new(0.0, 0.8, 0.08)));
     frame.set(J::LToe, Some(Vector3::new(0.14, 0.8, 0.02)));
@@ -236,7 +237,10 @@ fn double_support_puts_both_soles_on_the_ground() {
         assert!(scaled.get(toe).unwrap().z.abs() < 1e-12);
     }
     let left = scaled.sole(Side::Left).unwrap();
-    assert!((left.xy.y - 0.16).abs() < 1e-12, "{left:?}");
+    assert!(
+        (left.xy.y - FootArea::nao().lateral_max).abs() < 1e-12,
+        "{left:?}"
+    );
     assert!(left.xy.x.abs() < 1e-12 && left.yaw.abs() < 1e-12);
     // Leg loop: MidHip at loop length from the mid-ankle point.
     let mid_ankle = (scaled.get(J::LAnkle).unwrap() + scaled.get(J::RAnkle).unwrap()) / 2.0;

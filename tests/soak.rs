@@ -244,10 +244,14 @@ fn soak(clips: &[Vec<HumanFrame>], passes: usize) -> Soak {
         assert_eq!(m.joint_limit_violations, 0, "pass {pass}");
         assert_eq!(m.velocity_limit_violations, 0, "pass {pass}");
         assert_eq!(m.frames_com_outside, 0, "pass {pass}");
+        // Standing feet stay put up to the IK's one-step linearisation error (see
+        // tests/imitation_end_to_end.rs), larger here at the clip boundaries, where the human
+        // jumps and the robot's joints move at their speed limits.
         assert!(
-            m.max_support_slip < 1e-9,
-            "pass {pass}: {}",
-            m.max_support_slip
+            m.max_support_slip < 5e-5 && m.max_held_foot_slip < 5e-5,
+            "pass {pass}: {} / {}",
+            m.max_support_slip,
+            m.max_held_foot_slip
         );
         drop(m);
         drop(recorder);

@@ -11,7 +11,8 @@
 //! last pose is held for `--hold` seconds (default 5) so the robot can finish the step it is
 //! taking; those frames are in the outputs too. `--task-speed` (m/s, default 0.15) and
 //! `--iterations` (per frame, default 1) set `ImitatorConfig::max_task_speed` and
-//! `iterations_per_frame`.
+//! `iterations_per_frame`. `--walk` lets the robot's feet follow the human's footprints
+//! (`FootstepConfig::follow`): it walks where the human walks.
 
 mod plots;
 
@@ -52,6 +53,7 @@ fn main() -> ExitCode {
                 Some(h) => hold = h,
                 None => return usage(),
             },
+            "--walk" => config.footsteps.follow = true,
             "--velocity-fraction" => match args.next().and_then(|v| v.parse().ok()) {
                 Some(f) => fraction = f,
                 None => return usage(),
@@ -80,7 +82,7 @@ fn main() -> ExitCode {
 
 fn usage() -> ExitCode {
     eprintln!(
-        "usage: imitate [CLIP.bvh|CLIP.csv] [--out DIR] [--velocity-fraction F] [--hold S] [--task-speed V] [--iterations N]"
+        "usage: imitate [CLIP.bvh|CLIP.csv] [--out DIR] [--velocity-fraction F] [--hold S] [--task-speed V] [--iterations N] [--walk]"
     );
     ExitCode::from(2)
 }

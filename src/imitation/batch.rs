@@ -123,6 +123,9 @@ pub struct ClipSummary {
     pub velocity_limit_violations: usize,
     /// Largest move of the support foot between frames it stood on (m).
     pub max_support_slip: f64,
+    /// Largest move of the other standing foot (m), see
+    /// [`ImitationMetrics::max_held_foot_slip`].
+    pub max_held_foot_slip: f64,
     /// Mean distance of the left and right hand to their scaled references over the frames
     /// where they were tracked, single and double support together (m); `None` if never tracked.
     pub hand_tracking_mean: [Option<f64>; 2],
@@ -360,6 +363,7 @@ pub fn retarget_clip(
         joint_limit_violations: metrics.joint_limit_violations,
         velocity_limit_violations: metrics.velocity_limit_violations,
         max_support_slip: metrics.max_support_slip,
+        max_held_foot_slip: metrics.max_held_foot_slip,
         hand_tracking_mean: [hand("l_hand"), hand("r_hand")],
         metrics,
     })

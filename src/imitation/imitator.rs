@@ -29,6 +29,7 @@ use faer::Mat;
 use nalgebra::{IsometryMatrix3, Rotation3, UnitQuaternion, Vector2, Vector3};
 use thiserror::Error;
 
+use super::footsteps::{FootstepConfig, FootstepPlanner, GroundPose};
 use super::human::{HumanFrame, HumanJoint};
 use super::phase::{Measurements, PhaseConfig, PhaseError, PhaseMachine, SupportPhase, TakeOff};
 use super::scaler::{NAO_MAPPING, NaoJointAngles, RobotSkeleton, ScaleConfig, ScaleError, Scaler};
@@ -146,13 +147,9 @@ pub struct ImitatorConfig {
     /// have to take the tasks apart. Default 0.15 m/s, about what 10 % of the NAO's rated joint
     /// velocities give at its hands (0.8 rad/s × 0.2 m).
     pub max_task_speed: f64,
-    /// A human stance on one foot that lasts this long (s) is a step the robot takes: it reaches
-    /// single support on that foot, at its own pace, even if the human has put the other foot
-    /// down meanwhile (a walking human changes support faster than a robot at 10 % speed can
-    /// follow; the robot finishes each step, then takes the human's current one). A shorter
-    /// stance that ends first is a change of mind: the robot puts its CoM back. Default 0.3 s;
-    /// `f64::INFINITY` never commits (the robot follows the human's support as it is).
-    pub step_commit_time: f64,
+    /// When and where the robot steps: the human's footprints, scaled, clipped to the step
+    /// envelope, taken one step at a time (see [`super::footsteps`]).
+    pub footsteps: FootstepConfig,
     /// Time step assumed for the first frame, and for a frame with the same time as the previous
     /// one (s). Default 1/120 s.
     pub nominal_dt: f64,
@@ -178,7 +175,7 @@ impl Default for ImitatorConfig {
             motion: MotionLimits::default(),
             iterations_per_frame: 1,
             max_task_speed: 0.15,
-            step_commit_time: 0.3,
+            footsteps: FootstepConfig::default(),
             nominal_dt: 1.0 / 120.0,
             solver: Settings::default(),
             initial_q: None,
@@ -300,7 +297,7 @@ pub struct Imitator {
     phase: SupportPhase,
     measurements: Measurements,
     previous_time: Option<f64>,
-    commitment: StepCommitment,
+    footsteps: FootstepPlanner,
     motion: MotionLimits,
     /// The shaped CoM ground projection (world frame); `None` before the first frame.
     com_reference: Option<ComReference>,
@@ -425,11 +422,11 @@ impl Imitator {
                 reason: "must be finite and > 0 m/s",
             });
         }
-        if config.step_commit_time.is_nan() || config.step_commit_time < 0.0 {
+        if let Some((name, value)) = config.footsteps.invalid_field() {
             return Err(ImitationError::InvalidParameter {
-                name: "step_commit_time",
-                value: config.step_commit_time,
-                reason: "must be >= 0 s (infinity: never commit)",
+                name,
+                value,
+                reason: "must be >= 0",
             });
         }
         if let Some(fraction) = config.upper_body_velocity_fraction
@@ -526,8 +523,9 @@ impl Imitator {
             human_support: HumanSupport::Double,
             phase: SupportPhase::Double,
             root: Foot::Right,
+            // The world is the right sole's frame at the start.
             right_sole: IsometryMatrix3::identity(),
-            left_sole: IsometryMatrix3::identity(),
+            left_sole: *data[0].frame_placement(soles[0][1]),
             com: Vector3::zeros(),
             // Sized for the largest table, so a user's bigger table is reported whole.
             task_errors: vec![0.0; max_tasks],
@@ -570,11 +568,7 @@ impl Imitator {
                 swing_heel_height: 0.0,
             },
             previous_time: None,
-            commitment: StepCommitment {
-                commit_time: config.step_commit_time,
-                stance: None,
-                pending: None,
-            },
+            footsteps: FootstepPlanner::new(config.footsteps),
             motion: config.motion,
             com_reference: None,
             swing: SwingHeight::at(0.0),
@@ -622,10 +616,10 @@ impl Imitator {
         &self.bounds
     }
 
-    /// Human steps the robot has committed to and not reached yet (0 or 1: the robot takes one
-    /// step at a time).
+    /// Feet not on their targets (the scaled human footprints) after the last frame: the steps
+    /// the robot still has to take (0, 1 or 2).
     pub fn pending_steps(&self) -> usize {
-        usize::from(self.commitment.pending.is_some())
+        self.footsteps.steps_pending()
     }
 
     /// The velocity fraction in use.
@@ -651,10 +645,14 @@ impl Imitator {
             }
         };
         let human = self.detector.update(frame);
-        let phase = self.machine.update(
-            self.commitment.filter(human, self.phase, dt),
-            &self.measurements,
-        );
+        let feet = [
+            ground_pose(&self.output.right_sole),
+            ground_pose(&self.output.left_sole),
+        ];
+        let wanted =
+            self.footsteps
+                .update(frame, human, self.scaler.leg_ratio(), feet, self.phase, dt);
+        let phase = self.machine.update(wanted, &self.measurements);
         let changed = phase != self.phase || self.previous_time.is_none();
         self.switch_root(self.phases[phase.index()].table.model_root)?;
         let root = foot_index(self.root);
@@ -682,6 +680,17 @@ impl Imitator {
         }
         let (com_target, goal_distance) = self.shape_references(phase, dt)?;
         let swing_lift = self.swing.height();
+        let footstep = self.footsteps.target().map(|(_, world)| {
+            let xy = self
+                .world_t_root
+                .inverse_transform_point(&Vector3::new(world.xy.x, world.xy.y, 0.0).into())
+                .coords
+                .xy();
+            GroundPose {
+                xy,
+                yaw: world.yaw - ground_pose(&self.world_t_root).yaw,
+            }
+        });
         let model = self.models.rooted_at(self.root);
         let ps = &mut self.phases[phase.index()];
         // The velocity budget of the frame, split over its iterations.
@@ -703,6 +712,7 @@ impl Imitator {
             reference: &self.output.reference,
             com_target,
             swing_lift,
+            footstep,
             orientation_rows: &mut self.orientation_rows,
             table: &ps.table,
             limits: &self.limits,
@@ -862,44 +872,12 @@ impl Imitator {
     }
 }
 
-/// Turns every human stance on one foot that lasts long enough into a step the robot takes, at
-/// its own pace (see [`ImitatorConfig::step_commit_time`]).
-#[derive(Debug, Clone)]
-struct StepCommitment {
-    commit_time: f64,
-    /// The foot of the human's current single-support episode and how long it has lasted (s).
-    stance: Option<(HumanSupport, f64)>,
-    /// The long stance the robot is stepping to and has not reached yet.
-    pending: Option<HumanSupport>,
-}
-
-impl StepCommitment {
-    /// The human support the phase machine should see this frame.
-    fn filter(&mut self, human: HumanSupport, robot: SupportPhase, dt: f64) -> HumanSupport {
-        self.stance = match (human, self.stance) {
-            (HumanSupport::Right | HumanSupport::Left, Some((foot, t))) if foot == human => {
-                Some((foot, t + dt))
-            }
-            (HumanSupport::Right | HumanSupport::Left, _) => Some((human, dt)),
-            (HumanSupport::Airborne, stance) => stance,
-            (HumanSupport::Double, _) => None,
-        };
-        // One step at a time: the robot finishes the step it is taking before it takes the
-        // human's next one.
-        if let (None, Some((foot, t))) = (self.pending, self.stance)
-            && t >= self.commit_time
-        {
-            self.pending = Some(foot);
-        }
-        let reached = match robot {
-            SupportPhase::Right => Some(HumanSupport::Right),
-            SupportPhase::Left => Some(HumanSupport::Left),
-            _ => None,
-        };
-        if self.pending.is_some() && self.pending == reached {
-            self.pending = None;
-        }
-        self.pending.unwrap_or(human)
+/// The ground pose (sole point, heading) of a sole placement.
+fn ground_pose(sole: &IsometryMatrix3<f64>) -> GroundPose {
+    let x = sole.rotation * Vector3::x();
+    GroundPose {
+        xy: sole.translation.vector.xy(),
+        yaw: x.y.atan2(x.x),
     }
 }
 
@@ -958,6 +936,8 @@ struct PhaseTasks<'a> {
     com_target: Vector2<f64>,
     /// The shaped swing height (m) that replaces the lift of `Held` targets.
     swing_lift: f64,
+    /// The swing foot's target footprint in the root frame, while the robot steps.
+    footstep: Option<GroundPose>,
     orientation_rows: &'a mut Mat<f64>,
     table: &'a TaskTable,
     limits: &'a JointLimitAvoidance,
@@ -1028,6 +1008,11 @@ impl TaskModel for PhaseTasks<'_> {
                             self.model.orientation_jacobian(self.data, frame, jac)?;
                             error = flat_error(rotation, task.held_yaw).into();
                         }
+                        OrientationTarget::Footstep => {
+                            self.model.orientation_jacobian(self.data, frame, jac)?;
+                            let yaw = self.footstep.map_or(task.held_yaw, |f| f.yaw);
+                            error = flat_error(rotation, yaw).into();
+                        }
                         OrientationTarget::Upright { lean } => {
                             let rows = self.orientation_rows.as_mut();
                             self.model.orientation_jacobian(self.data, frame, rows)?;
@@ -1096,6 +1081,10 @@ impl PhaseTasks<'_> {
                 Vector3::new(task.held.x, task.held.y, task.rest_height + self.swing_lift)
             }
             PointTarget::Standing { lower } => task.standing - Vector3::z() * lower,
+            PointTarget::Footstep { lift } => {
+                let xy = self.footstep.map_or(task.held.xy(), |f| f.xy);
+                Vector3::new(xy.x, xy.y, task.rest_height + lift)
+            }
         };
         for (r, axis) in task.axes.iter().flatten().enumerate() {
             error[r] = goal[*axis as usize] - p[*axis as usize];

@@ -12,6 +12,7 @@
 //! clips in parallel.
 
 pub mod batch;
+pub mod footsteps;
 pub mod human;
 pub mod imitator;
 pub mod metrics;

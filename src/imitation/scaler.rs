@@ -427,20 +427,24 @@ pub struct FootArea {
 }
 
 impl FootArea {
-    /// For the NAO (chosen by hand from its 0.1 m hip width and 0.16 m long feet, not measured):
-    /// x ∈ [−0.06, 0.08], lateral ∈ [0.095, 0.16], |yaw| ≤ 0.3.
+    /// For the NAO: x ∈ [−0.04, 0.05], lateral ∈ [0.095, 0.12], |yaw| ≤ 0.15. The lateral bounds
+    /// come from its 0.1 m hip width (the feet stay 95 mm apart, uncrossed); the forward ones
+    /// from stepping with the torso upright 10 mm below its standing height and the CoM over the
+    /// stance foot: at 8 cm (NAOqi's largest step) the swing knee is straight when the foot
+    /// lands, and double support with the feet that far apart leaves the legs no posture to
+    /// hold the torso with.
     pub const fn nao() -> Self {
         FootArea {
-            x_min: -0.06,
-            x_max: 0.08,
+            x_min: -0.04,
+            x_max: 0.05,
             lateral_min: 0.095,
-            lateral_max: 0.16,
-            yaw_max: 0.3,
+            lateral_max: 0.12,
+            yaw_max: 0.15,
         }
     }
 
     /// Clips the placement of the foot on `side` relative to the other sole.
-    fn clip(&self, side: Side, placement: SolePlacement) -> SolePlacement {
+    pub fn clip(&self, side: Side, placement: SolePlacement) -> SolePlacement {
         let sign = if side == Side::Left { 1.0 } else { -1.0 };
         SolePlacement {
             xy: Vector2::new(

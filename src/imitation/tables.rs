@@ -186,6 +186,13 @@ pub enum PointTarget {
         /// How far below the initial posture (m).
         lower: f64,
     },
+    /// Above the target footprint of the step the robot is taking ([`super::footsteps`]), at
+    /// the frame's rest height plus `lift`: a swing foot carried to where it will land. Held
+    /// where the step began when no step is planned.
+    Footstep {
+        /// Height above the rest height (m).
+        lift: f64,
+    },
 }
 
 /// Target of a [`Task::Orientation`].
@@ -203,6 +210,9 @@ pub enum OrientationTarget {
         /// Sideways lean (rad, about the root sole's x axis; + toward +y).
         lean: f64,
     },
+    /// Flat with the heading of the target footprint of the step the robot is taking (3 rows;
+    /// the heading held when no step is planned).
+    Footstep,
 }
 
 /// One tracked task of an equality level.
@@ -240,7 +250,7 @@ impl Task {
             Task::Point { frame, axes, .. } => format!("{frame}{}", axes.suffix()),
             Task::Orientation {
                 frame,
-                target: OrientationTarget::HeldFlat,
+                target: OrientationTarget::HeldFlat | OrientationTarget::Footstep,
             } => format!("{frame}.rot"),
             Task::Orientation {
                 frame,
@@ -255,7 +265,7 @@ impl Task {
             Task::ComXY(_) => 2,
             Task::Point { axes, .. } => axes.count(),
             Task::Orientation {
-                target: OrientationTarget::HeldFlat,
+                target: OrientationTarget::HeldFlat | OrientationTarget::Footstep,
                 ..
             } => 3,
             Task::Orientation {
@@ -381,7 +391,7 @@ pub const SOLE_EDGE_OFFSET: f64 = 0.03;
 /// How far below its standing height the executable tables keep the torso (m). Shifting the
 /// hips over one foot with the torso upright lengthens the far leg; at the standing height both
 /// knees of a NAO end up straight (a singular posture the swing leg cannot lift from quickly).
-pub const TORSO_LOWERING: f64 = 0.01;
+pub const TORSO_LOWERING: f64 = 0.02;
 
 /// Sideways lean of the torso over the foot the robot stands or is about to stand on in the
 /// executable tables (rad). With an upright pelvis the stance hip ends up outside the CoM and
@@ -611,8 +621,11 @@ impl TaskTable {
     ///   stance foot instead of the whole robot leaning 16° sideways, which put the swing foot
     ///   on the floor early when a servo sagged; and a hand out of reach cannot stretch the
     ///   legs straight (a singular, slow posture to step from).
-    /// * In single support the free foot is kept flat with its heading (3 rows, with the hands
-    ///   and the scaled ankle), so that it lands flat.
+    /// * **Feet go where the human's went.** In single support the free foot is carried flat at
+    ///   the lift height ρ to the target footprint of the step ([`super::footsteps`]: the
+    ///   human's footprint, scaled and clipped to the step envelope), in its own level above the
+    ///   hands ("swing"), instead of following the human's swinging ankle beside them: a hand
+    ///   out of reach must not decide where a foot lands.
     ///
     /// The gradients are the paper's.
     pub fn executable(phase: SupportPhase, config: &PhaseConfig) -> Self {
@@ -651,14 +664,19 @@ impl TaskTable {
             }
             _ => (Some(held_foot(0.0)), support),
         };
-        let mut tracking = vec![
+        let tracking = vec![
             point("l_hand", PointTarget::Scaled(HumanJoint::LHand)),
             point("r_hand", PointTarget::Scaled(HumanJoint::RHand)),
         ];
-        if contact.is_none() {
-            tracking.push(point(ankle, PointTarget::Scaled(human_ankle(free))));
-            tracking.push(flat());
-        }
+        let swing = contact.is_none().then(|| {
+            vec![
+                point(ankle, PointTarget::Footstep { lift: config.rho }),
+                Task::Orientation {
+                    frame: free.sole().to_owned(),
+                    target: OrientationTarget::Footstep,
+                },
+            ]
+        });
         let level = |name: &str, tasks| Level {
             name: name.to_owned(),
             tasks,
@@ -684,6 +702,7 @@ impl TaskTable {
                 },
             ],
         ));
+        levels.extend(swing.map(|tasks| level("swing", tasks)));
         levels.push(level("tracking", tracking));
         Self {
             levels,
@@ -742,6 +761,10 @@ impl TaskTable {
                         target: PointTarget::Standing { lower },
                         ..
                     } if !lower.is_finite() => return Err(not_finite("lower")),
+                    Task::Point {
+                        target: PointTarget::Footstep { lift },
+                        ..
+                    } if !lift.is_finite() => return Err(not_finite("lift")),
                     Task::Orientation {
                         target: OrientationTarget::Upright { lean },
                         ..
@@ -833,6 +856,9 @@ impl fmt::Display for PointCell<'_> {
             PointTarget::Held { lift } => write!(f, "{coords} held, lifted {}", mm(lift)),
             PointTarget::Standing { lower: 0.0 } => write!(f, "{coords} as standing"),
             PointTarget::Standing { lower } => write!(f, "{coords} as standing − {}", mm(lower)),
+            PointTarget::Footstep { lift } => {
+                write!(f, "{coords} over the footstep + {}", mm(lift))
+            }
         }
     }
 }
@@ -862,6 +888,9 @@ impl fmt::Display for TaskTable {
                         rows += task.rows();
                         cells.push(match target {
                             OrientationTarget::HeldFlat => format!("R({frame}) flat, yaw held"),
+                            OrientationTarget::Footstep => {
+                                format!("R({frame}) flat, footstep yaw")
+                            }
                             OrientationTarget::Upright { lean: 0.0 } => {
                                 format!("z({frame}) vertical")
                             }

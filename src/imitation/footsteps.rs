@@ -1,0 +1,576 @@
+//! Where the robot puts its feet: the human's footprints, scaled to the robot, become robot
+//! steps, taken one at a time at the robot's own pace.
+//!
+//! # The footprints
+//!
+//! While a human foot is on the ground its footprint is its ankle's ground point and its heading
+//! (ankle → toe, or the hips' heading when the toe is missing), in the human's world. Each foot's
+//! move since the start, scaled by the leg ratio `k = robot leg / human leg` and turned into the
+//! robot's world, moves the same robot foot from where it started: a human footprint `(p, θ)` of
+//! a foot that started at `(p₀, θ₀)` is the robot footprint `(r₀ + R(Δθ)·k·(p − p₀), ρ₀ + θ − θ₀)`
+//! for the robot foot that started at `(r₀, ρ₀)`, with `Δθ` the difference of the starting
+//! stances' headings (robot − human). So the human's stance width and natural toe-out are not
+//! copied, only how the feet move. A robot foot's **target** is its footprint clipped to the
+//! step envelope ([`FootArea`]: forward offset, lateral offset that keeps the feet apart and
+//! uncrossed, relative yaw) around where the robot's other foot stands.
+//!
+//! # The steps
+//!
+//! In double support the robot steps with the foot farthest from its target, once that is more
+//! than [`FootstepConfig::distance`] or [`FootstepConfig::heading`] away: it shifts its CoM over
+//! the other foot, lifts the foot, carries it flat at the lift height to the target (which keeps
+//! following the human until the human's foot is down), lowers it and brings the CoM back to the
+//! middle. A human standing on one foot for [`FootstepConfig::stance_time`] makes the robot lift
+//! the same foot and stand on one leg until the human puts it down. So each deliberate human
+//! step becomes a robot step, steps the robot cannot take yet wait (the targets keep the latest
+//! footprints), and when the human stops the robot steps until both feet are on their targets:
+//! it stands where the scaled human stands. A step once started is finished: the foot is landed
+//! before anything else happens, so no foot on the floor ever moves. Without walking
+//! ([`FootstepConfig::follow`] off) a human who now stands on the other leg redirects a robot
+//! that is still shifting its weight (both feet down).
+//!
+//! Units: metres, radians. Frames: the human's world and the robot's world (the right sole at
+//! the first frame), both z up.
+
+use nalgebra::{Rotation2, Vector2};
+
+use super::human::{HumanFrame, HumanJoint};
+use super::phase::SupportPhase;
+use super::scaler::{FootArea, SolePlacement};
+use super::support::{HumanSupport, Side};
+use crate::robots::nao::Foot;
+
+/// When the robot steps.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FootstepConfig {
+    /// Whether the robot's feet follow the human's footprints (walking). Off by default: the
+    /// robot then only stands on one leg when the human does, for as long, lifting the foot in
+    /// place and putting it back where it was. Walking is not yet steady enough in physics to
+    /// be the default (see the CHANGELOG): it is there to try, `imitate --walk`.
+    pub follow: bool,
+    /// A foot farther than this from its target (m) is moved by a step. Default 0.02.
+    pub distance: f64,
+    /// A foot turned more than this from its target's heading (rad) is moved by a step.
+    /// Default 0.087 (5°).
+    pub heading: f64,
+    /// A human standing on one foot this long (s) is followed onto one leg. Default 0.3.
+    pub stance_time: f64,
+    /// The robot lands a foot that has been this long (s) in single support with the human's
+    /// foot down, even if it has not reached its target (5 mm, 2°): a target the legs cannot
+    /// reach must not keep the robot on one leg. Default 2.
+    pub swing_timeout: f64,
+    /// The robot's step envelope around its standing foot.
+    pub area: FootArea,
+}
+
+impl Default for FootstepConfig {
+    fn default() -> Self {
+        Self {
+            follow: false,
+            distance: 0.02,
+            heading: 0.087,
+            stance_time: 0.3,
+            swing_timeout: 2.0,
+            area: FootArea::nao(),
+        }
+    }
+}
+
+impl FootstepConfig {
+    /// The first field that is out of range (name and value).
+    pub fn invalid_field(&self) -> Option<(&'static str, f64)> {
+        [
+            ("footsteps.distance", self.distance),
+            ("footsteps.heading", self.heading),
+            ("footsteps.stance_time", self.stance_time),
+            ("footsteps.swing_timeout", self.swing_timeout),
+        ]
+        .into_iter()
+        .find(|(_, v)| v.is_nan() || *v < 0.0)
+    }
+}
+
+/// A ground pose: sole point (m) and heading (rad about z).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GroundPose {
+    /// x, y (m).
+    pub xy: Vector2<f64>,
+    /// Heading (rad).
+    pub yaw: f64,
+}
+
+impl GroundPose {
+    /// `other` expressed in this pose's frame.
+    fn relative(&self, other: &GroundPose) -> GroundPose {
+        GroundPose {
+            xy: Rotation2::new(-self.yaw) * (other.xy - self.xy),
+            yaw: wrap(other.yaw - self.yaw),
+        }
+    }
+
+    /// A pose given in this pose's frame, back in the world.
+    fn compose(&self, local: &GroundPose) -> GroundPose {
+        GroundPose {
+            xy: self.xy + Rotation2::new(self.yaw) * local.xy,
+            yaw: wrap(self.yaw + local.yaw),
+        }
+    }
+}
+
+fn wrap(angle: f64) -> f64 {
+    use std::f64::consts::{PI, TAU};
+    (angle + PI).rem_euclid(TAU) - PI
+}
+
+/// Whether `phase` shifts the CoM toward a foot with both feet still down.
+fn shifting(phase: SupportPhase) -> bool {
+    use super::phase::TakeOff;
+    matches!(
+        phase,
+        SupportPhase::DoubleToRight(TakeOff::ComToFoot)
+            | SupportPhase::DoubleToLeft(TakeOff::ComToFoot)
+    )
+}
+
+fn side(foot: Foot) -> Side {
+    match foot {
+        Foot::Right => Side::Right,
+        Foot::Left => Side::Left,
+    }
+}
+
+fn index(foot: Foot) -> usize {
+    match foot {
+        Foot::Right => 0,
+        Foot::Left => 1,
+    }
+}
+
+/// What the planner is doing.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Step {
+    /// Both feet down, nothing to do or deciding.
+    Idle,
+    /// Stepping with this foot: shifting, lifting, carrying it to its target; the time (s) spent
+    /// in single support with the human's foot down.
+    Swing(Foot, f64),
+    /// The swing foot is on its target and the human's foot is down: landing, back to DS.
+    Landing,
+}
+
+/// Turns the human's footprints into robot steps (see the module docs).
+#[derive(Clone, Debug)]
+pub struct FootstepPlanner {
+    config: FootstepConfig,
+    /// The human's last footprint of each foot (right, left), human world.
+    human: [Option<GroundPose>; 2],
+    /// The starting footprints (right, left) of the human and of the robot, and the heading
+    /// difference of the starting stances (robot − human, rad).
+    origin: Option<([GroundPose; 2], [GroundPose; 2], f64)>,
+    /// How long the human has stood on one foot (s), and which foot is lifted.
+    stance: Option<(Foot, f64)>,
+    /// Which human feet (right, left) are on the ground at this frame.
+    down: [bool; 2],
+    step: Step,
+    /// The current swing target (robot world), while stepping.
+    target: Option<GroundPose>,
+    /// Feet off their targets at the last update (0, 1 or 2).
+    off_target: usize,
+    /// Where the robot's feet stood when the current step began (right, left): the targets
+    /// when the feet do not follow the human's.
+    home: Option<[GroundPose; 2]>,
+}
+
+impl FootstepPlanner {
+    /// A planner with `config`.
+    pub fn new(config: FootstepConfig) -> Self {
+        Self {
+            config,
+            human: [None; 2],
+            origin: None,
+            stance: None,
+            down: [true; 2],
+            step: Step::Idle,
+            target: None,
+            off_target: 0,
+            home: None,
+        }
+    }
+
+    /// The swing foot and its target (robot world), while the robot steps.
+    pub fn target(&self) -> Option<(Foot, GroundPose)> {
+        match self.step {
+            Step::Swing(foot, _) => Some((foot, self.target?)),
+            Step::Idle | Step::Landing => None,
+        }
+    }
+
+    /// Feet not on their targets after the last update: steps still to take.
+    pub fn steps_pending(&self) -> usize {
+        self.off_target
+    }
+
+    /// One frame. `human` is the detected human support, `ratio` the leg ratio, `feet` the
+    /// robot's sole poses (right, left; robot world) and `phase` its phase at the previous
+    /// frame, `dt` the frame's time step (s). Returns the support the phase machine should work
+    /// toward.
+    pub fn update(
+        &mut self,
+        frame: &HumanFrame,
+        human: HumanSupport,
+        ratio: f64,
+        feet: [GroundPose; 2],
+        phase: SupportPhase,
+        dt: f64,
+    ) -> HumanSupport {
+        self.observe(frame, human, dt);
+        if self.origin.is_none()
+            && let [Some(r), Some(l)] = self.human
+        {
+            let heading = |[r, l]: [GroundPose; 2]| wrap(r.yaw + 0.5 * wrap(l.yaw - r.yaw));
+            self.origin = Some(([r, l], feet, wrap(heading(feet) - heading([r, l]))));
+        }
+        if self.step == Step::Idle || self.home.is_none() {
+            self.home = Some(feet);
+        }
+        let targets = match self.home {
+            Some(home) if !self.config.follow => home.map(Some),
+            _ => [Foot::Right, Foot::Left].map(|f| self.target_of(f, feet, ratio)),
+        };
+        let error = |f: Foot| -> Option<(f64, f64)> {
+            let t = targets[index(f)]?;
+            let d = feet[index(f)].relative(&t);
+            Some((d.xy.norm(), d.yaw.abs()))
+        };
+        let config = self.config;
+        let off =
+            |f: Foot| error(f).is_some_and(|(d, a)| d > config.distance || a > config.heading);
+        self.off_target = usize::from(off(Foot::Right)) + usize::from(off(Foot::Left));
+        match self.step {
+            Step::Idle if phase == SupportPhase::Double => {
+                self.step = self.choose(off, error);
+                if let Step::Swing(foot, _) = self.step {
+                    self.target = targets[index(foot)];
+                }
+            }
+            // Without walking the robot imitates the human's one-leg stances: if the human now
+            // stands on the other leg and the robot's foot is still down, it takes the human's
+            // current stance instead (the phase machine aborts the weight shift). A walking robot
+            // finishes the step it chose: its targets, not the stances, decide.
+            Step::Swing(foot, _)
+                if !self.config.follow
+                    && shifting(phase)
+                    && matches!(self.stance, Some((lifted, t))
+                        if lifted == foot.other() && t >= self.config.stance_time) =>
+            {
+                self.step = Step::Swing(foot.other(), 0.0);
+                self.target = targets[index(foot.other())];
+            }
+            Step::Swing(foot, waited) => {
+                self.target = targets[index(foot)];
+                let there = error(foot).is_none_or(|(d, a)| d <= 0.005 && a <= 0.035);
+                let human_down = self.down[index(foot)];
+                let single = matches!(phase, SupportPhase::Right | SupportPhase::Left);
+                let waited = if single && human_down {
+                    waited + dt
+                } else {
+                    waited
+                };
+                self.step =
+                    if single && human_down && (there || waited >= self.config.swing_timeout) {
+                        Step::Landing
+                    } else {
+                        Step::Swing(foot, waited)
+                    };
+            }
+            Step::Landing if phase == SupportPhase::Double => self.step = Step::Idle,
+            Step::Idle | Step::Landing => {}
+        }
+        match self.step {
+            Step::Swing(Foot::Left, _) => HumanSupport::Right,
+            Step::Swing(Foot::Right, _) => HumanSupport::Left,
+            Step::Idle | Step::Landing => HumanSupport::Double,
+        }
+    }
+
+    /// The next step from double support: the human's one-leg stance, or the foot farthest off
+    /// its target.
+    fn choose(
+        &self,
+        off: impl Fn(Foot) -> bool,
+        error: impl Fn(Foot) -> Option<(f64, f64)>,
+    ) -> Step {
+        if let Some((lifted, t)) = self.stance
+            && t >= self.config.stance_time
+        {
+            return Step::Swing(lifted, 0.0);
+        }
+        let cost = |f: Foot| {
+            error(f).map_or(0.0, |(d, a)| {
+                d / self.config.distance + a / self.config.heading
+            })
+        };
+        match (off(Foot::Right), off(Foot::Left)) {
+            (false, false) => Step::Idle,
+            (true, false) => Step::Swing(Foot::Right, 0.0),
+            (false, true) => Step::Swing(Foot::Left, 0.0),
+            (true, true) if cost(Foot::Right) >= cost(Foot::Left) => Step::Swing(Foot::Right, 0.0),
+            (true, true) => Step::Swing(Foot::Left, 0.0),
+        }
+    }
+
+    /// Updates the human footprints and the one-leg stance from this frame.
+    fn observe(&mut self, frame: &HumanFrame, human: HumanSupport, dt: f64) {
+        let down = match human {
+            HumanSupport::Double => [true, true],
+            HumanSupport::Right => [true, false],
+            HumanSupport::Left => [false, true],
+            HumanSupport::Airborne => [false, false],
+        };
+        self.down = down;
+        for foot in [Foot::Right, Foot::Left] {
+            if down[index(foot)]
+                && let Some(print) = footprint(frame, foot)
+            {
+                self.human[index(foot)] = Some(print);
+            }
+        }
+        let lifted = match human {
+            HumanSupport::Right => Some(Foot::Left),
+            HumanSupport::Left => Some(Foot::Right),
+            HumanSupport::Double | HumanSupport::Airborne => None,
+        };
+        self.stance = match (lifted, self.stance) {
+            (Some(f), Some((g, t))) if f == g => Some((f, t + dt)),
+            (Some(f), _) => Some((f, dt)),
+            (None, _) => None,
+        };
+    }
+
+    /// The target of `foot` (robot world): its scaled human footprint, clipped to the envelope
+    /// around the robot's other foot.
+    fn target_of(&self, foot: Foot, feet: [GroundPose; 2], ratio: f64) -> Option<GroundPose> {
+        let (human0, robot0, turn) = self.origin?;
+        let (h0, r0) = (human0[index(foot)], robot0[index(foot)]);
+        let print = self.human[index(foot)]?;
+        let scaled = GroundPose {
+            xy: r0.xy + Rotation2::new(turn) * ((print.xy - h0.xy) * ratio),
+            yaw: wrap(r0.yaw + print.yaw - h0.yaw),
+        };
+        let other = feet[index(foot.other())];
+        let local = other.relative(&scaled);
+        let clipped = self.config.area.clip(
+            side(foot),
+            SolePlacement {
+                xy: local.xy,
+                yaw: local.yaw,
+            },
+        );
+        Some(other.compose(&GroundPose {
+            xy: clipped.xy,
+            yaw: clipped.yaw,
+        }))
+    }
+}
+
+/// The footprint of a human foot: ankle ground point and heading.
+fn footprint(frame: &HumanFrame, foot: Foot) -> Option<GroundPose> {
+    let (ankle, toe) = match foot {
+        Foot::Right => (HumanJoint::RAnkle, HumanJoint::RToe),
+        Foot::Left => (HumanJoint::LAnkle, HumanJoint::LToe),
+    };
+    let ankle = frame.get(ankle)?;
+    let forward = match frame.get(toe) {
+        Some(toe) if (toe - ankle).xy().norm() > 0.03 => (toe - ankle).xy(),
+        _ => {
+            let left = frame.get(HumanJoint::LHip)? - frame.get(HumanJoint::RHip)?;
+            Vector2::new(left.y, -left.x)
+        }
+    };
+    Some(GroundPose {
+        xy: ankle.xy(),
+        yaw: forward.y.atan2(forward.x),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pose(x: f64, y: f64, yaw: f64) -> GroundPose {
+        GroundPose {
+            xy: Vector2::new(x, y),
+            yaw,
+        }
+    }
+
+    /// A human frame standing with the ankles at `r` and `l` (x, y), feet pointing +x.
+    fn human(r: [f64; 2], l: [f64; 2]) -> HumanFrame {
+        let mut frame = HumanFrame::new(0.0);
+        let v = |x: f64, y: f64, z: f64| nalgebra::Vector3::new(x, y, z);
+        frame.set(HumanJoint::RAnkle, Some(v(r[0], r[1], 0.08)));
+        frame.set(HumanJoint::LAnkle, Some(v(l[0], l[1], 0.08)));
+        frame.set(HumanJoint::RToe, Some(v(r[0] + 0.15, r[1], 0.02)));
+        frame.set(HumanJoint::LToe, Some(v(l[0] + 0.15, l[1], 0.02)));
+        frame.set(HumanJoint::RHip, Some(v(0.0, -0.1, 0.9)));
+        frame.set(HumanJoint::LHip, Some(v(0.0, 0.1, 0.9)));
+        frame
+    }
+
+    fn walking() -> FootstepConfig {
+        FootstepConfig {
+            follow: true,
+            ..FootstepConfig::default()
+        }
+    }
+
+    const FEET: [GroundPose; 2] = [
+        GroundPose {
+            xy: Vector2::new(0.0, 0.0),
+            yaw: 0.0,
+        },
+        GroundPose {
+            xy: Vector2::new(0.0, 0.1),
+            yaw: 0.0,
+        },
+    ];
+
+    #[test]
+    fn a_human_step_forward_becomes_a_clipped_robot_step() {
+        let mut planner = FootstepPlanner::new(walking());
+        let double = SupportPhase::Double;
+        let dt = 0.01;
+        // Standing: no step.
+        let start = human([0.0, -0.1], [0.0, 0.1]);
+        let s = planner.update(&start, HumanSupport::Double, 0.25, FEET, double, dt);
+        assert_eq!(s, HumanSupport::Double);
+        assert_eq!(planner.steps_pending(), 0);
+        // The left foot lands 0.4 m ahead: 0.1 m for the robot at ratio 0.25, clipped to the
+        // NAO envelope's 0.05 m ahead of the right foot.
+        let moved = human([0.0, -0.1], [0.4, 0.1]);
+        let s = planner.update(&moved, HumanSupport::Double, 0.25, FEET, double, dt);
+        assert_eq!(
+            s,
+            HumanSupport::Right,
+            "stand on the right foot to move the left"
+        );
+        let (foot, target) = planner.target().unwrap();
+        assert_eq!(foot, Foot::Left);
+        assert!(
+            (target.xy - Vector2::new(0.05, 0.1)).norm() < 1e-12,
+            "{target:?}"
+        );
+        assert!(target.yaw.abs() < 1e-12);
+        assert_eq!(planner.steps_pending(), 1);
+        // Once the robot stands on the right foot with the left on its target, it lands.
+        let feet = [FEET[0], pose(0.05, 0.1, 0.0)];
+        let s = planner.update(
+            &moved,
+            HumanSupport::Double,
+            0.25,
+            feet,
+            SupportPhase::Right,
+            dt,
+        );
+        assert_eq!(s, HumanSupport::Double);
+        assert_eq!(planner.target(), None);
+        // The right foot, 1 cm behind its clipped target (0.04 m behind the left foot at most),
+        // is close enough: no step.
+        let s = planner.update(&moved, HumanSupport::Double, 0.25, feet, double, dt);
+        assert_eq!(s, HumanSupport::Double);
+        assert_eq!(planner.steps_pending(), 0);
+        // The human brings the right foot up: the robot's right foot goes 0.1 m forward, which
+        // is 0.05 m ahead of the left foot and within the envelope.
+        let together = human([0.4, -0.1], [0.4, 0.1]);
+        let s = planner.update(&together, HumanSupport::Double, 0.25, feet, double, dt);
+        assert_eq!(s, HumanSupport::Left);
+        let (foot, target) = planner.target().unwrap();
+        assert_eq!(foot, Foot::Right);
+        assert!(
+            (target.xy - Vector2::new(0.1, 0.0)).norm() < 1e-12,
+            "{target:?}"
+        );
+    }
+
+    /// The human's toe-out is not copied: a foot that keeps its heading keeps the robot's.
+    #[test]
+    fn headings_are_relative_to_the_start() {
+        let mut planner = FootstepPlanner::new(walking());
+        let mut frame = human([0.0, -0.1], [0.0, 0.1]);
+        // Toes out by 0.3 rad on both feet.
+        let v = |x: f64, y: f64| nalgebra::Vector3::new(x, y, 0.02);
+        frame.set(
+            HumanJoint::RToe,
+            Some(v(0.15 * 0.3f64.cos(), -0.1 - 0.15 * 0.3f64.sin())),
+        );
+        frame.set(
+            HumanJoint::LToe,
+            Some(v(0.15 * 0.3f64.cos(), 0.1 + 0.15 * 0.3f64.sin())),
+        );
+        let s = planner.update(
+            &frame,
+            HumanSupport::Double,
+            0.25,
+            FEET,
+            SupportPhase::Double,
+            0.01,
+        );
+        assert_eq!(s, HumanSupport::Double);
+        assert_eq!(planner.steps_pending(), 0);
+    }
+
+    #[test]
+    fn a_human_on_one_leg_is_followed_after_the_stance_time() {
+        // Without walking: the foot is lifted in place.
+        let mut planner = FootstepPlanner::new(FootstepConfig::default());
+        let frame = human([0.0, -0.1], [0.0, 0.1]);
+        planner.update(
+            &frame,
+            HumanSupport::Double,
+            0.25,
+            FEET,
+            SupportPhase::Double,
+            0.01,
+        );
+        let mut support = HumanSupport::Double;
+        for _ in 0..29 {
+            support = planner.update(
+                &frame,
+                HumanSupport::Right,
+                0.25,
+                FEET,
+                SupportPhase::Double,
+                0.01,
+            );
+        }
+        assert_eq!(support, HumanSupport::Double, "0.29 s is not yet a stance");
+        let support = planner.update(
+            &frame,
+            HumanSupport::Right,
+            0.25,
+            FEET,
+            SupportPhase::Double,
+            0.02,
+        );
+        assert_eq!(support, HumanSupport::Right);
+        // In single support with the foot on its target, it stays up while the human's is.
+        let support = planner.update(
+            &frame,
+            HumanSupport::Right,
+            0.25,
+            FEET,
+            SupportPhase::Right,
+            0.01,
+        );
+        assert_eq!(support, HumanSupport::Right);
+        let support = planner.update(
+            &frame,
+            HumanSupport::Double,
+            0.25,
+            FEET,
+            SupportPhase::Right,
+            0.01,
+        );
+        assert_eq!(support, HumanSupport::Double);
+    }
+}
