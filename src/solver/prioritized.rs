@@ -342,33 +342,40 @@ impl Solver {
                 self.contributions[k * n..(k + 1) * n].copy_from_slice(&self.velocity);
             }
             self.fixed_velocity.copy_from_slice(&self.saved_fixed);
-            let mut blocked = None;
-            'joints: for i in (0..n).filter(|&i| !self.clamped[i]) {
-                // A bound tighter than the velocity limit comes from a position limit: a joint
-                // pushed through it is clamped there (the paper's clamping), since slowing the
-                // step would only have it creep toward the limit. Velocity limits are left to the
-                // scales. The running sums are checked level by level, as the scales add them
-                // up: a joint at its limit that a higher level pushes out and a lower one pulls
-                // back in would otherwise scale the higher level, and every level after it, to
-                // zero, and the robot would stop for good.
+            // A bound tighter than the velocity limit comes from a position limit: a joint
+            // pushed through it is clamped there (the paper's clamping), since slowing the
+            // step would only have it creep toward the limit. Velocity limits are left to the
+            // scales. The running sums are checked level by level, as the scales add them up: a
+            // joint at its limit that a higher level pushes out and a lower one pulls back in
+            // would otherwise scale the higher level, and every level after it, to zero, and
+            // the robot would stop for good. Every such joint is clamped at once (each is
+            // pinned by its own limit, whatever the others do), then the parts are recomputed.
+            let mut blocked = false;
+            for i in 0..n {
+                if self.clamped[i] {
+                    continue;
+                }
                 let (lo, hi, v) = (self.step_lo[i], self.step_hi[i], self.step_vmax[i]);
                 let mut sum = self.base_velocity[i];
                 for k in 0..parts {
                     sum += self.contributions[k * n + i];
-                    if sum > hi && hi < v {
-                        blocked = Some((i, hi));
+                    let bound = if sum > hi && hi < v {
+                        hi
                     } else if sum < lo && lo > -v {
-                        blocked = Some((i, lo));
+                        lo
                     } else {
                         continue;
-                    }
-                    break 'joints;
+                    };
+                    self.clamped[i] = true;
+                    self.fixed_velocity[i] = bound;
+                    self.report.clamped.push(i);
+                    blocked = true;
+                    break;
                 }
             }
-            let Some((i, bound)) = blocked else { break };
-            self.clamped[i] = true;
-            self.fixed_velocity[i] = bound;
-            self.report.clamped.push(i);
+            if !blocked {
+                break;
+            }
         }
         // Running sum of the scaled parts, kept in `velocity`.
         self.velocity.copy_from_slice(&self.base_velocity);
