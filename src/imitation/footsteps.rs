@@ -117,7 +117,8 @@ impl GroundPose {
     }
 }
 
-fn wrap(angle: f64) -> f64 {
+/// `angle` wrapped to [−π, π) (rad).
+pub(crate) fn wrap(angle: f64) -> f64 {
     use std::f64::consts::{PI, TAU};
     (angle + PI).rem_euclid(TAU) - PI
 }
@@ -136,13 +137,6 @@ fn side(foot: Foot) -> Side {
     match foot {
         Foot::Right => Side::Right,
         Foot::Left => Side::Left,
-    }
-}
-
-fn index(foot: Foot) -> usize {
-    match foot {
-        Foot::Right => 0,
-        Foot::Left => 1,
     }
 }
 
@@ -238,8 +232,8 @@ impl FootstepPlanner {
             _ => [Foot::Right, Foot::Left].map(|f| self.target_of(f, feet, ratio)),
         };
         let error = |f: Foot| -> Option<(f64, f64)> {
-            let t = targets[index(f)]?;
-            let d = feet[index(f)].relative(&t);
+            let t = targets[f.index()]?;
+            let d = feet[f.index()].relative(&t);
             Some((d.xy.norm(), d.yaw.abs()))
         };
         let config = self.config;
@@ -250,7 +244,7 @@ impl FootstepPlanner {
             Step::Idle if phase == SupportPhase::Double => {
                 self.step = self.choose(off, error);
                 if let Step::Swing(foot, _) = self.step {
-                    self.target = targets[index(foot)];
+                    self.target = targets[foot.index()];
                 }
             }
             // Without walking the robot imitates the human's one-leg stances: if the human now
@@ -264,12 +258,12 @@ impl FootstepPlanner {
                         if lifted == foot.other() && t >= self.config.stance_time) =>
             {
                 self.step = Step::Swing(foot.other(), 0.0);
-                self.target = targets[index(foot.other())];
+                self.target = targets[foot.other().index()];
             }
             Step::Swing(foot, waited) => {
-                self.target = targets[index(foot)];
+                self.target = targets[foot.index()];
                 let there = error(foot).is_none_or(|(d, a)| d <= 0.005 && a <= 0.035);
-                let human_down = self.down[index(foot)];
+                let human_down = self.down[foot.index()];
                 let single = matches!(phase, SupportPhase::Right | SupportPhase::Left);
                 let waited = if single && human_down {
                     waited + dt
@@ -329,10 +323,10 @@ impl FootstepPlanner {
         };
         self.down = down;
         for foot in [Foot::Right, Foot::Left] {
-            if down[index(foot)]
+            if down[foot.index()]
                 && let Some(print) = footprint(frame, foot)
             {
-                self.human[index(foot)] = Some(print);
+                self.human[foot.index()] = Some(print);
             }
         }
         let lifted = match human {
@@ -351,13 +345,13 @@ impl FootstepPlanner {
     /// around the robot's other foot.
     fn target_of(&self, foot: Foot, feet: [GroundPose; 2], ratio: f64) -> Option<GroundPose> {
         let (human0, robot0, turn) = self.origin?;
-        let (h0, r0) = (human0[index(foot)], robot0[index(foot)]);
-        let print = self.human[index(foot)]?;
+        let (h0, r0) = (human0[foot.index()], robot0[foot.index()]);
+        let print = self.human[foot.index()]?;
         let scaled = GroundPose {
             xy: r0.xy + Rotation2::new(turn) * ((print.xy - h0.xy) * ratio),
             yaw: wrap(r0.yaw + print.yaw - h0.yaw),
         };
-        let other = feet[index(foot.other())];
+        let other = feet[foot.other().index()];
         let local = other.relative(&scaled);
         let clipped = self.config.area.clip(
             side(foot),

@@ -308,13 +308,6 @@ pub struct Imitator {
     output: RobotFrame,
 }
 
-fn foot_index(foot: Foot) -> usize {
-    match foot {
-        Foot::Right => 0,
-        Foot::Left => 1,
-    }
-}
-
 fn axes_of(task: &Task) -> [Option<Axis>; 3] {
     match task {
         Task::ComXY(_) | Task::Orientation { .. } => [Some(Axis::X), Some(Axis::Y), None],
@@ -655,7 +648,7 @@ impl Imitator {
         let phase = self.machine.update(wanted, &self.measurements);
         let changed = phase != self.phase || self.previous_time.is_none();
         self.switch_root(self.phases[phase.index()].table.model_root)?;
-        let root = foot_index(self.root);
+        let root = self.root.index();
 
         let scaled = *self.scaler.scale(frame, human)?;
         self.angles.compute(&scaled, &mut self.human_q)?;
@@ -669,7 +662,7 @@ impl Imitator {
         let root_t_base = if scaled.base() == side_of(self.root) {
             IsometryMatrix3::identity()
         } else {
-            *self.data[root].frame_placement(self.soles[root][foot_index(foot_of(scaled.base()))])
+            *self.data[root].frame_placement(self.soles[root][foot_of(scaled.base()).index()])
         };
         for (out, (_, p)) in self.output.reference.iter_mut().zip(scaled.points()) {
             *out = p.map(|p| root_t_base.transform_point(&p.into()).coords);
@@ -747,7 +740,7 @@ impl Imitator {
         // at ρ, a landing when the highest is on the ground (flat, so that the foot can become
         // the support without tilting the world).
         let swing = phase.swing_foot().unwrap_or(self.root.other());
-        let sole = data.frame_placement(self.soles[root][foot_index(swing)]);
+        let sole = data.frame_placement(self.soles[root][swing.index()]);
         let corner_z = swing
             .sole_outline()
             .map(|[x, y]| sole.transform_point(&Vector3::new(x, y, 0.0).into()).z);
@@ -765,7 +758,7 @@ impl Imitator {
 
         let world_t_root = self.world_t_root;
         let placement = |foot: Foot| -> Result<IsometryMatrix3<f64>, ModelError> {
-            model.placement_in_world(data, &world_t_root, self.soles[root][foot_index(foot)])
+            model.placement_in_world(data, &world_t_root, self.soles[root][foot.index()])
         };
         out.right_sole = placement(Foot::Right)?;
         out.left_sole = placement(Foot::Left)?;
@@ -789,7 +782,7 @@ impl Imitator {
     /// At the start of a step: the held targets of `phase`'s tasks become the frames' current
     /// positions and headings, and the swing height the swing sole's current height.
     fn hold_targets(&mut self, phase: SupportPhase) {
-        let root = foot_index(self.root);
+        let root = self.root.index();
         let data = &self.data[root];
         for task in &mut self.phases[phase.index()].tasks {
             if let Some(f) = task.frame {
@@ -800,7 +793,7 @@ impl Imitator {
             }
         }
         let swing = phase.swing_foot().unwrap_or(self.root.other());
-        let sole = data.frame_placement(self.soles[root][foot_index(swing)]);
+        let sole = data.frame_placement(self.soles[root][swing.index()]);
         self.swing = SwingHeight::at(sole.translation.vector.z);
     }
 
@@ -812,7 +805,7 @@ impl Imitator {
         phase: SupportPhase,
         dt: f64,
     ) -> Result<(Vector2<f64>, f64), ImitationError> {
-        let root = foot_index(self.root);
+        let root = self.root.index();
         let model = self.models.rooted_at(self.root);
         let data = &self.data[root];
         let ps = &self.phases[phase.index()];
@@ -856,7 +849,7 @@ impl Imitator {
 
     /// Re-roots the model at `foot` if it is not already, keeping the world placement.
     fn switch_root(&mut self, foot: Foot) -> Result<(), ImitationError> {
-        let from = foot_index(self.root);
+        let from = self.root.index();
         let model = self.models.rooted_at(self.root);
         model.forward_kinematics(&mut self.data[from], &self.q)?;
         if foot != self.root {
@@ -864,7 +857,7 @@ impl Imitator {
                 nao::switch_support(model, &self.data[from], &self.world_t_root, foot)?;
             self.root = foot;
         }
-        let to = foot_index(self.root);
+        let to = self.root.index();
         self.models
             .rooted_at(self.root)
             .forward_kinematics(&mut self.data[to], &self.q)?;

@@ -224,6 +224,19 @@ fn continuous_name(phase: SupportPhase) -> Option<&'static str> {
     }
 }
 
+/// The tracking errors of [`EFFECTORS`] from their single- and double-support series.
+fn effector_errors(single: &[Series], double: &[Series]) -> Vec<EffectorError> {
+    EFFECTORS
+        .iter()
+        .zip(single.iter().zip(double))
+        .map(|((name, _), (single, double))| EffectorError {
+            name,
+            single_support: single.summary(),
+            double_support: double.summary(),
+        })
+        .collect()
+}
+
 /// Which feet (right, left) stand on the floor in `phase`: the support, and both while the free
 /// foot is on the ground (DS and the CoM steps of the transitions).
 fn standing_feet(phase: SupportPhase) -> [bool; 2] {
@@ -240,13 +253,6 @@ fn standing_feet(phase: SupportPhase) -> [bool; 2] {
         SupportPhase::Left
         | SupportPhase::DoubleToLeft(TakeOff::LiftFoot)
         | SupportPhase::LeftToDouble(Landing::LowerFoot) => [false, true],
-    }
-}
-
-fn foot_index(foot: Foot) -> usize {
-    match foot {
-        Foot::Right => 0,
-        Foot::Left => 1,
     }
 }
 
@@ -346,7 +352,7 @@ impl MetricsRecorder {
     /// Records one frame, as returned by [`Imitator::step`].
     pub fn record(&mut self, imitator: &Imitator, frame: &RobotFrame) -> Result<(), ModelError> {
         let root_model = imitator.models().rooted_at(frame.root);
-        let data = &mut self.data[foot_index(frame.root)];
+        let data = &mut self.data[frame.root.index()];
         root_model.forward_kinematics(data, &frame.q)?;
 
         // Tracking, against the references of the tasks this phase tracks.
@@ -438,7 +444,7 @@ impl MetricsRecorder {
             let now = placement[foot];
             let slip = (now.translation.vector - then.translation.vector).norm();
             let turn = rotation_angle(&(then.rotation.inverse() * now.rotation));
-            let (max_slip, max_turn) = if foot == foot_index(frame.root) {
+            let (max_slip, max_turn) = if foot == frame.root.index() {
                 (&mut self.slip, &mut self.turn)
             } else {
                 (&mut self.held_slip, &mut self.held_turn)
@@ -509,7 +515,7 @@ impl MetricsRecorder {
         model: &crate::model::Model,
         frame: &RobotFrame,
     ) -> Result<(), ModelError> {
-        let data = &self.data[foot_index(frame.root)];
+        let data = &self.data[frame.root.index()];
         let mut robot = [Vector3::zeros(); 2];
         let mut reference = [None; 2];
         for (h, (name, joint)) in EFFECTORS[..2].iter().enumerate() {
@@ -542,15 +548,7 @@ impl MetricsRecorder {
             robot_support_changes: self.sequence.len().saturating_sub(1),
             robot_support_sequence: self.sequence.clone(),
             transition_durations: Spread::of(&mut transitions),
-            effectors: EFFECTORS
-                .iter()
-                .enumerate()
-                .map(|(e, (name, _))| EffectorError {
-                    name,
-                    single_support: self.single[e].summary(),
-                    double_support: self.double[e].summary(),
-                })
-                .collect(),
+            effectors: effector_errors(&self.single, &self.double),
             min_com_margin: self.min_margin,
             frames_com_outside: self.outside,
             joint_limit_violations: self.joint_violations,
@@ -560,15 +558,7 @@ impl MetricsRecorder {
             max_held_foot_slip: self.held_slip,
             max_held_foot_turn: self.held_turn,
             solve_time_us: Spread::of(&mut times),
-            effectors_clip: EFFECTORS
-                .iter()
-                .enumerate()
-                .map(|(e, (name, _))| EffectorError {
-                    name,
-                    single_support: self.single_clip[e].summary(),
-                    double_support: self.double_clip[e].summary(),
-                })
-                .collect(),
+            effectors_clip: effector_errors(&self.single_clip, &self.double_clip),
             hands_clip_lag_removed: {
                 let (errors, _) = self.hands.lag_removed();
                 let cell = |(mean, max, count): (f64, f64, usize)| MeanMax { mean, max, count };

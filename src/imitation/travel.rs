@@ -16,6 +16,8 @@
 
 use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 
+use super::footsteps::wrap;
+
 /// Largest distance (m) between the robot's and the scaled human's stance at which the robot has
 /// caught up.
 pub const CATCH_UP_DISTANCE: f64 = 0.03;
@@ -52,11 +54,6 @@ pub(crate) fn robot_stance(right: &IsometryMatrix3<f64>, left: &IsometryMatrix3<
         point: (right.translation.vector + left.translation.vector).xy() * 0.5,
         heading: forward.y.atan2(forward.x),
     }
-}
-
-fn wrap(angle: f64) -> f64 {
-    use std::f64::consts::{PI, TAU};
-    (angle + PI).rem_euclid(TAU) - PI
 }
 
 /// Follows the human's and the robot's stances over a run.

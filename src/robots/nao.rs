@@ -122,6 +122,14 @@ impl Foot {
         }
     }
 
+    /// 0 for the right foot, 1 for the left: the order of per-foot arrays (right, left).
+    pub const fn index(self) -> usize {
+        match self {
+            Foot::Right => 0,
+            Foot::Left => 1,
+        }
+    }
+
     /// The other foot.
     pub fn other(self) -> Foot {
         match self {
