@@ -343,13 +343,41 @@ fn run(imitator: &mut Imitator, frames: &[HumanFrame]) -> Vec<RobotFrame> {
 #[test]
 fn imitator_config_out_of_range_is_refused_by_name() {
     type Set = fn(&mut ImitatorConfig, f64);
-    let fields: [(&str, Set); 3] = [
+    let fields: [(&str, Set); 9] = [
         ("velocity_fraction", |c, v| c.velocity_fraction = v),
         ("nominal_dt", |c, v| c.nominal_dt = v),
         ("max_task_speed", |c, v| c.max_task_speed = v),
+        ("upper_body_velocity_fraction", |c, v| {
+            c.upper_body_velocity_fraction = Some(v)
+        }),
+        ("com_speed", |c, v| c.motion.com_speed = v),
+        ("com_acceleration", |c, v| c.motion.com_acceleration = v),
+        ("foot_speed", |c, v| c.motion.foot_speed = v),
+        ("touchdown_speed", |c, v| c.motion.touchdown_speed = v),
+        ("landing_time", |c, v| c.motion.landing_time = v),
     ];
     for (name, set) in fields {
         for v in [f64::NAN, f64::INFINITY, 0.0, -1.0] {
+            let mut c = ImitatorConfig::default();
+            set(&mut c, v);
+            let err = Imitator::new(FootRootedModels::nao(), c).err();
+            assert!(
+                matches!(err, Some(ImitationError::InvalidParameter { name: n, .. }) if n == name),
+                "{name} = {v}: {err:?}"
+            );
+        }
+    }
+    // Footstep thresholds may be 0 (step at once) but not negative or NaN.
+    let steps: [(&str, Set); 4] = [
+        ("footsteps.distance", |c, v| c.footsteps.distance = v),
+        ("footsteps.heading", |c, v| c.footsteps.heading = v),
+        ("footsteps.stance_time", |c, v| c.footsteps.stance_time = v),
+        ("footsteps.swing_timeout", |c, v| {
+            c.footsteps.swing_timeout = v
+        }),
+    ];
+    for (name, set) in steps {
+        for v in [f64::NAN, -1.0] {
             let mut c = ImitatorConfig::default();
             set(&mut c, v);
             let err = Imitator::new(FootRootedModels::nao(), c).err();

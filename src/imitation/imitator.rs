@@ -603,8 +603,8 @@ impl Imitator {
         &self.models
     }
 
-    /// The joint bounds the output respects: position limits and the rated velocities times the
-    /// velocity fraction.
+    /// The joint bounds the output respects: position limits, and the rated velocities times
+    /// the velocity fraction (legs) or the upper-body velocity fraction (the other joints).
     pub fn bounds(&self) -> &JointBounds {
         &self.bounds
     }
