@@ -518,53 +518,19 @@ mod tests {
         // Without walking: the foot is lifted in place.
         let mut planner = FootstepPlanner::new(FootstepConfig::default());
         let frame = human([0.0, -0.1], [0.0, 0.1]);
-        planner.update(
-            &frame,
-            HumanSupport::Double,
-            0.25,
-            FEET,
-            SupportPhase::Double,
-            0.01,
-        );
+        let mut step = |human, phase, dt| planner.update(&frame, human, 0.25, FEET, phase, dt);
+        step(HumanSupport::Double, SupportPhase::Double, 0.01);
         let mut support = HumanSupport::Double;
         for _ in 0..29 {
-            support = planner.update(
-                &frame,
-                HumanSupport::Right,
-                0.25,
-                FEET,
-                SupportPhase::Double,
-                0.01,
-            );
+            support = step(HumanSupport::Right, SupportPhase::Double, 0.01);
         }
         assert_eq!(support, HumanSupport::Double, "0.29 s is not yet a stance");
-        let support = planner.update(
-            &frame,
-            HumanSupport::Right,
-            0.25,
-            FEET,
-            SupportPhase::Double,
-            0.02,
-        );
+        let support = step(HumanSupport::Right, SupportPhase::Double, 0.02);
         assert_eq!(support, HumanSupport::Right);
         // In single support with the foot on its target, it stays up while the human's is.
-        let support = planner.update(
-            &frame,
-            HumanSupport::Right,
-            0.25,
-            FEET,
-            SupportPhase::Right,
-            0.01,
-        );
+        let support = step(HumanSupport::Right, SupportPhase::Right, 0.01);
         assert_eq!(support, HumanSupport::Right);
-        let support = planner.update(
-            &frame,
-            HumanSupport::Double,
-            0.25,
-            FEET,
-            SupportPhase::Right,
-            0.01,
-        );
+        let support = step(HumanSupport::Double, SupportPhase::Right, 0.01);
         assert_eq!(support, HumanSupport::Double);
     }
 }

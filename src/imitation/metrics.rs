@@ -541,6 +541,8 @@ impl MetricsRecorder {
     pub fn finish(&self) -> ImitationMetrics {
         let mut times = self.times.clone();
         let mut transitions = self.transitions.clone();
+        // The lag search is quadratic in the clip's frames: once.
+        let (lag_errors, hand_lag_s) = self.hands.lag_removed();
         ImitationMetrics {
             frames: self.frames,
             duration: self.last_time - self.first_time.unwrap_or(self.last_time),
@@ -560,11 +562,10 @@ impl MetricsRecorder {
             solve_time_us: Spread::of(&mut times),
             effectors_clip: effector_errors(&self.single_clip, &self.double_clip),
             hands_clip_lag_removed: {
-                let (errors, _) = self.hands.lag_removed();
                 let cell = |(mean, max, count): (f64, f64, usize)| MeanMax { mean, max, count };
                 EFFECTORS[..2]
                     .iter()
-                    .zip(errors)
+                    .zip(lag_errors)
                     .map(|((name, _), [single, double])| EffectorError {
                         name,
                         single_support: cell(single),
@@ -572,7 +573,7 @@ impl MetricsRecorder {
                     })
                     .collect()
             },
-            hand_lag_s: self.hands.lag_removed().1,
+            hand_lag_s,
             travel: self.travel.travel(),
             human_steps: self.human_steps.steps(),
             robot_steps: self.robot_steps.steps(),
