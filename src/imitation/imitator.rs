@@ -183,6 +183,60 @@ impl Default for ImitatorConfig {
     }
 }
 
+impl ImitatorConfig {
+    /// Checks the imitator's own settings (the phase, table, support and solver settings are
+    /// checked by their owners): every speed, fraction and time finite and > 0, footstep
+    /// thresholds ≥ 0, at least one iteration per frame. The error names the field.
+    fn validate(&self) -> Result<(), ImitationError> {
+        let invalid = |name, value, reason| {
+            Err(ImitationError::InvalidParameter {
+                name,
+                value,
+                reason,
+            })
+        };
+        let positive = [
+            (
+                "velocity_fraction",
+                Some(self.velocity_fraction),
+                "must be finite and > 0",
+            ),
+            (
+                "nominal_dt",
+                Some(self.nominal_dt),
+                "must be finite and > 0 s",
+            ),
+            (
+                "max_task_speed",
+                Some(self.max_task_speed),
+                "must be finite and > 0 m/s",
+            ),
+            (
+                "upper_body_velocity_fraction",
+                self.upper_body_velocity_fraction,
+                "must be finite and > 0",
+            ),
+        ];
+        for (name, value, reason) in positive {
+            if let Some(v) = value
+                && !(v.is_finite() && v > 0.0)
+            {
+                return invalid(name, v, reason);
+            }
+        }
+        if let Some((name, value)) = self.footsteps.invalid_field() {
+            return invalid(name, value, "must be >= 0");
+        }
+        if let Some((name, value)) = self.motion.invalid_field() {
+            return invalid(name, value, "motion limits must be finite and > 0");
+        }
+        if self.iterations_per_frame == 0 {
+            return invalid("iterations_per_frame", 0.0, "must be >= 1");
+        }
+        Ok(())
+    }
+}
+
 /// The NAOqi StandInit-like posture (both feet flat: hip + knee + ankle pitch = 0), in the NAO
 /// variable order of [`nao::VARIABLES`].
 pub const NAO_STAND: [f64; 23] = [
@@ -393,58 +447,8 @@ impl Imitator {
     /// An imitator for a biped's foot-rooted models. The models must have the NAO's variables
     /// and named frames (the scaler's mapping and the joint-angle map are the NAO's).
     pub fn new(models: FootRootedModels, config: ImitatorConfig) -> Result<Self, ImitationError> {
+        config.validate()?;
         let fraction = config.velocity_fraction;
-        if !(fraction.is_finite() && fraction > 0.0) {
-            return Err(ImitationError::InvalidParameter {
-                name: "velocity_fraction",
-                value: fraction,
-                reason: "must be finite and > 0",
-            });
-        }
-        if !(config.nominal_dt.is_finite() && config.nominal_dt > 0.0) {
-            return Err(ImitationError::InvalidParameter {
-                name: "nominal_dt",
-                value: config.nominal_dt,
-                reason: "must be finite and > 0 s",
-            });
-        }
-        if !(config.max_task_speed.is_finite() && config.max_task_speed > 0.0) {
-            return Err(ImitationError::InvalidParameter {
-                name: "max_task_speed",
-                value: config.max_task_speed,
-                reason: "must be finite and > 0 m/s",
-            });
-        }
-        if let Some((name, value)) = config.footsteps.invalid_field() {
-            return Err(ImitationError::InvalidParameter {
-                name,
-                value,
-                reason: "must be >= 0",
-            });
-        }
-        if let Some(fraction) = config.upper_body_velocity_fraction
-            && !(fraction.is_finite() && fraction > 0.0)
-        {
-            return Err(ImitationError::InvalidParameter {
-                name: "upper_body_velocity_fraction",
-                value: fraction,
-                reason: "must be finite and > 0",
-            });
-        }
-        if let Some((name, value)) = config.motion.invalid_field() {
-            return Err(ImitationError::InvalidParameter {
-                name,
-                value,
-                reason: "motion limits must be finite and > 0",
-            });
-        }
-        if config.iterations_per_frame == 0 {
-            return Err(ImitationError::InvalidParameter {
-                name: "iterations_per_frame",
-                value: 0.0,
-                reason: "must be >= 1",
-            });
-        }
         let model = &models.right;
         let nv = model.nv();
         let lower: Vec<f64> = model.variables().iter().map(|v| v.lower).collect();

@@ -754,17 +754,13 @@ impl TaskTable {
                         return Err(TableError::NoAxis { phase, task: name });
                     }
                     Task::Point {
-                        target: PointTarget::Held { lift },
+                        target: PointTarget::Held { lift } | PointTarget::Footstep { lift },
                         ..
                     } if !lift.is_finite() => return Err(not_finite("lift")),
                     Task::Point {
                         target: PointTarget::Standing { lower },
                         ..
                     } if !lower.is_finite() => return Err(not_finite("lower")),
-                    Task::Point {
-                        target: PointTarget::Footstep { lift },
-                        ..
-                    } if !lift.is_finite() => return Err(not_finite("lift")),
                     Task::Orientation {
                         target: OrientationTarget::Upright { lean },
                         ..

@@ -269,27 +269,17 @@ mod tests {
             0.0,
         );
         t.mark_clip_end(1.0);
-        t.record(
-            Some(stance(1.0, 0.0, 0.0)),
-            0.5,
-            stance(0.3, 0.0, 0.0),
-            true,
-            1.5,
-        );
-        t.record(
-            Some(stance(1.0, 0.0, 0.0)),
-            0.5,
-            stance(0.49, 0.0, 0.0),
-            false,
-            2.0,
-        );
-        t.record(
-            Some(stance(1.0, 0.0, 0.0)),
-            0.5,
-            stance(0.49, 0.0, 0.0),
-            true,
-            2.5,
-        );
+        // The scaled human stands 0.5 m ahead; the robot is short of it at 1.5 s, there but on
+        // one foot at 2.0 s, there in double support at 2.5 s: 1.5 s after the clip's end.
+        for (robot_x, double, time) in [(0.3, true, 1.5), (0.49, false, 2.0), (0.49, true, 2.5)] {
+            t.record(
+                Some(stance(1.0, 0.0, 0.0)),
+                0.5,
+                stance(robot_x, 0.0, 0.0),
+                double,
+                time,
+            );
+        }
         assert_eq!(t.catch_up(), Some(1.5));
     }
 
