@@ -145,8 +145,9 @@ fn double_support_clip_never_leaves_double_support() {
 }
 
 /// Walking (`FootstepConfig::follow`), the robot steps with both feet on the walks and goes the
-/// human's way: it travels at least half the scaled human's distance in the clip and a
-/// 60 s hold.
+/// human's way: it travels at least a third of the scaled human's distance in the clip and a
+/// 60 s hold (a step takes 5–7 s: before a foot lifts, the torso leans over the stance foot,
+/// and it comes back upright after the landing).
 #[test]
 fn walks_are_walked() {
     for name in [
@@ -175,7 +176,7 @@ fn walks_are_walked() {
         );
         assert!(m.robot_steps >= 2, "{name}: {} robot steps", m.robot_steps);
         assert!(
-            m.travel.robot_m > m.travel.scaled_human_m / 2.0,
+            m.travel.robot_m > m.travel.scaled_human_m / 3.0,
             "{name}: {:?}",
             m.travel
         );

@@ -2,7 +2,7 @@
 
 use proptest::prelude::*;
 use taskstack::imitation::phase::{
-    Landing, Measurements, PhaseConfig, PhaseError, PhaseMachine, SupportPhase, TakeOff,
+    Landing, Measurements, PhaseConfig, PhaseError, PhaseMachine, Settling, SupportPhase, TakeOff,
 };
 use taskstack::imitation::support::HumanSupport;
 use taskstack::imitation::tables::{Gradient, GradientKind, TableError, Task, TaskTables};
@@ -14,30 +14,40 @@ use SupportPhase as P;
 /// CoM far from its goal (40 mm > 5 mm tolerance), swing sole on the ground.
 const FAR: Measurements = Measurements {
     com_error: 0.040,
+    posture_error: 0.0,
+    posture_settled: false,
     swing_toe_height: 0.0,
     swing_heel_height: 0.0,
 };
 /// CoM 1 mm from its goal (< 5 mm), swing sole on the ground.
 const COM_OK: Measurements = Measurements {
     com_error: 0.001,
+    posture_error: 0.0,
+    posture_settled: false,
     swing_toe_height: 0.0,
     swing_heel_height: 0.0,
 };
 /// Swing sole half-way up (10 mm: neither ≥ ρ − 2 mm = 28 mm nor ≤ 2 mm).
 const HALF_UP: Measurements = Measurements {
     com_error: 0.001,
+    posture_error: 0.0,
+    posture_settled: false,
     swing_toe_height: 0.010,
     swing_heel_height: 0.010,
 };
 /// Swing sole lifted: toe 30 mm, heel 28.5 mm, both ≥ 28 mm.
 const LIFTED: Measurements = Measurements {
     com_error: 0.001,
+    posture_error: 0.0,
+    posture_settled: false,
     swing_toe_height: 0.030,
     swing_heel_height: 0.0285,
 };
 /// Swing sole down: 1 mm ≤ 2 mm.
 const DOWN: Measurements = Measurements {
     com_error: 0.040,
+    posture_error: 0.0,
+    posture_settled: false,
     swing_toe_height: 0.001,
     swing_heel_height: 0.001,
 };
@@ -62,6 +72,101 @@ fn config() -> PhaseConfig {
 
 fn machine() -> PhaseMachine {
     PhaseMachine::new(config()).unwrap()
+}
+
+#[test]
+fn a_foot_lifts_only_once_the_torso_leans_over_the_stance_foot() {
+    // CoM on its goal, torso 0.05 rad from its lean (> 0.03 rad): the foot stays down, and the
+    // same holds for the CoM's return to the middle; within the tolerance both steps end.
+    let leaning = Measurements {
+        posture_error: 0.05,
+        posture_settled: false,
+        ..COM_OK
+    };
+    let leant = Measurements {
+        posture_error: 0.02,
+        posture_settled: false,
+        ..COM_OK
+    };
+    let mut m = machine();
+    run(
+        &mut m,
+        &[
+            (H::Right, leaning, P::DoubleToRight(TakeOff::ComToFoot)),
+            (H::Right, leaning, P::DoubleToRight(TakeOff::ComToFoot)),
+            (H::Right, leant, P::DoubleToRight(TakeOff::LiftFoot)),
+            (H::Right, LIFTED, P::Right),
+            (H::Double, DOWN, P::RightToDouble(Landing::LowerFoot)),
+            (H::Double, leaning, P::RightToDouble(Landing::ComToMiddle)),
+            (H::Double, leaning, P::RightToDouble(Landing::ComToMiddle)),
+            (H::Double, leant, P::Double),
+        ],
+    );
+}
+
+#[test]
+fn a_lean_that_cannot_be_reached_does_not_keep_the_robot_waiting() {
+    // The torso stopped 0.3 rad short of its lean (a joint limit): the CoM step ends anyway.
+    let stuck = Measurements {
+        posture_error: 0.3,
+        posture_settled: true,
+        ..COM_OK
+    };
+    let moving = Measurements {
+        posture_settled: false,
+        ..stuck
+    };
+    let mut m = machine();
+    run(
+        &mut m,
+        &[
+            (H::Left, moving, P::DoubleToLeft(TakeOff::ComToFoot)),
+            (H::Left, moving, P::DoubleToLeft(TakeOff::ComToFoot)),
+            (H::Left, stuck, P::DoubleToLeft(TakeOff::LiftFoot)),
+        ],
+    );
+}
+
+#[test]
+fn an_error_settles_after_a_quarter_second_without_a_milliradian_of_progress() {
+    let mut s = Settling::new();
+    // 0.1 s frames. 0.3 → 0.2 is progress; 0.2 → 0.1995 (0.5 mrad) is not, nor is standing
+    // still: settled once 0.25 s have passed since the last progress, at the third such frame.
+    let steps = [
+        (0.3, false),
+        (0.2, false),
+        (0.1995, false),
+        (0.1995, false),
+        (0.2, true),
+        // 2 mrad of progress restarts the wait.
+        (0.197, false),
+        (f64::NAN, false),
+    ];
+    for (i, (error, settled)) in steps.into_iter().enumerate() {
+        assert_eq!(s.update(error, 0.1), settled, "step {i}: error {error}");
+    }
+}
+
+#[test]
+fn a_foot_below_the_floor_has_not_landed() {
+    // 3 mm below the floor is as far from flat on it as 3 mm above (tolerance 2 mm).
+    let below = Measurements {
+        swing_toe_height: -0.003,
+        swing_heel_height: 0.0,
+        ..DOWN
+    };
+    let mut m = machine();
+    run(
+        &mut m,
+        &[
+            (H::Right, COM_OK, P::DoubleToRight(TakeOff::ComToFoot)),
+            (H::Right, COM_OK, P::DoubleToRight(TakeOff::LiftFoot)),
+            (H::Right, LIFTED, P::Right),
+            (H::Double, below, P::RightToDouble(Landing::LowerFoot)),
+            (H::Double, below, P::RightToDouble(Landing::LowerFoot)),
+            (H::Double, DOWN, P::RightToDouble(Landing::ComToMiddle)),
+        ],
+    );
 }
 
 #[test]
@@ -171,6 +276,8 @@ fn airborne_keeps_the_last_support() {
 fn nan_measurements_never_end_a_step() {
     let nan = Measurements {
         com_error: f64::NAN,
+        posture_error: f64::NAN,
+        posture_settled: false,
         swing_toe_height: f64::NAN,
         swing_heel_height: f64::NAN,
     };
@@ -221,6 +328,13 @@ fn bad_config_is_rejected_naming_the_field() {
                 ..PhaseConfig::default()
             },
             "support_margin",
+        ),
+        (
+            PhaseConfig {
+                posture_tolerance: 0.0,
+                ..PhaseConfig::default()
+            },
+            "posture_tolerance",
         ),
         // ρ = 4 mm ≤ 2 × 2 mm: a foot could be "lifted" and "on the ground" at once.
         (
@@ -432,11 +546,20 @@ fn measurement() -> impl Strategy<Value = Measurements> {
         Just(f64::INFINITY),
         -0.01..0.06f64,
     ];
-    (length.clone(), length.clone(), length).prop_map(|(c, t, h)| Measurements {
-        com_error: c,
-        swing_toe_height: t,
-        swing_heel_height: h,
-    })
+    (
+        length.clone(),
+        length.clone(),
+        length.clone(),
+        length,
+        any::<bool>(),
+    )
+        .prop_map(|(c, p, t, h, settled)| Measurements {
+            com_error: c,
+            posture_error: p,
+            posture_settled: settled,
+            swing_toe_height: t,
+            swing_heel_height: h,
+        })
 }
 
 proptest! {

@@ -9,19 +9,24 @@
 //! | DS | — | right sole | (continuous) |
 //! | RS | — | right sole | (continuous) |
 //! | LS | — | left sole | (continuous) |
-//! | DS → RS | CoM to RFoot | right sole | `e_c ≤ com_tolerance` |
+//! | DS → RS | CoM to RFoot | right sole | `e_c ≤ com_tolerance`, posture reached |
 //! | DS → RS | Lift LFoot | right sole | `min(h_toe, h_heel) ≥ ρ − foot_height_tolerance` |
-//! | DS → LS | CoM to LFoot | right sole | `e_c ≤ com_tolerance` |
+//! | DS → LS | CoM to LFoot | right sole | `e_c ≤ com_tolerance`, posture reached |
 //! | DS → LS | Lift RFoot | left sole | `min(h_toe, h_heel) ≥ ρ − foot_height_tolerance` |
-//! | RS → DS | Lower LFoot | right sole | `max(h_toe, h_heel) ≤ foot_height_tolerance` |
-//! | RS → DS | CoM to middle | right sole | `e_c ≤ com_tolerance` |
-//! | LS → DS | Lower RFoot | left sole | `max(h_toe, h_heel) ≤ foot_height_tolerance` |
-//! | LS → DS | CoM to middle | right sole | `e_c ≤ com_tolerance` |
+//! | RS → DS | Lower LFoot | right sole | `max(|h_toe|, |h_heel|) ≤ foot_height_tolerance` |
+//! | RS → DS | CoM to middle | right sole | `e_c ≤ com_tolerance`, posture reached |
+//! | LS → DS | Lower RFoot | left sole | `max(|h_toe|, |h_heel|) ≤ foot_height_tolerance` |
+//! | LS → DS | CoM to middle | right sole | `e_c ≤ com_tolerance`, posture reached |
 //!
 //! `e_c` is the horizontal distance (m) between the CoM ground projection and the current step's
-//! CoM goal; `h_toe`, `h_heel` are the heights (m) above the ground of the swing foot's toe and
-//! heel points ([`SupportPhase::swing_foot`]). A step whose condition is not met is repeated at
-//! the next update. A NaN measurement never meets a condition, so it never ends a step.
+//! CoM goal. The posture is reached when the torso is within `posture_tolerance` (rad) of its
+//! target orientation, or has come as close as it can ([`Measurements::posture_settled`]: a
+//! lean that a wide stance or a joint limit forbids must not keep the robot waiting forever);
+//! tables without a torso task (the paper's) always reach it. `h_toe`, `h_heel` are the heights
+//! (m) above the ground of the swing foot's toe and heel points ([`SupportPhase::swing_foot`]);
+//! a landing ends with the foot flat on the floor, not above it and not below it. A step whose
+//! condition is not met is repeated at the next update. A NaN measurement never meets a
+//! condition, so it never ends a step.
 //!
 //! # Transition graph
 //!
@@ -242,11 +247,16 @@ pub struct PhaseConfig {
     /// far the CoM goes past the hip, and at the sole's centre a NAO's hip roll servo works at
     /// 88 % of its rated torque (Poubel's [0, 0] under the ankle is worse). Default 15 mm.
     pub support_margin: f64,
+    /// A CoM step also waits until the torso is within this angle (rad) of its target
+    /// orientation: a foot lifts only once the torso leans over the stance foot, because until
+    /// then the stance hip's roll servo holds the upper body out to the side (on a NAO beyond
+    /// its torque limit when the servos are weak). Default 0.03 rad.
+    pub posture_tolerance: f64,
 }
 
 impl Default for PhaseConfig {
     /// The paper's λ = 15 mm and ρ = 30 mm, with a 5 mm CoM and a 1 µm foot height tolerance
-    /// and a 15 mm support margin.
+    /// a 15 mm support margin and a 0.03 rad posture tolerance.
     fn default() -> Self {
         Self {
             com_tolerance: 0.005,
@@ -254,6 +264,7 @@ impl Default for PhaseConfig {
             rho: 0.030,
             foot_height_tolerance: 0.000001,
             support_margin: 0.015,
+            posture_tolerance: 0.03,
         }
     }
 }
@@ -266,6 +277,12 @@ impl PhaseConfig {
         if !positive(self.com_tolerance) {
             return Err(PhaseError::Config(
                 "com_tolerance",
+                "must be finite and > 0",
+            ));
+        }
+        if !positive(self.posture_tolerance) {
+            return Err(PhaseError::Config(
+                "posture_tolerance",
                 "must be finite and > 0",
             ));
         }
@@ -302,16 +319,70 @@ pub enum PhaseError {
     Config(&'static str, &'static str),
 }
 
-/// What the robot achieved at the last solve, in the current phase (metres).
+/// What the robot achieved at the last solve, in the current phase (metres, radians).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Measurements {
     /// Horizontal distance between the CoM ground projection and the current phase's CoM goal.
     pub com_error: f64,
-    /// Height above the ground of the swing foot's toe point ([`SupportPhase::swing_foot`]);
-    /// ignored in DS.
+    /// Angle (rad) between the torso and its target orientation; 0 when the phase's table
+    /// has no torso task.
+    pub posture_error: f64,
+    /// Whether the torso has stopped approaching its target orientation in this step (the
+    /// higher levels or the joint limits keep it where it is), so that waiting longer for
+    /// [`PhaseConfig::posture_tolerance`] is pointless.
+    pub posture_settled: bool,
+    /// Height above the ground of the swing foot's toe point ([`SupportPhase::swing_foot`]),
+    /// negative below it; ignored in DS.
     pub swing_toe_height: f64,
-    /// Height above the ground of the swing foot's heel point; ignored in DS.
+    /// Height above the ground of the swing foot's heel point, negative below it; ignored in
+    /// DS.
     pub swing_heel_height: f64,
+}
+
+/// Whether an error has stopped shrinking: it has not come down by [`Settling::PROGRESS`] below
+/// its smallest value for [`Settling::PATIENCE`]. The imitator watches the torso's posture error
+/// with it ([`Measurements::posture_settled`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Settling {
+    best: f64,
+    waited: f64,
+}
+
+impl Settling {
+    /// Progress that counts (rad): 1 mrad.
+    pub const PROGRESS: f64 = 1e-3;
+    /// How long the error may stay without progress before it counts as settled (s).
+    pub const PATIENCE: f64 = 0.25;
+
+    /// Watching starts (at a new step): nothing has settled yet.
+    pub fn new() -> Self {
+        Self {
+            best: f64::INFINITY,
+            waited: 0.0,
+        }
+    }
+
+    /// Records `error` after `dt` seconds; returns whether it has settled. A NaN error never
+    /// settles.
+    pub fn update(&mut self, error: f64, dt: f64) -> bool {
+        if error.is_nan() {
+            *self = Self::new();
+            return false;
+        }
+        if error < self.best - Self::PROGRESS || self.best.is_infinite() {
+            self.best = error;
+            self.waited = 0.0;
+        } else {
+            self.waited += dt;
+        }
+        self.waited >= Self::PATIENCE
+    }
+}
+
+impl Default for Settling {
+    fn default() -> Self {
+        Self::new()
+    }
 }
 
 /// The support phase state machine (see the module docs for the graph).
@@ -321,7 +392,13 @@ pub struct Measurements {
 /// use taskstack::imitation::support::HumanSupport;
 ///
 /// let mut machine = PhaseMachine::new(PhaseConfig::default())?;
-/// let far = Measurements { com_error: 0.04, swing_toe_height: 0.0, swing_heel_height: 0.0 };
+/// let far = Measurements {
+///     com_error: 0.04,
+///     posture_error: 0.0,
+///     posture_settled: false,
+///     swing_toe_height: 0.0,
+///     swing_heel_height: 0.0,
+/// };
 /// // The human lifts the left foot: the robot first moves its CoM over the right foot.
 /// assert_eq!(
 ///     machine.update(HumanSupport::Right, &far),
@@ -415,9 +492,11 @@ impl Done {
         let (toe, heel) = (m.swing_toe_height, m.swing_heel_height);
         let lift_goal = config.rho - config.foot_height_tolerance;
         Self {
-            com: m.com_error <= config.com_tolerance,
+            com: m.com_error <= config.com_tolerance
+                && (m.posture_error <= config.posture_tolerance || m.posture_settled),
             lifted: toe >= lift_goal && heel >= lift_goal,
-            grounded: toe <= config.foot_height_tolerance && heel <= config.foot_height_tolerance,
+            grounded: toe.abs() <= config.foot_height_tolerance
+                && heel.abs() <= config.foot_height_tolerance,
         }
     }
 }

@@ -24,6 +24,14 @@ pub trait TaskModel {
     /// its task **error** `x* − x(q)` (task units) into `stack`; and the gradient term
     /// `Σ κ_k ∇f_k(q)` (or clears it).
     fn evaluate(&mut self, q: &[f64], stack: &mut TaskStack) -> Result<(), Self::Error>;
+
+    /// Largest error norm task `task` (stack order, from 0) may ask for in one iteration, in
+    /// task units, when it differs from [`DriverSettings::max_task_error`]: a task the caller
+    /// lets move faster (a hand following a human) or slower than the rest. Default: none; a limit that is not > 0 (NaN, 0) is ignored.
+    fn max_task_error(&self, task: usize) -> Option<f64> {
+        let _ = task;
+        None
+    }
 }
 
 /// Settings of the position-level iteration.
@@ -210,7 +218,7 @@ impl PositionDriver {
                 break StopReason::IterationLimit;
             }
             self.previous.copy_from_slice(errors);
-            self.set_velocities(solver.stack_mut());
+            self.set_velocities(model, solver.stack_mut());
             solver.solve(q, &self.step_bounds, s.dt)?;
             for (qi, v) in q.iter_mut().zip(solver.velocity()) {
                 *qi += v * s.dt;
@@ -225,13 +233,18 @@ impl PositionDriver {
         Ok(&self.report)
     }
 
-    /// `ẋ = K e`, with each task's error clipped to `max_task_error`.
-    fn set_velocities(&self, stack: &mut TaskStack) {
-        let (gain, limit) = (self.settings.gain, self.settings.max_task_error);
+    /// `ẋ = K e`, with each task's error clipped to the model's limit for it or to
+    /// `max_task_error`.
+    fn set_velocities<M: TaskModel>(&self, model: &M, stack: &mut TaskStack) {
+        let gain = self.settings.gain;
         let errors = &self.report.task_errors;
         let mut level = 0;
         for t in 0..errors.len() {
             let (start, end) = (self.task_start[t], self.task_start[t + 1]);
+            let limit = model
+                .max_task_error(t)
+                .filter(|l| *l > 0.0)
+                .unwrap_or(self.settings.max_task_error);
             while start >= stack.level_start(level + 1) {
                 level += 1;
             }

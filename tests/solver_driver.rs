@@ -1,0 +1,74 @@
+//! The position-level driver's per-task error limits ([`TaskModel::max_task_error`]).
+
+use taskstack::solver::driver::{DriverSettings, PositionDriver, TaskModel};
+use taskstack::solver::{JointBounds, Solver, SolverError, StackShape, TaskStack};
+
+/// Two joints, two tasks of one level, `x_k = q_k` with target 1; task 1's error limit is
+/// `limit` when given.
+struct Pair {
+    limit: Option<f64>,
+}
+
+impl TaskModel for Pair {
+    type Error = SolverError;
+    fn evaluate(&mut self, q: &[f64], stack: &mut TaskStack) -> Result<(), SolverError> {
+        let mut level = stack.level_mut(0);
+        level.set_row(0, &[1.0, 0.0], 1.0 - q[0])?;
+        level.set_row(1, &[0.0, 1.0], 1.0 - q[1])?;
+        stack.clear_gradient();
+        Ok(())
+    }
+
+    fn max_task_error(&self, task: usize) -> Option<f64> {
+        if task == 1 { self.limit } else { None }
+    }
+}
+
+/// One Gauss–Newton step (K Δt = 1) from q = 0 with the default limit 0.05.
+fn one_step(limit: Option<f64>) -> [f64; 2] {
+    let shape = StackShape::new(2).with_level("x", &[("a", 1), ("b", 1)]);
+    let mut solver = Solver::new(&shape).unwrap();
+    let settings = DriverSettings {
+        max_iterations: 1,
+        max_joint_step: f64::INFINITY,
+        ..DriverSettings::default()
+    };
+    let mut driver = PositionDriver::new(&solver, settings).unwrap();
+    let mut q = [0.0, 0.0];
+    driver
+        .run(
+            &mut solver,
+            &mut Pair { limit },
+            &mut q,
+            &JointBounds::unbounded(2),
+        )
+        .unwrap();
+    q
+}
+
+#[test]
+fn a_task_with_its_own_limit_steps_by_that_limit() {
+    // Both errors are 1: the first task steps by the driver's 0.05, the second by its own 0.2.
+    let q = one_step(Some(0.2));
+    assert!(
+        (q[0] - 0.05).abs() < 1e-12 && (q[1] - 0.2).abs() < 1e-12,
+        "{q:?}"
+    );
+    // A limit past the error does not clip it: the second task is reached in one step.
+    let q = one_step(Some(f64::INFINITY));
+    assert!(
+        (q[0] - 0.05).abs() < 1e-12 && (q[1] - 1.0).abs() < 1e-12,
+        "{q:?}"
+    );
+}
+
+#[test]
+fn a_limit_that_is_not_positive_falls_back_to_the_driver_setting() {
+    for limit in [None, Some(f64::NAN), Some(0.0), Some(-1.0)] {
+        let q = one_step(limit);
+        assert!(
+            (q[0] - 0.05).abs() < 1e-12 && (q[1] - 0.05).abs() < 1e-12,
+            "{limit:?}: {q:?}"
+        );
+    }
+}
