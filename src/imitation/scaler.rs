@@ -429,8 +429,8 @@ pub struct FootArea {
 impl FootArea {
     /// For the NAO: x ∈ [−0.04, 0.05], lateral ∈ [0.095, 0.12], |yaw| ≤ 0.15. The lateral bounds
     /// come from its 0.1 m hip width (the feet stay 95 mm apart, uncrossed); the forward ones
-    /// from stepping with the torso upright 10 mm below its standing height and the CoM over the
-    /// stance foot: at 8 cm (NAOqi's largest step) the swing knee is straight when the foot
+    /// from stepping with the torso 20 mm below its standing height (`TORSO_LOWERING`) and the
+    /// CoM over the stance foot: at 8 cm (NAOqi's largest step) the swing knee is straight when the foot
     /// lands, and double support with the feet that far apart leaves the legs no posture to
     /// hold the torso with.
     pub const fn nao() -> Self {
