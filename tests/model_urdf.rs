@@ -261,3 +261,65 @@ fn fixed_links_fold_mass_com_and_inertia() {
     let expected = nalgebra::Matrix3::from_diagonal(&nalgebra::Vector3::new(0.8, 0.3, 1.1));
     assert!((at_b.links()[0].inertia.unwrap() - expected).amax() < 1e-15);
 }
+
+/// `TREE` behind a free base: a `floating` joint from a massless `world` link to `base`.
+fn tree_on_free_base() -> String {
+    TREE.replace(
+        r#"<robot name="test_tree">"#,
+        r#"<robot name="test_tree"><link name="world"/>
+        <joint name="free" type="floating"><parent link="world"/><child link="base"/></joint>"#,
+    )
+}
+
+#[test]
+fn a_free_base_is_dropped_and_its_child_is_the_default_root() {
+    let plain = load(TREE).unwrap();
+    let floating = load(&tree_on_free_base()).unwrap();
+    assert_eq!(floating, plain);
+    // Rooted elsewhere, the same: the world link and its joint are gone, not re-rooted.
+    let at = |text: &str| {
+        Model::from_urdf_str(
+            text,
+            &UrdfOptions {
+                root_link: Some("tool".into()),
+                ..UrdfOptions::default()
+            },
+        )
+        .unwrap()
+    };
+    assert_eq!(at(&tree_on_free_base()), at(TREE));
+    let err = Model::from_urdf_str(
+        &tree_on_free_base(),
+        &UrdfOptions {
+            root_link: Some("world".into()),
+            ..UrdfOptions::default()
+        },
+    )
+    .unwrap_err();
+    assert_eq!(err, UrdfError::UnknownRootLink("world".into()));
+}
+
+#[test]
+fn a_floating_joint_inside_the_tree_is_refused() {
+    // Between two links with mass it is a real 6-DoF joint, which a fixed-base tree cannot hold.
+    let text = TREE.replacen(r#"type="revolute""#, r#"type="floating""#, 1);
+    let err = load(&text).unwrap_err();
+    assert!(
+        matches!(&err, UrdfError::UnsupportedJointType { kind, .. } if kind == "floating"),
+        "{err:?}"
+    );
+    // A world link with mass is a body, not a stand-in for the world.
+    let heavy = tree_on_free_base().replace(
+        r#"<link name="world"/>"#,
+        r#"<link name="world"><inertial><mass value="1.0"/>
+        <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>"#,
+    );
+    let err = load(&heavy).unwrap_err();
+    assert_eq!(
+        err,
+        UrdfError::UnsupportedJointType {
+            joint: "free".into(),
+            kind: "floating".into()
+        }
+    );
+}

@@ -219,8 +219,9 @@ pub enum ModelError {
     NoMass,
 }
 
-/// An immutable kinematic tree (see the [module docs](self) for the maths).
-#[derive(Debug, Clone)]
+/// An immutable kinematic tree (see the [module docs](self) for the maths). Two models are equal
+/// when their links, joints, variables and frames are.
+#[derive(Debug, Clone, PartialEq)]
 pub struct Model {
     name: String,
     links: Vec<Link>,

@@ -16,7 +16,10 @@
 //! theorem about `c`). A `<mimic>` joint
 //! `v = μ·v_t + o` of a free joint `t` becomes a joint driven by `t`'s variable; mimics of mimics
 //! compose; mimics of locked joints are locked too. Continuous joints are revolute joints with
-//! infinite limits. All lengths metres, angles radians, masses kilograms.
+//! infinite limits. A free base — a `floating` joint from a massless link with no other joint,
+//! the `world → pelvis` of most humanoid descriptions — is dropped: a model is a fixed-base tree
+//! and rooting it (at a sole, say) is what replaces the free base. All lengths metres, angles
+//! radians, masses kilograms.
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -115,7 +118,9 @@ pub enum UrdfError {
     /// A link is not connected to the root, or the joints form a loop.
     #[error("link `{0}` is not reachable from the root as a tree (disconnected or in a loop)")]
     NotATree(String),
-    /// Floating, planar or spherical joints are not supported.
+    /// Planar or spherical joints are not supported, nor floating joints other than a free base
+    /// (a `floating` joint from a massless world link, which is dropped: the model's root
+    /// replaces it).
     #[error("joint `{joint}`: unsupported type {kind}")]
     UnsupportedJointType {
         /// Joint name.
@@ -211,7 +216,9 @@ pub enum UrdfError {
 impl Model {
     /// Builds a model from URDF text (see [`urdf`](self)).
     pub fn from_urdf_str(text: &str, options: &UrdfOptions) -> Result<Model, UrdfError> {
-        let robot = urdf_rs::read_from_string(text).map_err(|e| UrdfError::Xml(e.to_string()))?;
+        let mut robot =
+            urdf_rs::read_from_string(text).map_err(|e| UrdfError::Xml(e.to_string()))?;
+        drop_free_base(&mut robot);
         build(&robot, options)
     }
 
@@ -226,6 +233,35 @@ impl Model {
             message: e.to_string(),
         })?;
         Model::from_urdf_str(&text, options)
+    }
+}
+
+/// Removes a free base: a `floating` joint whose parent link is a massless stand-in for the world
+/// (no other joint, as in `world → pelvis` of the Unitree and many ROS descriptions). A model is
+/// a fixed-base tree rooted where the caller says (a sole, usually); the free base is what the
+/// rooting replaces, so the joint and the world link go and the joint's child becomes the
+/// default root. Any other `floating` joint stays and is refused by [`check_joint`].
+fn drop_free_base(robot: &mut urdf_rs::Robot) {
+    let joints_at = |joints: &[urdf_rs::Joint], link: &str| {
+        joints
+            .iter()
+            .filter(|j| j.parent.link == link || j.child.link == link)
+            .count()
+    };
+    let massless = |robot: &urdf_rs::Robot, link: &str| {
+        robot
+            .links
+            .iter()
+            .any(|l| l.name == link && l.inertial.mass.value == 0.0)
+    };
+    let free_base = robot.joints.iter().position(|j| {
+        j.joint_type == JointType::Floating
+            && joints_at(&robot.joints, &j.parent.link) == 1
+            && massless(robot, &j.parent.link)
+    });
+    if let Some(j) = free_base {
+        let world = robot.joints.remove(j).parent.link;
+        robot.links.retain(|l| l.name != world);
     }
 }
 
