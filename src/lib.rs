@@ -7,3 +7,4 @@ pub mod io;
 pub mod model;
 pub mod robots;
 pub mod solver;
+pub mod tasks;

@@ -343,6 +343,21 @@ impl LevelMut<'_> {
         self.target
     }
 
+    /// Rows `first..first + rows` of the Jacobian (an `rows × n` view) and of the desired
+    /// velocity, together: one task's block, written in place.
+    ///
+    /// # Panics
+    /// If `first + rows` exceeds [`LevelMut::rows`].
+    pub fn rows_mut(&mut self, first: usize, rows: usize) -> (MatMut<'_, f64>, &mut [f64]) {
+        (
+            self.jacobian_t
+                .as_mut()
+                .transpose_mut()
+                .subrows_mut(first, rows),
+            &mut self.target[first..first + rows],
+        )
+    }
+
     /// Sets row `row`: its Jacobian entries (`n` values) and its desired velocity.
     pub fn set_row(
         &mut self,

@@ -1,0 +1,75 @@
+//! The centre of mass at a target.
+
+use std::any::Any;
+
+use faer::MatMut;
+use nalgebra::Vector3;
+
+use super::{Task, TaskError, finite_target};
+use crate::model::{Model, ModelData, ModelError};
+
+/// The whole-body centre of mass at a target in the base frame (m): its ground projection (x, y;
+/// [`ComTask::ground`], the balance task of a robot rooted at a sole) or all of x, y, z
+/// ([`ComTask::new`]). Named `"com"`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ComTask {
+    rows: usize,
+    /// Target (m, base frame); z is read only by a three-row task.
+    pub target: Vector3<f64>,
+}
+
+impl ComTask {
+    /// The CoM at `target` (x, y, z).
+    ///
+    /// # Errors
+    /// [`TaskError::Model`] when the model has no mass, [`TaskError::NonFiniteTarget`].
+    pub fn new(model: &Model, target: Vector3<f64>) -> Result<Self, TaskError> {
+        Self::with_rows(model, 3, target)
+    }
+
+    /// The CoM's ground projection at `xy` (x, y), its height free.
+    ///
+    /// # Errors
+    /// As [`ComTask::new`].
+    pub fn ground(model: &Model, xy: [f64; 2]) -> Result<Self, TaskError> {
+        Self::with_rows(model, 2, Vector3::new(xy[0], xy[1], 0.0))
+    }
+
+    fn with_rows(model: &Model, rows: usize, target: Vector3<f64>) -> Result<Self, TaskError> {
+        finite_target("com", target.as_slice())?;
+        if model.total_mass() <= 0.0 {
+            return Err(ModelError::NoMass.into());
+        }
+        Ok(Self { rows, target })
+    }
+}
+
+impl Task for ComTask {
+    fn name(&self) -> &str {
+        "com"
+    }
+
+    fn rows(&self) -> usize {
+        self.rows
+    }
+
+    fn write(
+        &self,
+        model: &Model,
+        data: &ModelData,
+        _q: &[f64],
+        jacobian: MatMut<'_, f64>,
+        error: &mut [f64],
+    ) -> Result<(), ModelError> {
+        model.com_jacobian_rows(data, self.rows, jacobian)?;
+        let c = model.com(data)?;
+        for r in 0..self.rows {
+            error[r] = self.target[r] - c[r];
+        }
+        Ok(())
+    }
+
+    fn as_any_mut(&mut self) -> &mut dyn Any {
+        self
+    }
+}

@@ -1,0 +1,133 @@
+//! Ready-made tasks for the solver, built from a [`Model`] by frame name: a frame's position
+//! ([`PositionTask`]), orientation ([`OrientationTask`]) or both ([`PoseTask`]), the centre of
+//! mass ([`ComTask`]) and a joint posture ([`PostureTask`]); and [`TaskSet`], which stacks them in
+//! priority levels and drives the solver with them ([`TaskModel`](crate::solver::driver::TaskModel)).
+//!
+//! Every task writes, for the configuration whose forward kinematics a [`ModelData`] holds, its
+//! Jacobian `J` (rows × nv) and its error `e = x* − x(q)` in task units (metres, radians). The
+//! position-level driver then solves `J q̇ = K e` level by level (see [`crate::solver::driver`]);
+//! with `K Δt = 1` each iteration is a Gauss–Newton step. Orientation errors are rotation vectors
+//! in the base frame, `e = log(R* Rᵀ)` (radians), whose rate is `−ω` to first order: `J` is then
+//! the angular-velocity Jacobian.
+//!
+//! ```
+//! use nalgebra::Vector3;
+//! use taskstack::robots::nao;
+//! use taskstack::solver::driver::{DriverSettings, PositionDriver};
+//! use taskstack::solver::Solver;
+//! use taskstack::tasks::{joint_bounds, ComTask, PositionTask, TaskSet};
+//!
+//! let model = nao::rfoot();
+//! let hand = PositionTask::new(&model, "l_hand", Vector3::new(0.15, 0.1, 0.35))?;
+//! let com = ComTask::ground(&model, [0.0, 0.05])?;
+//! let mut set = TaskSet::new(&model)
+//!     .level("balance", vec![Box::new(com)])
+//!     .level("reach", vec![Box::new(hand)]);
+//! let mut solver = Solver::new(&set.shape())?;
+//! let mut driver = PositionDriver::new(&solver, DriverSettings::default())?;
+//! let mut q = vec![0.0; model.nv()];
+//! let report = driver.run(&mut solver, &mut set, &mut q, &joint_bounds(&model)?)?;
+//! assert!(report.task_errors()[0] < 1e-4); // the CoM first
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+mod com;
+mod orientation;
+mod pose;
+mod position;
+mod posture;
+mod set;
+
+use std::any::Any;
+use std::fmt::Debug;
+
+use faer::MatMut;
+use thiserror::Error;
+
+use crate::model::{Model, ModelData, ModelError};
+use crate::solver::{JointBounds, SolverError};
+
+pub use com::ComTask;
+pub use orientation::OrientationTask;
+pub use pose::PoseTask;
+pub use position::PositionTask;
+pub use posture::PostureTask;
+pub use set::TaskSet;
+
+/// Errors of building or evaluating tasks.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum TaskError {
+    /// A model error: unknown frame or variable, kinematics not computed, no mass.
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    /// A solver error: shapes, non-finite numbers.
+    #[error(transparent)]
+    Solver(#[from] SolverError),
+    /// A target or reference that is NaN or infinite.
+    #[error("task `{task}`: target is not finite")]
+    NonFiniteTarget {
+        /// The task's name.
+        task: String,
+    },
+    /// A list of the wrong length (e.g. posture values for the joints named).
+    #[error("task `{task}`: {got} values for {expected}")]
+    WrongLength {
+        /// The task's name.
+        task: String,
+        /// Expected length.
+        expected: usize,
+        /// Given length.
+        got: usize,
+    },
+    /// [`TaskSet::task_mut`] found no task of that name and type.
+    #[error("no task `{0}` of the requested type")]
+    UnknownTask(String),
+}
+
+/// A task: rows of the stack with their Jacobian and error.
+pub trait Task: Debug + Any {
+    /// Name of the task in the stack (unique inside a [`TaskSet`]).
+    fn name(&self) -> &str;
+
+    /// Number of rows.
+    fn rows(&self) -> usize;
+
+    /// Writes the `rows × nv` Jacobian into `jacobian` and the error `x* − x(q)` into `error`
+    /// (`rows` entries), for the configuration `q` whose forward kinematics `data` holds.
+    ///
+    /// # Errors
+    /// [`ModelError`] when `data` has no kinematics or the task's frame is not in `model`.
+    fn write(
+        &self,
+        model: &Model,
+        data: &ModelData,
+        q: &[f64],
+        jacobian: MatMut<'_, f64>,
+        error: &mut [f64],
+    ) -> Result<(), ModelError>;
+
+    /// `self` as [`Any`], so that [`TaskSet::task_mut`] can hand back the concrete type.
+    fn as_any_mut(&mut self) -> &mut dyn Any;
+}
+
+/// The model's joint position and velocity limits as solver bounds (radians or metres, and per
+/// second).
+///
+/// # Errors
+/// [`SolverError`] when a limit is NaN or a lower limit is above its upper limit.
+pub fn joint_bounds(model: &Model) -> Result<JointBounds, SolverError> {
+    let variables = model.variables();
+    let lower: Vec<f64> = variables.iter().map(|v| v.lower).collect();
+    let upper: Vec<f64> = variables.iter().map(|v| v.upper).collect();
+    let velocity: Vec<f64> = variables.iter().map(|v| v.velocity).collect();
+    JointBounds::with_velocity(&lower, &upper, &velocity)
+}
+
+fn finite_target(name: &str, values: &[f64]) -> Result<(), TaskError> {
+    match values.iter().all(|v| v.is_finite()) {
+        true => Ok(()),
+        false => Err(TaskError::NonFiniteTarget {
+            task: name.to_owned(),
+        }),
+    }
+}

@@ -1,0 +1,96 @@
+//! A point of a frame at a target position.
+
+use std::any::Any;
+
+use faer::MatMut;
+use nalgebra::Vector3;
+
+use super::{Task, TaskError, finite_target};
+use crate::model::{Axis, FrameId, Model, ModelData, ModelError};
+
+/// A point of a named frame at a target position in the base frame (metres), on all three axes
+/// or on some ([`PositionTask::axes`]): one row per axis, `e = x* − x(q)`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PositionTask {
+    name: String,
+    frame: FrameId,
+    offset: Vector3<f64>,
+    axes: Vec<Axis>,
+    /// Target position in the base frame (m); only the constrained axes are read.
+    pub target: Vector3<f64>,
+}
+
+impl PositionTask {
+    /// The origin of `frame` at `target` (base frame, m), on x, y and z; named after the frame.
+    ///
+    /// # Errors
+    /// [`TaskError::Model`] for an unknown frame, [`TaskError::NonFiniteTarget`].
+    pub fn new(model: &Model, frame: &str, target: Vector3<f64>) -> Result<Self, TaskError> {
+        finite_target(frame, target.as_slice())?;
+        Ok(Self {
+            name: frame.to_owned(),
+            frame: model.frame_id(frame)?,
+            offset: Vector3::zeros(),
+            axes: vec![Axis::X, Axis::Y, Axis::Z],
+            target,
+        })
+    }
+
+    /// The point at `offset` (m, in the frame's axes) from the frame's origin instead.
+    ///
+    /// # Errors
+    /// [`TaskError::NonFiniteTarget`] for a NaN or infinite offset.
+    pub fn with_offset(mut self, offset: Vector3<f64>) -> Result<Self, TaskError> {
+        finite_target(&self.name, offset.as_slice())?;
+        self.offset = offset;
+        Ok(self)
+    }
+
+    /// Only these axes of the base frame (e.g. `[Axis::Z]` for a height), in this row order.
+    pub fn axes(mut self, axes: &[Axis]) -> Self {
+        self.axes = axes.to_vec();
+        self
+    }
+
+    /// Another name in the stack (default: the frame's name).
+    pub fn named(mut self, name: &str) -> Self {
+        self.name = name.to_owned();
+        self
+    }
+}
+
+impl Task for PositionTask {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn rows(&self) -> usize {
+        self.axes.len()
+    }
+
+    fn write(
+        &self,
+        model: &Model,
+        data: &ModelData,
+        _q: &[f64],
+        mut jacobian: MatMut<'_, f64>,
+        error: &mut [f64],
+    ) -> Result<(), ModelError> {
+        let x = model.point_position(data, self.frame, &self.offset)?;
+        for (r, &axis) in self.axes.iter().enumerate() {
+            model.point_jacobian_row(
+                data,
+                self.frame,
+                &self.offset,
+                axis,
+                jacobian.as_mut().subrows_mut(r, 1),
+            )?;
+            error[r] = self.target[axis as usize] - x[axis as usize];
+        }
+        Ok(())
+    }
+
+    fn as_any_mut(&mut self) -> &mut dyn Any {
+        self
+    }
+}

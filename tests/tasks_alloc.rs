@@ -1,0 +1,80 @@
+//! A warmed-up solve of a `TaskSet` (ready-made tasks) allocates nothing on the heap: a counting
+//! global allocator in its own test binary counts allocations during the solves.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use nalgebra::Vector3;
+use taskstack::robots::nao;
+use taskstack::solver::Solver;
+use taskstack::solver::driver::{DriverSettings, PositionDriver};
+use taskstack::tasks::{ComTask, OrientationTask, PoseTask, PositionTask, TaskSet, joint_bounds};
+
+struct Counting;
+
+static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+
+// SAFETY: forwards to the system allocator; only counts.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+#[test]
+fn a_warmed_up_task_set_solve_does_not_allocate() {
+    let model = nao::rfoot();
+    let mut data = model.new_data();
+    let mut q = vec![0.0; model.nv()];
+    model.forward_kinematics(&mut data, &q).unwrap();
+    let at = |frame: &str| *data.frame_placement(model.frame_id(frame).unwrap());
+    let mut set = TaskSet::new(&model)
+        .level(
+            "contact",
+            vec![Box::new(
+                PoseTask::new(&model, "l_sole", at("l_sole")).unwrap(),
+            )],
+        )
+        .level(
+            "balance",
+            vec![Box::new(ComTask::ground(&model, [0.0, 0.05]).unwrap())],
+        )
+        .level(
+            "tracking",
+            vec![
+                Box::new(
+                    PositionTask::new(&model, "r_hand", Vector3::new(0.15, -0.1, 0.3)).unwrap(),
+                ),
+                Box::new(OrientationTask::new(&model, "torso", at("torso").rotation).unwrap()),
+            ],
+        )
+        .posture_gradient(0.1, &vec![0.0; model.nv()])
+        .unwrap();
+    let mut solver = Solver::new(&set.shape()).unwrap();
+    let mut driver = PositionDriver::new(&solver, DriverSettings::default()).unwrap();
+    let bounds = joint_bounds(&model).unwrap();
+    driver.run(&mut solver, &mut set, &mut q, &bounds).unwrap();
+
+    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    for k in 0..20 {
+        set.task_mut::<PositionTask>("r_hand").unwrap().target.z = 0.25 + 0.005 * k as f64;
+        driver.run(&mut solver, &mut set, &mut q, &bounds).unwrap();
+    }
+    let after = ALLOCATIONS.load(Ordering::SeqCst);
+    assert_eq!(
+        after - before,
+        0,
+        "heap allocations during warmed-up task-set solves"
+    );
+}
