@@ -8,14 +8,15 @@ use std::time::Instant;
 
 use nalgebra::Vector3;
 use serde_json::Value;
-use taskstack::model::{Axis, FrameId, Model, ModelData};
+use taskstack::model::{Axis, Model};
 use taskstack::robots::nao;
-use taskstack::solver::driver::{DriverSettings, PositionDriver, StopReason, TaskModel};
-use taskstack::solver::{JointBounds, JointTracking, Solver, SolverError, StackShape, TaskStack};
+use taskstack::solver::driver::{DriverSettings, PositionDriver, StopReason};
+use taskstack::solver::{JointBounds, Solver};
+use taskstack::tasks::{self, ComTask, PositionTask, TaskSet};
 
 /// Gain of the posture task (lowest priority, a gradient task): each iteration moves this
 /// fraction of the way to `q_ref` inside the null space of every level.
-const POSTURE_KAPPA: f64 = -0.1;
+const POSTURE_GAIN: f64 = 0.1;
 
 type Error = Box<dyn std::error::Error>;
 
@@ -33,13 +34,12 @@ enum Target {
 #[derive(Debug, Clone)]
 struct Task {
     name: String,
-    /// Point: frame and offset in it; `None` for the CoM.
-    point: Option<(FrameId, Vector3<f64>)>,
+    /// Point: frame name and offset in it (m); `None` for the CoM.
+    point: Option<(String, Vector3<f64>)>,
     axes: Vec<Axis>,
     target: Target,
-    /// Level index and first row inside the level.
+    /// Level index.
     level: usize,
-    row: usize,
 }
 
 /// A benchmark problem, ready to solve.
@@ -54,7 +54,6 @@ pub struct Problem {
     pub bounds: JointBounds,
     pub frames: usize,
     pub settings: DriverSettings,
-    shape: StackShape,
     tasks: Vec<Task>,
     /// Name of each level, for the report.
     pub level_names: Vec<String>,
@@ -134,14 +133,14 @@ impl Problem {
             .ok_or("frames.count missing")? as usize;
 
         let points = &doc["points"];
-        let point = |name: &str| -> Result<(FrameId, Vector3<f64>), Error> {
+        let point = |name: &str| -> Result<(String, Vector3<f64>), Error> {
             let p = &points[name];
             let link = p["link"]
                 .as_str()
                 .ok_or_else(|| format!("point {name}: no link"))?;
             let offset = floats(&p["offset"], "point offset")?;
             Ok((
-                model.frame_id(link)?,
+                link.to_owned(),
                 Vector3::new(offset[0], offset[1], offset[2]),
             ))
         };
@@ -159,7 +158,6 @@ impl Problem {
 
         let mut tasks = Vec::new();
         let mut level_names = Vec::new();
-        let mut shape = StackShape::new(model.nv());
         let mut level_defs: Vec<&Value> = doc["tasks"]
             .as_array()
             .ok_or("tasks missing")?
@@ -179,7 +177,6 @@ impl Problem {
                         axes: vec![Axis::X, Axis::Y],
                         target: Target::Com([t[0], t[1]]),
                         level,
-                        row: 0,
                     });
                 }
                 Some("points") if def["rows"].is_array() => {
@@ -195,7 +192,6 @@ impl Problem {
                             axes,
                             target: Target::Fixed(floats(&row["target"], "row target")?),
                             level,
-                            row: 0,
                         });
                     }
                 }
@@ -211,7 +207,6 @@ impl Problem {
                             axes: axes.clone(),
                             target: Target::PerFrame(per_frame(&p)?),
                             level,
-                            row: 0,
                         });
                     }
                 }
@@ -219,16 +214,6 @@ impl Problem {
                 Some("posture") => continue,
                 other => return Err(format!("unknown task kind {other:?}").into()),
             }
-            let mut row = 0;
-            for t in &mut level_tasks {
-                t.row = row;
-                row += t.axes.len();
-            }
-            let specs: Vec<(&str, usize)> = level_tasks
-                .iter()
-                .map(|t| (t.name.as_str(), t.axes.len()))
-                .collect();
-            shape = shape.with_level(&name, &specs);
             level_names.push(name);
             tasks.extend(level_tasks);
         }
@@ -253,7 +238,6 @@ impl Problem {
             bounds,
             frames,
             settings,
-            shape,
             tasks,
             level_names,
             model,
@@ -276,13 +260,12 @@ impl Problem {
     }
 }
 
-/// The solver side of a problem: model data, solver, driver and the frame being solved.
+/// The solver side of a problem: its tasks as a [`TaskSet`], solver and driver.
 pub struct Runner<'p> {
     problem: &'p Problem,
-    data: ModelData,
+    set: TaskSet<'p>,
     solver: Solver,
     driver: PositionDriver,
-    posture: JointTracking,
 }
 
 /// Outcome of one frame.
@@ -295,31 +278,63 @@ pub struct FrameResult {
     pub micros: f64,
 }
 
+/// The ready-made task of a problem task, at its first frame's target.
+fn ready_made(model: &Model, task: &Task) -> Result<Box<dyn tasks::Task>, Error> {
+    let target = match &task.target {
+        Target::Com(xy) => return Ok(Box::new(ComTask::ground(model, *xy)?)),
+        Target::Fixed(values) => {
+            let mut target = Vector3::zeros();
+            for (&axis, &v) in task.axes.iter().zip(values) {
+                target[axis as usize] = v;
+            }
+            target
+        }
+        Target::PerFrame(targets) => Vector3::from(*targets.first().ok_or("no frames")?),
+    };
+    let (frame, offset) = task.point.as_ref().ok_or("a point task without a point")?;
+    let point = PositionTask::new(model, frame, target)?
+        .with_offset(*offset)?
+        .axes(&task.axes)
+        .named(&task.name);
+    Ok(Box::new(point))
+}
+
 impl<'p> Runner<'p> {
     pub fn new(problem: &'p Problem) -> Result<Self, Error> {
-        let solver = Solver::new(&problem.shape)?;
+        let model = &problem.model;
+        let mut set = TaskSet::new(model);
+        for (level, name) in problem.level_names.iter().enumerate() {
+            let tasks = problem
+                .tasks
+                .iter()
+                .filter(|t| t.level == level)
+                .map(|t| ready_made(model, t))
+                .collect::<Result<_, _>>()?;
+            set = set.level(name, tasks);
+        }
+        let set = set.posture_gradient(POSTURE_GAIN, &problem.q_ref)?;
+        let solver = Solver::new(&set.shape())?;
         let driver = PositionDriver::new(&solver, problem.settings)?;
         Ok(Self {
             problem,
-            data: problem.model.new_data(),
+            set,
             solver,
             driver,
-            posture: JointTracking::new(&problem.q_ref)?,
         })
     }
 
     /// Solves frame `frame`, warm-started from `q` (updated in place).
     pub fn solve_frame(&mut self, frame: usize, q: &mut [f64]) -> Result<FrameResult, Error> {
         let start = Instant::now();
-        let mut model = FrameModel {
-            problem: self.problem,
-            data: &mut self.data,
-            posture: &self.posture,
-            frame,
-        };
+        for task in &self.problem.tasks {
+            if let Target::PerFrame(targets) = &task.target {
+                let target = targets.get(frame).ok_or("frame out of range")?;
+                self.set.task_mut::<PositionTask>(&task.name)?.target = Vector3::from(*target);
+            }
+        }
         let report = self
             .driver
-            .run(&mut self.solver, &mut model, q, &self.problem.bounds)?;
+            .run(&mut self.solver, &mut self.set, q, &self.problem.bounds)?;
         let micros = start.elapsed().as_secs_f64() * 1e6;
         Ok(FrameResult {
             iterations: report.iterations,
@@ -327,93 +342,6 @@ impl<'p> Runner<'p> {
             errors: report.task_errors().to_vec(),
             micros,
         })
-    }
-}
-
-/// The `TaskModel` of one frame: task errors and Jacobians from the NAO model.
-struct FrameModel<'a> {
-    problem: &'a Problem,
-    data: &'a mut ModelData,
-    posture: &'a JointTracking,
-    frame: usize,
-}
-
-#[derive(Debug)]
-struct EvalError(String);
-
-impl std::fmt::Display for EvalError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.0)
-    }
-}
-
-impl std::error::Error for EvalError {}
-
-impl From<SolverError> for EvalError {
-    fn from(e: SolverError) -> Self {
-        Self(e.to_string())
-    }
-}
-
-impl From<taskstack::model::ModelError> for EvalError {
-    fn from(e: taskstack::model::ModelError) -> Self {
-        Self(e.to_string())
-    }
-}
-
-impl TaskModel for FrameModel<'_> {
-    type Error = EvalError;
-
-    fn evaluate(&mut self, q: &[f64], stack: &mut TaskStack) -> Result<(), EvalError> {
-        let model = &self.problem.model;
-        model.forward_kinematics(self.data, q)?;
-        for task in &self.problem.tasks {
-            let rows = task.axes.len();
-            let mut level = stack.level_mut(task.level);
-            let jac = level.jacobian_mut().subrows_mut(task.row, rows);
-            let (current, target): ([f64; 3], &[f64]) = match (&task.point, &task.target) {
-                (None, Target::Com(t)) => {
-                    model.com_jacobian_rows(self.data, 2, jac)?;
-                    let c = model.com(self.data)?;
-                    ([c.x, c.y, 0.0], t)
-                }
-                (Some((frame, offset)), target) => {
-                    if rows == 3 {
-                        model.point_jacobian(self.data, *frame, offset, jac)?;
-                    } else {
-                        let mut jac = jac;
-                        for (r, &a) in task.axes.iter().enumerate() {
-                            model.point_jacobian_row(
-                                self.data,
-                                *frame,
-                                offset,
-                                a,
-                                jac.as_mut().subrows_mut(r, 1),
-                            )?;
-                        }
-                    }
-                    let p = model.point_position(self.data, *frame, offset)?;
-                    let mut current = [0.0; 3];
-                    for (r, &a) in task.axes.iter().enumerate() {
-                        current[r] = p[a as usize];
-                    }
-                    let target: &[f64] = match target {
-                        Target::Fixed(t) => t,
-                        Target::PerFrame(t) => &t[self.frame],
-                        Target::Com(t) => t,
-                    };
-                    (current, target)
-                }
-                (None, _) => return Err(EvalError(format!("task {} has no point", task.name))),
-            };
-            let errors = &mut level.target_mut()[task.row..task.row + rows];
-            for r in 0..rows {
-                errors[r] = target[r] - current[r];
-            }
-        }
-        stack.clear_gradient();
-        stack.add_gradient(POSTURE_KAPPA, self.posture, q)?;
-        Ok(())
     }
 }
 

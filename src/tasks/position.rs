@@ -77,14 +77,21 @@ impl Task for PositionTask {
         error: &mut [f64],
     ) -> Result<(), ModelError> {
         let x = model.point_position(data, self.frame, &self.offset)?;
+        // All three axes in order: one walk of the chain instead of three.
+        let xyz = self.axes == [Axis::X, Axis::Y, Axis::Z];
+        if xyz {
+            model.point_jacobian(data, self.frame, &self.offset, jacobian.as_mut())?;
+        }
         for (r, &axis) in self.axes.iter().enumerate() {
-            model.point_jacobian_row(
-                data,
-                self.frame,
-                &self.offset,
-                axis,
-                jacobian.as_mut().subrows_mut(r, 1),
-            )?;
+            if !xyz {
+                model.point_jacobian_row(
+                    data,
+                    self.frame,
+                    &self.offset,
+                    axis,
+                    jacobian.as_mut().subrows_mut(r, 1),
+                )?;
+            }
             error[r] = self.target[axis as usize] - x[axis as usize];
         }
         Ok(())
