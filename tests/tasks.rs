@@ -24,25 +24,25 @@ fn bent(model: &Model) -> Vec<f64> {
         .collect()
 }
 
-fn error_of(task: &dyn Task, model: &Model, q: &[f64]) -> Vec<f64> {
+/// The task's Jacobian and error at `q`.
+fn rows_of(task: &dyn Task, model: &Model, q: &[f64]) -> (Mat<f64>, Vec<f64>) {
     let mut data = model.new_data();
     model.forward_kinematics(&mut data, q).unwrap();
     let mut jacobian = Mat::<f64>::zeros(task.rows(), model.nv());
     let mut error = vec![0.0; task.rows()];
     task.write(model, &data, q, jacobian.as_mut(), &mut error)
         .unwrap();
-    error
+    (jacobian, error)
+}
+
+fn error_of(task: &dyn Task, model: &Model, q: &[f64]) -> Vec<f64> {
+    rows_of(task, model, q).1
 }
 
 /// `J = −∂e/∂q` by central differences, with the task's target at the current value (e = 0,
 /// where the rotation-vector error is exactly linear to first order).
 fn check_jacobian(task: &dyn Task, model: &Model, q: &[f64]) {
-    let mut data = model.new_data();
-    model.forward_kinematics(&mut data, q).unwrap();
-    let mut jacobian = Mat::<f64>::zeros(task.rows(), model.nv());
-    let mut error = vec![0.0; task.rows()];
-    task.write(model, &data, q, jacobian.as_mut(), &mut error)
-        .unwrap();
+    let (jacobian, error) = rows_of(task, model, q);
     assert!(error.iter().all(|e| e.abs() < 1e-12), "{error:?}");
     let h = 1e-6;
     for k in 0..model.nv() {
