@@ -7,7 +7,7 @@ use std::hint::black_box;
 use std::io::Cursor;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use taskstack::imitation::human::HumanFrame;
+use taskstack::human::HumanFrame;
 use taskstack::imitation::support::{SupportConfig, SupportDetector};
 use taskstack::io::bvh::{BvhConfig, BvhReader};
 use taskstack::io::kinect::{KinectConfig, KinectReader};

@@ -6,21 +6,25 @@ use std::hint::black_box;
 use std::io::Cursor;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use taskstack::imitation::human::HumanFrame;
-use taskstack::imitation::scaler::{NaoJointAngles, RobotSkeleton, ScaleConfig, Scaler};
+use taskstack::human::HumanFrame;
+use taskstack::imitation::scaler::{RobotSkeleton, ScaleConfig, Scaler};
 use taskstack::imitation::support::{SupportConfig, SupportDetector};
 use taskstack::io::bvh::{BvhConfig, BvhReader};
-use taskstack::robots::nao;
+use taskstack::robots::{HumanJointAngles, nao};
 
 const CLIP: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
     "/tests/data/mocap/cmu_09_12_walk_forward_backward_sideways.bvh"
 );
 
-fn pipeline(bytes: &[u8], angles: Option<&mut NaoJointAngles>) -> u64 {
+fn pipeline(bytes: &[u8], angles: Option<&mut nao::JointAngles>) -> u64 {
     let mut reader = BvhReader::new(Cursor::new(bytes), "bench", BvhConfig::cmu()).unwrap();
     let mut detector = SupportDetector::new(SupportConfig::optical()).unwrap();
-    let mut scaler = Scaler::new(RobotSkeleton::nao(), ScaleConfig::nao()).unwrap();
+    let mut scaler = Scaler::new(
+        RobotSkeleton::of(&nao::profile()).unwrap(),
+        ScaleConfig::new(nao::STEP_ENVELOPE),
+    )
+    .unwrap();
     let mut q = [0.0; nao::VARIABLES.len()];
     let mut angles = angles;
     let mut frame = HumanFrame::new(0.0);
@@ -29,7 +33,7 @@ fn pipeline(bytes: &[u8], angles: Option<&mut NaoJointAngles>) -> u64 {
         let support = detector.update(&frame);
         let scaled = scaler.scale(&frame, support).unwrap();
         if let Some(a) = angles.as_deref_mut() {
-            a.compute(scaled, &mut q).unwrap();
+            a.compute(scaled.directions(), &mut q).unwrap();
         }
         black_box(scaled);
         n += 1;
@@ -47,7 +51,7 @@ fn imitation_input(c: &mut Criterion) {
     let mut detector = SupportDetector::new(SupportConfig::optical()).unwrap();
     let supports: Vec<_> = frames.iter().map(|f| detector.update(f)).collect();
     let model = nao::rfoot();
-    let mut angles = NaoJointAngles::new(&model).unwrap();
+    let mut angles = nao::JointAngles::new(&model).unwrap();
 
     let mut group = c.benchmark_group("imitation_input");
     group.throughput(Throughput::Elements(frames.len() as u64));
@@ -58,7 +62,11 @@ fn imitation_input(c: &mut Criterion) {
         b.iter(|| pipeline(black_box(&bvh), Some(&mut angles)))
     });
     group.bench_function("scale_only", |b| {
-        let mut scaler = Scaler::new(RobotSkeleton::nao(), ScaleConfig::nao()).unwrap();
+        let mut scaler = Scaler::new(
+            RobotSkeleton::of(&nao::profile()).unwrap(),
+            ScaleConfig::new(nao::STEP_ENVELOPE),
+        )
+        .unwrap();
         b.iter(|| {
             for (f, s) in frames.iter().zip(&supports) {
                 black_box(scaler.scale(black_box(f), *s).unwrap());

@@ -3,10 +3,11 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
-use taskstack::imitation::human::HumanFrame;
-use taskstack::imitation::imitator::{FootRootedModels, Imitator, ImitatorConfig};
+use taskstack::human::HumanFrame;
+use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
 use taskstack::imitation::phase::SupportPhase;
 use taskstack::io::clip::Clip;
+use taskstack::robots::nao;
 
 fn frames(name: &str) -> Vec<HumanFrame> {
     let path = format!("{}/tests/data/mocap/{name}", env!("CARGO_MANIFEST_DIR"));
@@ -23,8 +24,7 @@ fn bench(c: &mut Criterion) {
     ] {
         let frames = frames(clip);
         let duration = frames.last().unwrap().time - frames[0].time + 1.0 / 120.0;
-        let mut imitator =
-            Imitator::new(FootRootedModels::nao(), ImitatorConfig::default()).unwrap();
+        let mut imitator = Imitator::new(nao::profile(), ImitatorConfig::default()).unwrap();
         // Warm up on the whole clip once, and count the phases the bench will see.
         let mut single = 0;
         for f in &frames {

@@ -1,4 +1,4 @@
-//! Batch retargeting of a folder of clips across cores (`taskstack::imitation::batch`).
+//! Batch retargeting of a folder of clips across cores (`taskstack::batch`).
 //!
 //! `cargo run --release --example batch -- [DIR_WITH_CLIPS] [--out DIR] [--threads N]`
 //!
@@ -10,7 +10,7 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use taskstack::imitation::batch::{BatchOptions, BatchSummary, clips_in, retarget_all};
+use taskstack::batch::{BatchOptions, BatchSummary, clips_in, retarget_all};
 
 const DEFAULT_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/mocap");
 

@@ -22,10 +22,12 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use nalgebra::{Rotation3, Vector3};
-use taskstack::imitation::human::{HumanFrame, HumanJoint};
+use taskstack::human::Side;
+use taskstack::human::{HumanFrame, HumanJoint};
 use taskstack::imitation::scaler::{RobotSkeleton, ScaleConfig, ScaledSkeleton, Scaler, Stance};
-use taskstack::imitation::support::{HumanSupport, Side, SupportConfig, SupportDetector};
+use taskstack::imitation::support::{HumanSupport, SupportConfig, SupportDetector};
 use taskstack::io::clip::Clip;
+use taskstack::robots::nao;
 
 const DEFAULT_CLIP: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
@@ -167,9 +169,9 @@ fn panel(
 fn run(args: &Args) -> Result<(), String> {
     let (frames, support_config) = read_clip(&args.clip)?;
     let mut detector = SupportDetector::new(support_config).map_err(|e| e.to_string())?;
-    let skeleton = RobotSkeleton::nao();
-    let mut scaler =
-        Scaler::new(skeleton.clone(), ScaleConfig::nao()).map_err(|e| e.to_string())?;
+    let skeleton = RobotSkeleton::of(&nao::profile()).unwrap();
+    let mut scaler = Scaler::new(skeleton.clone(), ScaleConfig::new(nao::STEP_ENVELOPE))
+        .map_err(|e| e.to_string())?;
     std::fs::create_dir_all(&args.out).map_err(|e| format!("{}: {e}", args.out.display()))?;
 
     let points: Vec<HumanJoint> = skeleton.joints().to_vec();

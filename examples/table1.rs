@@ -2,7 +2,8 @@
 //! `src/imitation/table1.md` is generated.
 
 use taskstack::imitation::tables::TaskTables;
+use taskstack::robots::nao;
 
 fn main() {
-    print!("{}", TaskTables::paper());
+    print!("{}", TaskTables::paper(&nao::profile()));
 }

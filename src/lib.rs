@@ -2,6 +2,8 @@
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
 
+pub mod batch;
+pub mod human;
 pub mod imitation;
 pub mod io;
 pub mod model;

@@ -3,16 +3,16 @@
 
 use std::path::{Path, PathBuf};
 
-use taskstack::imitation::batch::{BatchError, BatchOptions, clips_in, retarget_all};
-use taskstack::imitation::imitator::FootRootedModels;
+use taskstack::batch::{BatchError, BatchOptions, clips_in, retarget_all};
 use taskstack::model::Model;
+use taskstack::robots::BipedProfile;
 
 // Compile-time: the batch shares one model set between worker threads (`Sync`) and moves clones
 // into them (`Send`).
 const _: () = {
     const fn send_sync<T: Send + Sync>() {}
     send_sync::<Model>();
-    send_sync::<FootRootedModels>();
+    send_sync::<BipedProfile>();
 };
 
 fn mocap(name: &str) -> PathBuf {

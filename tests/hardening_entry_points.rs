@@ -3,10 +3,8 @@
 //! and checks the typed error (by variant and by the name it gives) or the documented graceful
 //! behaviour, and that a refused call changed nothing.
 
-use taskstack::imitation::human::{HumanFrame, HumanJoint};
-use taskstack::imitation::imitator::{
-    FootRootedModels, ImitationError, Imitator, ImitatorConfig, RobotFrame,
-};
+use taskstack::human::{HumanFrame, HumanJoint};
+use taskstack::imitation::imitator::{ImitationError, Imitator, ImitatorConfig, RobotFrame};
 use taskstack::imitation::scaler::ScaleError;
 use taskstack::io::clip::Clip;
 use taskstack::model::ModelError;
@@ -330,7 +328,7 @@ fn frames(n: usize) -> Vec<HumanFrame> {
 }
 
 fn imitator() -> Imitator {
-    Imitator::new(FootRootedModels::nao(), ImitatorConfig::default()).unwrap()
+    Imitator::new(nao::profile(), ImitatorConfig::default()).unwrap()
 }
 
 fn run(imitator: &mut Imitator, frames: &[HumanFrame]) -> Vec<RobotFrame> {
@@ -362,7 +360,7 @@ fn imitator_config_out_of_range_is_refused_by_name() {
         for &v in values {
             let mut c = ImitatorConfig::default();
             set(&mut c, v);
-            let err = Imitator::new(FootRootedModels::nao(), c).err();
+            let err = Imitator::new(nao::profile(), c).err();
             assert!(
                 matches!(err, Some(ImitationError::InvalidParameter { name: n, .. }) if n == name),
                 "{name} = {v}: {err:?}"
@@ -389,7 +387,7 @@ fn imitator_config_out_of_range_is_refused_by_name() {
         ..ImitatorConfig::default()
     };
     assert!(matches!(
-        Imitator::new(FootRootedModels::nao(), c),
+        Imitator::new(nao::profile(), c),
         Err(ImitationError::InvalidParameter {
             name: "iterations_per_frame",
             ..
@@ -400,7 +398,7 @@ fn imitator_config_out_of_range_is_refused_by_name() {
         ..ImitatorConfig::default()
     };
     assert!(matches!(
-        Imitator::new(FootRootedModels::nao(), c),
+        Imitator::new(nao::profile(), c),
         Err(ImitationError::Solver(SolverError::DimensionMismatch {
             expected: 23,
             got: 22,

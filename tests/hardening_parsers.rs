@@ -26,7 +26,7 @@ use std::io::{BufReader, Cursor, Read};
 use std::sync::OnceLock;
 
 use proptest::prelude::*;
-use taskstack::imitation::human::HumanFrame;
+use taskstack::human::HumanFrame;
 use taskstack::io::bvh::{BvhConfig, BvhError, BvhReader};
 use taskstack::io::kinect::{KinectConfig, KinectError, KinectReader};
 use taskstack::model::{Model, UrdfOptions};
@@ -614,7 +614,7 @@ fn bvh_claiming_1e12_frames_reads_what_is_there_without_reserving() {
     let config = BvhConfig {
         names: taskstack::io::bvh::BvhNames::Custom(vec![(
             "Hips".into(),
-            taskstack::imitation::human::HumanJoint::Pelvis,
+            taskstack::human::HumanJoint::Pelvis,
         )]),
         ..BvhConfig::cmu()
     };

@@ -8,13 +8,14 @@
 //! a robot moving at 10 % of its rated speed can finish the step it is taking.
 //! `cargo test --release --test imitation_end_to_end -- --nocapture` prints the per-clip metrics.
 
+use taskstack::human::HumanFrame;
 use taskstack::imitation::footsteps::FootstepConfig;
-use taskstack::imitation::human::HumanFrame;
-use taskstack::imitation::imitator::{FootRootedModels, Imitator, ImitatorConfig};
+use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
 use taskstack::imitation::metrics::{ImitationMetrics, MetricsRecorder};
 use taskstack::imitation::phase::SupportPhase;
 use taskstack::imitation::shaping::MotionLimits;
 use taskstack::io::clip::Clip;
+use taskstack::robots::nao;
 
 const SETTLE_SECONDS: f64 = 5.0;
 
@@ -58,7 +59,7 @@ fn run_held(
         support: clip.support_config(),
         ..config
     };
-    let mut imitator = Imitator::new(FootRootedModels::nao(), config).unwrap();
+    let mut imitator = Imitator::new(nao::profile(), config).unwrap();
     let mut recorder = MetricsRecorder::new(&imitator);
     let mut phases = Vec::new();
     let mut frame = HumanFrame::new(0.0);
@@ -230,10 +231,10 @@ fn a_walk_at_full_speed_keeps_the_invariants() {
 /// frames' heights held: up to 17 tasks) is solved and reported whole.
 #[test]
 fn overridden_tables_are_solved_and_reported_whole() {
-    use taskstack::imitation::human::HumanJoint;
+    use taskstack::human::HumanJoint;
     use taskstack::imitation::phase::PhaseConfig;
     use taskstack::imitation::tables::{Axes, PointTarget, Task, TaskTables};
-    let mut tables = TaskTables::contact_first(&PhaseConfig::default());
+    let mut tables = TaskTables::contact_first(&PhaseConfig::default(), &nao::profile());
     for phase in SupportPhase::ALL {
         let mut table = tables.table(phase).clone();
         let last = table.levels.len() - 1;
@@ -265,7 +266,7 @@ fn overridden_tables_are_solved_and_reported_whole() {
         tables.set(table).unwrap();
     }
     let config = ImitatorConfig {
-        tables: tables.clone(),
+        tables: Some(tables.clone()),
         ..ImitatorConfig::default()
     };
     // Double support (17 tasks) and a walk's single supports and transitions (14 and 15 tasks).
@@ -278,7 +279,7 @@ fn overridden_tables_are_solved_and_reported_whole() {
             support: clip.support_config(),
             ..config.clone()
         };
-        let mut imitator = Imitator::new(FootRootedModels::nao(), config).unwrap();
+        let mut imitator = Imitator::new(nao::profile(), config).unwrap();
         let mut frame = HumanFrame::new(0.0);
         while clip.read_frame(&mut frame).unwrap() && frame.time < 3.0 {
             let r = imitator.step(&frame).unwrap();

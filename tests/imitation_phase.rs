@@ -1,12 +1,13 @@
 //! The support-phase machine and the paper's task tables (Poubel §III.B, §IV.B, Table I).
 
 use proptest::prelude::*;
+use taskstack::human::Side;
 use taskstack::imitation::phase::{
     Landing, Measurements, PhaseConfig, PhaseError, PhaseMachine, Settling, SupportPhase, TakeOff,
 };
 use taskstack::imitation::support::HumanSupport;
 use taskstack::imitation::tables::{Gradient, GradientKind, TableError, Task, TaskTables};
-use taskstack::robots::nao::Foot;
+use taskstack::robots::nao;
 
 use HumanSupport as H;
 use SupportPhase as P;
@@ -373,7 +374,7 @@ fn tracks_a_hand(tables: &TaskTables, phase: SupportPhase) -> bool {
 
 #[test]
 fn paper_tables_have_table_one_row_counts() {
-    let tables = TaskTables::paper();
+    let tables = TaskTables::paper(&nao::profile());
     // Table I: X'_c is 2×1 everywhere; X_t is 9×1 in RS and LS, 11×1 in DS, 5×1 in transitions.
     assert_eq!(level_rows(&tables, P::Right), vec![2, 9]);
     assert_eq!(level_rows(&tables, P::Left), vec![2, 9]);
@@ -414,7 +415,7 @@ fn paper_tables_have_table_one_row_counts() {
 
 #[test]
 fn paper_model_roots_follow_section_iv_b() {
-    let tables = TaskTables::paper();
+    let tables = TaskTables::paper(&nao::profile());
     // LFoot only while the right foot is off the ground or being lowered (Table I "Model").
     let left_rooted = [
         P::Left,
@@ -423,9 +424,9 @@ fn paper_model_roots_follow_section_iv_b() {
     ];
     for phase in SupportPhase::ALL {
         let expected = if left_rooted.contains(&phase) {
-            Foot::Left
+            Side::Left
         } else {
-            Foot::Right
+            Side::Right
         };
         assert_eq!(tables.table(phase).model_root, expected, "{phase}");
     }
@@ -433,7 +434,7 @@ fn paper_model_roots_follow_section_iv_b() {
 
 #[test]
 fn overrides_are_validated() {
-    let mut tables = TaskTables::paper();
+    let mut tables = TaskTables::paper(&nao::profile());
     let mut ds = tables.table(P::Double).clone();
     let first = ds.levels[1].tasks[0].clone();
     ds.levels[1].tasks.push(first);
@@ -452,7 +453,10 @@ fn overrides_are_validated() {
     tables.set(rs.clone()).unwrap();
     assert_eq!(tables.table(P::Right), &rs);
     // The other tables are untouched.
-    assert_eq!(tables.table(P::Left), TaskTables::paper().table(P::Left));
+    assert_eq!(
+        tables.table(P::Left),
+        TaskTables::paper(&nao::profile()).table(P::Left)
+    );
 }
 
 #[test]
@@ -466,7 +470,9 @@ fn phases_print_like_table_one() {
         P::LeftToDouble(Landing::ComToMiddle).to_string(),
         "LS to DS: CoM to middle"
     );
-    let row = TaskTables::paper().table(P::Right).to_string();
+    let row = TaskTables::paper(&nao::profile())
+        .table(P::Right)
+        .to_string();
     assert!(
         row.starts_with("| RS |  | RFoot | (9×1) p(l_hand) ← LHand"),
         "{row}"
@@ -569,7 +575,7 @@ proptest! {
     fn random_human_sequences_stay_on_the_graph(
         steps in proptest::collection::vec((human(), measurement()), 1..80)
     ) {
-        let tables = TaskTables::paper();
+        let tables = TaskTables::paper(&nao::profile());
         let config = config();
         let mut m = PhaseMachine::new(config).unwrap();
         let mut last_human = H::Double;
@@ -585,7 +591,7 @@ proptest! {
             prop_assert_eq!(table.phase, to);
             prop_assert_eq!(table.model_root, to.model_root());
             // The tracked foot is never the model root (it is fixed to the world).
-            let root_ankle = match to.model_root() { Foot::Right => "r_ankle", Foot::Left => "l_ankle" };
+            let root_ankle = match to.model_root() { Side::Right => "r_ankle", Side::Left => "l_ankle" };
             let tracks_root = table.levels.iter().flat_map(|l| &l.tasks).any(
                 |t| matches!(t, Task::Point { frame, .. } if frame == root_ankle)
             );
@@ -608,4 +614,14 @@ proptest! {
             }
         }
     }
+}
+
+/// The docs include `src/imitation/table1.md`; it must be exactly the rendering of the data.
+#[test]
+fn checked_in_table_matches_the_data() {
+    assert_eq!(
+        include_str!("../src/imitation/table1.md"),
+        TaskTables::paper(&nao::profile()).to_string(),
+        "regenerate with `cargo run --example table1 > src/imitation/table1.md`"
+    );
 }

@@ -6,16 +6,17 @@
 
 use nalgebra::Vector3;
 use proptest::prelude::*;
+use taskstack::human::Side;
 use taskstack::imitation::phase::{PhaseConfig, SupportPhase};
 use taskstack::imitation::tables::{Task, TaskTable, TaskTables};
 use taskstack::model::{Axis, Model};
-use taskstack::robots::nao::{self, Foot};
+use taskstack::robots::nao;
 use taskstack::solver::{Solver, StackShape};
 
-fn model(foot: Foot) -> Model {
+fn model(foot: Side) -> Model {
     match foot {
-        Foot::Right => nao::rfoot(),
-        Foot::Left => nao::lfoot(),
+        Side::Right => nao::rfoot(),
+        Side::Left => nao::lfoot(),
     }
 }
 
@@ -114,9 +115,9 @@ proptest! {
     ) {
         let config = PhaseConfig::default();
         let tables = if executable {
-            TaskTables::executable(&config)
+            TaskTables::executable(&config, &nao::profile())
         } else {
-            TaskTables::contact_first(&config)
+            TaskTables::contact_first(&config, &nao::profile())
         };
         let table = tables.table(SupportPhase::ALL[phase]);
         let model = model(table.model_root);

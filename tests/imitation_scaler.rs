@@ -6,14 +6,15 @@
 
 use nalgebra::{Rotation3, Vector3};
 use proptest::prelude::*;
-use taskstack::imitation::human::{HumanFrame, HumanJoint as J};
+use taskstack::human::Side;
+use taskstack::human::{HumanFrame, HumanJoint as J};
 use taskstack::imitation::scaler::{
-    FootArea, NAO_MAPPING, NaoJointAngles, RobotPoint, RobotSkeleton, ScaleConfig, ScaleError,
-    ScaledSkeleton, Scaler, Stance,
+    RobotSkeleton, ScaleConfig, ScaleError, ScaledSkeleton, Scaler, Stance,
 };
-use taskstack::imitation::support::{HumanSupport, Side, SupportConfig, SupportDetector};
+use taskstack::imitation::support::{HumanSupport, SupportConfig, SupportDetector};
 use taskstack::io::bvh::{BvhConfig, BvhReader};
 use taskstack::robots::nao;
+use taskstack::robots::{HumanJointAngles, RobotPoint};
 
 const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/mocap/");
 /// NAOqi FootHeight: ankle above sole.
@@ -48,7 +49,11 @@ fn standing() -> HumanFrame {
 }
 
 fn scaler() -> Scaler {
-    Scaler::new(RobotSkeleton::nao(), ScaleConfig::nao()).unwrap()
+    Scaler::new(
+        RobotSkeleton::of(&nao::profile()).unwrap(),
+        ScaleConfig::new(nao::STEP_ENVELOPE),
+    )
+    .unwrap()
 }
 
 fn is_pair(j: J) -> bool {
@@ -116,7 +121,7 @@ fn check_segments(scaled: &ScaledSkeleton, sk: &RobotSkeleton, frame: Option<&Hu
 
 #[test]
 fn nao_segment_lengths_come_from_the_model() {
-    let sk = RobotSkeleton::nao();
+    let sk = RobotSkeleton::of(&nao::profile()).unwrap();
     // NAO dimensions: thigh 0.100, tibia 0.1029, hip offset 0.050, upper arm √(0.105² + 0.015²),
     // MidHip→MidShoulder = 0.085 (torso above hips) + 0.100 (shoulders above torso).
     assert!((sk.length(J::LKnee).unwrap() - 0.100).abs() < 1e-12);
@@ -134,37 +139,25 @@ fn nao_segment_lengths_come_from_the_model() {
 #[test]
 fn mapping_errors_name_the_problem() {
     let model = nao::rfoot();
-    let no_knee = taskstack::imitation::scaler::RobotMapping {
-        points: &NAO_MAPPING.points[..3],
-        ..NAO_MAPPING
-    };
+    let soles = ["l_sole", "r_sole"];
+    let zero = vec![0.0; model.nv()];
+    let skeleton = |points: &[(J, RobotPoint)]| RobotSkeleton::new(&model, points, soles, &zero);
     assert_eq!(
-        RobotSkeleton::at_zero(&model, &no_knee).unwrap_err(),
+        skeleton(&nao::points()[..3]).unwrap_err(),
         ScaleError::MissingJoint("LKnee")
     );
-    let points = [
-        (J::MidHip, RobotPoint::Frame("l_hip")),
-        (J::MidHip, RobotPoint::Frame("r_hip")),
-    ];
-    let twice = taskstack::imitation::scaler::RobotMapping {
-        points: &points,
-        ..NAO_MAPPING
-    };
+    let frame = |name: &str| RobotPoint::Frame(name.to_owned());
+    let points = [(J::MidHip, frame("l_hip")), (J::MidHip, frame("r_hip"))];
     assert_eq!(
-        RobotSkeleton::at_zero(&model, &twice).unwrap_err(),
+        skeleton(&points).unwrap_err(),
         ScaleError::DuplicateJoint("MidHip")
     );
-    let points = [(J::MidHip, RobotPoint::Frame("pelvis_nowhere"))];
-    let unknown = taskstack::imitation::scaler::RobotMapping {
-        points: &points,
-        ..NAO_MAPPING
-    };
-    let err = RobotSkeleton::at_zero(&model, &unknown).unwrap_err();
+    let err = skeleton(&[(J::MidHip, frame("pelvis_nowhere"))]).unwrap_err();
     assert!(err.to_string().contains("pelvis_nowhere"), "{err}");
-    let mut bad = ScaleConfig::nao();
+    let mut bad = ScaleConfig::new(nao::STEP_ENVELOPE);
     bad.area.x_min = 1.0;
     assert!(matches!(
-        Scaler::new(RobotSkeleton::nao(), bad),
+        Scaler::new(RobotSkeleton::of(&nao::profile()).unwrap(), bad),
         Err(ScaleError::BadConfig(_))
     ));
     let mut s = scaler();
@@ -176,7 +169,7 @@ fn mapping_errors_name_the_problem() {
 
 #[test]
 fn single_support_lengths_directions_and_origin() {
-    let sk = RobotSkeleton::nao();
+    let sk = RobotSkeleton::of(&nao::profile()).unwrap();
     // A pose with bent limbs, turned 0.4 rad, standing on the right foot.
     let mut frame = standing();
     frame.set(J::LKnee, Some(Vector3::new(0.3, 0.1, 0.75)));
@@ -217,7 +210,7 @@ impl OtherSide for Side {
 
 #[test]
 fn double_support_puts_both_soles_on_the_ground() {
-    let sk = RobotSkeleton::nao();
+    let sk = RobotSkeleton::of(&nao::profile()).unwrap();
     let mut frame = standing();
     // Human feet 1.0 m apart, knees at ±0.45 m: legs (hip→knee→ankle) 0.87 (right) and
     // |(0, .36, −.45)| + |(0, .35, −.42)| = 0.5763 + 0.5467 (left), mean 0.9965; robot leg
@@ -238,7 +231,7 @@ fn double_support_puts_both_soles_on_the_ground() {
     }
     let left = scaled.sole(Side::Left).unwrap();
     assert!(
-        (left.xy.y - FootArea::nao().lateral_max).abs() < 1e-12,
+        (left.xy.y - nao::STEP_ENVELOPE.lateral_max).abs() < 1e-12,
         "{left:?}"
     );
     assert!(left.xy.x.abs() < 1e-12 && left.yaw.abs() < 1e-12);
@@ -319,7 +312,7 @@ fn missing_and_coincident_joints_reuse_the_previous_direction() {
     // First frame with nothing at all: the robot's reference posture (arms forward at q = 0).
     let mut s = scaler();
     let empty = s.scale(&HumanFrame::new(0.0), HumanSupport::Right).unwrap();
-    let sk = RobotSkeleton::nao();
+    let sk = RobotSkeleton::of(&nao::profile()).unwrap();
     let r = sk.reference(J::RAnkle).unwrap() - Vector3::new(0.0, 0.0, FOOT_HEIGHT);
     for (j, p) in empty.points() {
         if let Some(p) = p {
@@ -382,17 +375,17 @@ proptest! {
     fn random_frames_never_give_nan_and_keep_lengths(
         frames in prop::collection::vec((frame_strategy(true, -6.0..3.0), support_strategy()), 1..6)
     ) {
-        let sk = RobotSkeleton::nao();
+        let sk = RobotSkeleton::of(&nao::profile()).unwrap();
         let mut s = scaler();
         let angles_model = nao::rfoot();
-        let mut angles = NaoJointAngles::new(&angles_model).unwrap();
+        let mut angles = nao::JointAngles::new(&angles_model).unwrap();
         let mut q = vec![0.0; angles_model.nv()];
         for (frame, support) in &frames {
             let scaled = s.scale(frame, *support).unwrap();
             check_segments(scaled, &sk, None);
             let ankle = if scaled.base() == Side::Right { J::RAnkle } else { J::LAnkle };
             prop_assert!((scaled.get(ankle).unwrap() - Vector3::new(0.0, 0.0, FOOT_HEIGHT)).norm() < 1e-12);
-            angles.compute(scaled, &mut q).unwrap();
+            angles.compute(scaled.directions(), &mut q).unwrap();
             for (v, var) in q.iter().zip(angles_model.variables()) {
                 prop_assert!(v.is_finite() && *v >= var.lower && *v <= var.upper, "{} = {v}", var.name);
             }
@@ -422,7 +415,7 @@ proptest! {
 
 #[test]
 fn real_clip_keeps_robot_lengths_on_every_frame() {
-    let sk = RobotSkeleton::nao();
+    let sk = RobotSkeleton::of(&nao::profile()).unwrap();
     let mut s = scaler();
     let mut detector = SupportDetector::new(SupportConfig::optical()).unwrap();
     let mut reader = BvhReader::open(
@@ -457,10 +450,10 @@ fn robot_as_human(q: &[f64]) -> HumanFrame {
             .vector
     };
     let mut f = HumanFrame::new(0.0);
-    for &(j, point) in NAO_MAPPING.points {
+    for (j, point) in nao::points() {
         f.set(
             j,
-            Some(match point {
+            Some(match &point {
                 RobotPoint::Frame(a) => p(a),
                 RobotPoint::Midpoint(a, b) => (p(a) + p(b)) / 2.0,
             }),
@@ -474,9 +467,9 @@ fn angles_of(frame: &HumanFrame) -> Vec<f64> {
     let mut s = scaler();
     let scaled = s.scale(frame, HumanSupport::Right).unwrap();
     let mut q = vec![0.0; model.nv()];
-    NaoJointAngles::new(&model)
+    nao::JointAngles::new(&model)
         .unwrap()
-        .compute(scaled, &mut q)
+        .compute(scaled.directions(), &mut q)
         .unwrap();
     q
 }

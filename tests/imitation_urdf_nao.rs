@@ -4,21 +4,23 @@
 //! joint trajectories are not equal; the imitation must run the same way on both: the same
 //! support phases, every posture within the limits, the joints close.
 
-use taskstack::imitation::human::HumanFrame;
-use taskstack::imitation::imitator::{FootRootedModels, Imitator, ImitatorConfig};
+use taskstack::human::HumanFrame;
+use taskstack::human::Side;
+use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
 use taskstack::imitation::phase::SupportPhase;
 use taskstack::io::clip::Clip;
-use taskstack::robots::nao::{self, Foot};
+use taskstack::robots::BipedProfile;
+use taskstack::robots::nao;
 
 /// Per frame: the joint angles and the phase.
-fn run(models: FootRootedModels, clip: &str) -> Vec<(Vec<f64>, SupportPhase)> {
+fn run(profile: BipedProfile, clip: &str) -> Vec<(Vec<f64>, SupportPhase)> {
     let path = format!("{}/tests/data/mocap/{clip}", env!("CARGO_MANIFEST_DIR"));
     let mut clip = Clip::open(path).unwrap();
     let config = ImitatorConfig {
         support: clip.support_config(),
         ..ImitatorConfig::default()
     };
-    let mut imitator = Imitator::new(models, config).unwrap();
+    let mut imitator = Imitator::new(profile, config).unwrap();
     let bounds = imitator.bounds().clone();
     let mut frame = HumanFrame::new(0.0);
     let mut out = Vec::new();
@@ -38,12 +40,11 @@ fn run(models: FootRootedModels, clip: &str) -> Vec<(Vec<f64>, SupportPhase)> {
 #[test]
 fn urdf_nao_imitates_like_the_dh_nao() {
     let urdf = format!("{}/tests/data/nao.urdf", env!("CARGO_MANIFEST_DIR"));
-    let urdf = FootRootedModels {
-        right: nao::from_urdf_file(&urdf, Some(Foot::Right.sole())).unwrap(),
-        left: nao::from_urdf_file(&urdf, Some(Foot::Left.sole())).unwrap(),
-    };
+    let urdf = nao::profile_with(
+        Side::BOTH.map(|side| nao::from_urdf_file(&urdf, Some(nao::sole(side))).unwrap()),
+    );
     let clip = "cmu_05_12_slow_dance_tendu_arms_high.bvh";
-    let dh = run(FootRootedModels::nao(), clip);
+    let dh = run(nao::profile(), clip);
     let urdf = run(urdf, clip);
     assert_eq!(dh.len(), urdf.len());
     let phases = |run: &[(Vec<f64>, SupportPhase)]| {

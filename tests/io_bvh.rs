@@ -4,7 +4,7 @@ use std::io::Cursor;
 
 use nalgebra::Vector3;
 use proptest::prelude::*;
-use taskstack::imitation::human::{HumanFrame, HumanJoint as J};
+use taskstack::human::{HumanFrame, HumanJoint as J};
 use taskstack::io::bvh::{BvhConfig, BvhError, BvhNames, BvhReader, UpAxis};
 
 const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/mocap/");

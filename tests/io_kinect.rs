@@ -4,7 +4,7 @@
 use std::io::Cursor;
 
 use proptest::prelude::*;
-use taskstack::imitation::human::{HumanFrame, HumanJoint as J};
+use taskstack::human::{HumanFrame, HumanJoint as J};
 use taskstack::io::kinect::{KINECT_FIELDS, KinectConfig, KinectError, KinectReader};
 
 const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/mocap/");

@@ -5,8 +5,9 @@ mod common;
 
 use nalgebra::{IsometryMatrix3, Rotation3, Translation3, Vector3};
 use proptest::prelude::*;
+use taskstack::human::Side;
 use taskstack::model::Model;
-use taskstack::robots::nao::{self, Foot};
+use taskstack::robots::nao;
 
 const URDF: &str = include_str!("data/nao.urdf");
 const TOL: f64 = 1e-9;
@@ -153,7 +154,7 @@ proptest! {
         u in proptest::collection::vec(0.0..1.0f64, 23),
         x in -1.0..1.0f64, y in -1.0..1.0f64, yaw in -3.0..3.0f64,
     ) {
-        let (r, l) = (Foot::Right.model(), Foot::Left.model());
+        let (r, l) = (nao::rfoot(), nao::lfoot());
         let q = common::q_from_unit(&r, &u);
         let world_t_rsole = IsometryMatrix3::from_parts(
             Translation3::new(x, y, 0.0),
@@ -162,9 +163,9 @@ proptest! {
         let (mut dr, mut dl) = (r.new_data(), l.new_data());
         r.forward_kinematics(&mut dr, &q).unwrap();
         l.forward_kinematics(&mut dl, &q).unwrap();
-        let world_t_lsole = nao::switch_support(&r, &dr, &world_t_rsole, Foot::Left).unwrap();
+        let world_t_lsole = nao::switch_support(&r, &dr, &world_t_rsole, Side::Left).unwrap();
         // And back: the right sole lands where it started.
-        let back = nao::switch_support(&l, &dl, &world_t_lsole, Foot::Right).unwrap();
+        let back = nao::switch_support(&l, &dl, &world_t_lsole, Side::Right).unwrap();
         prop_assert!((back.translation.vector - world_t_rsole.translation.vector).norm() < TOL);
         for (name, _, _) in nao::FRAMES {
             let a = r.placement_in_world(&dr, &world_t_rsole, r.frame_id(name).unwrap()).unwrap();
@@ -246,10 +247,28 @@ fn hip_yaw_pitch_is_one_variable_driving_both_legs() {
 fn stance_point_keeps_the_margin_from_the_inner_edge() {
     let close =
         |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).abs() < 1e-12 && (a[1] - b[1]).abs() < 1e-12;
-    assert!(close(Foot::Left.sole_centre(), [0.020, 0.0034]));
-    assert!(close(Foot::Right.sole_centre(), [0.020, -0.0034]));
-    assert!(close(Foot::Left.stance_point(0.015), [0.020, -0.0081]));
-    assert!(close(Foot::Right.stance_point(0.015), [0.020, 0.0081]));
-    assert!(close(Foot::Left.stance_point(0.04), [0.020, 0.0034]));
-    assert!(close(Foot::Right.stance_point(0.04), [0.020, -0.0034]));
+    assert!(close(
+        nao::profile().sole_centre(Side::Left),
+        [0.020, 0.0034]
+    ));
+    assert!(close(
+        nao::profile().sole_centre(Side::Right),
+        [0.020, -0.0034]
+    ));
+    assert!(close(
+        nao::profile().stance_point(Side::Left, 0.015),
+        [0.020, -0.0081]
+    ));
+    assert!(close(
+        nao::profile().stance_point(Side::Right, 0.015),
+        [0.020, 0.0081]
+    ));
+    assert!(close(
+        nao::profile().stance_point(Side::Left, 0.04),
+        [0.020, 0.0034]
+    ));
+    assert!(close(
+        nao::profile().stance_point(Side::Right, 0.04),
+        [0.020, -0.0034]
+    ));
 }

@@ -31,11 +31,12 @@ use std::hash::{DefaultHasher, Hasher};
 use std::path::Path;
 
 use nalgebra::{IsometryMatrix3, Vector2, Vector3};
-use taskstack::imitation::human::HumanFrame;
-use taskstack::imitation::imitator::{FootRootedModels, Imitator, ImitatorConfig, RobotFrame};
+use taskstack::human::HumanFrame;
+use taskstack::human::Side;
+use taskstack::imitation::imitator::{Imitator, ImitatorConfig, RobotFrame};
 use taskstack::imitation::metrics::{CONTACT_HEIGHT, MetricsRecorder, convex_margin};
 use taskstack::io::clip::Clip;
-use taskstack::robots::nao::Foot;
+use taskstack::robots::nao;
 
 struct Counting;
 
@@ -129,10 +130,9 @@ struct Soak {
     max_slip: f64,
 }
 
-fn grounded_outline(foot: Foot, sole: &IsometryMatrix3<f64>) -> Option<[Vector2<f64>; 4]> {
-    let outline = foot
-        .sole_outline()
-        .map(|[x, y]| sole.transform_point(&Vector3::new(x, y, 0.0).into()));
+fn grounded_outline(foot: Side, sole: &IsometryMatrix3<f64>) -> Option<[Vector2<f64>; 4]> {
+    let outline =
+        nao::sole_outline(foot).map(|[x, y]| sole.transform_point(&Vector3::new(x, y, 0.0).into()));
     outline
         .iter()
         .all(|p| p.z.abs() <= CONTACT_HEIGHT)
@@ -162,7 +162,7 @@ fn check_frame(
     }
     let mut points = [Vector2::zeros(); 8];
     let mut n = 0;
-    for (foot, sole) in [(Foot::Right, &r.right_sole), (Foot::Left, &r.left_sole)] {
+    for (foot, sole) in [(Side::Right, &r.right_sole), (Side::Left, &r.left_sole)] {
         if let Some(outline) = grounded_outline(foot, sole) {
             points[n..n + 4].copy_from_slice(&outline);
             n += 4;
@@ -187,8 +187,8 @@ fn check_frame(
             );
         }
         let (now, before) = match r.root {
-            Foot::Right => (&r.right_sole, &p.right_sole),
-            Foot::Left => (&r.left_sole, &p.left_sole),
+            Side::Right => (&r.right_sole, &p.right_sole),
+            Side::Left => (&r.left_sole, &p.left_sole),
         };
         if grounded_outline(r.root, before).is_some() {
             slip = (now.translation.vector - before.translation.vector).norm();
@@ -200,7 +200,7 @@ fn check_frame(
 
 fn soak(clips: &[Vec<HumanFrame>], passes: usize) -> Soak {
     let start_bytes = live_bytes();
-    let mut imitator = Imitator::new(FootRootedModels::nao(), ImitatorConfig::default()).unwrap();
+    let mut imitator = Imitator::new(nao::profile(), ImitatorConfig::default()).unwrap();
     let mut previous: Option<RobotFrame> = None;
     let mut hasher = DefaultHasher::new();
     let mut out = Soak {

@@ -1,10 +1,10 @@
-//! Online imitation of a motion clip by the NAO (the README's main job).
+//! Online imitation of a motion clip by a biped (the README's main job).
 //!
-//! `cargo run --release --example imitate -- [CLIP.bvh|CLIP.csv] [--out DIR] [--velocity-fraction F] [--hold S]`
+//! `cargo run --release --example imitate -- [CLIP.bvh|CLIP.csv] [--robot nao|g1|PROFILE.toml] [--out DIR] [--velocity-fraction F] [--hold S]`
 //!
 //! With no clip, a bundled real clip with a support change (CMU 05_02: standing, arm gestures,
 //! small steps, then a stance on the right leg). Writes into DIR (default `target/imitate`):
-//! `joints.csv` (time in s + the 23 joint angles in rad, NAOqi names), `metrics.json` (see
+//! `joints.csv` (time in s + the robot's joint angles in rad, named as its model's variables), `metrics.json` (see
 //! `taskstack::imitation::metrics`), and the plots `effectors.svg` (Poubel Fig. 6), `com.svg`
 //! (Fig. 8) and `phases.svg`; prints a summary. `--velocity-fraction` is the share of the rated
 //! joint velocities the robot may use (default 0.1, as in the paper). After the clip the human's
@@ -12,7 +12,8 @@
 //! taking; those frames are in the outputs too. `--task-speed` (m/s, default 0.15) and
 //! `--iterations` (per frame, default 1) set `ImitatorConfig::max_task_speed` and
 //! `iterations_per_frame`. `--walk` lets the robot's feet follow the human's footprints
-//! (`FootstepConfig::follow`): it walks where the human walks.
+//! (`FootstepConfig::follow`): it walks where the human walks. `--robot` picks the robot: the
+//! built-in NAO (default) or Unitree G1, or a biped profile file (`BipedProfile::from_toml_file`).
 
 mod plots;
 
@@ -20,12 +21,13 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use taskstack::imitation::batch::metrics_json;
-use taskstack::imitation::human::HumanFrame;
-use taskstack::imitation::imitator::{FootRootedModels, Imitator, ImitatorConfig};
+use taskstack::batch::metrics_json;
+use taskstack::human::HumanFrame;
+use taskstack::human::Side;
+use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
 use taskstack::imitation::metrics::{CONTACT_HEIGHT, EFFECTORS, ImitationMetrics, MetricsRecorder};
 use taskstack::io::clip::Clip;
-use taskstack::robots::nao::Foot;
+use taskstack::robots::{BipedProfile, g1, nao};
 
 const DEFAULT_CLIP: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
@@ -38,6 +40,7 @@ fn main() -> ExitCode {
     let mut fraction = ImitatorConfig::default().velocity_fraction;
     let mut hold = 5.0;
     let mut config = ImitatorConfig::default();
+    let mut robot = "nao".to_owned();
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
@@ -54,6 +57,10 @@ fn main() -> ExitCode {
                 None => return usage(),
             },
             "--walk" => config.footsteps.follow = true,
+            "--robot" => match args.next() {
+                Some(r) => robot = r,
+                None => return usage(),
+            },
             "--velocity-fraction" => match args.next().and_then(|v| v.parse().ok()) {
                 Some(f) => fraction = f,
                 None => return usage(),
@@ -71,7 +78,18 @@ fn main() -> ExitCode {
         }
     }
     config.velocity_fraction = fraction;
-    match run(&clip, &out, config, hold) {
+    let profile = match robot.as_str() {
+        "nao" => nao::profile(),
+        "g1" => g1::profile(),
+        path => match BipedProfile::from_toml_file(path) {
+            Ok(p) => p,
+            Err(e) => {
+                eprintln!("imitate: --robot {path}: {e}");
+                return ExitCode::FAILURE;
+            }
+        },
+    };
+    match run(&clip, &out, profile, config, hold) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("imitate: {}: {e}", clip.display());
@@ -82,7 +100,7 @@ fn main() -> ExitCode {
 
 fn usage() -> ExitCode {
     eprintln!(
-        "usage: imitate [CLIP.bvh|CLIP.csv] [--out DIR] [--velocity-fraction F] [--hold S] [--task-speed V] [--iterations N] [--walk]"
+        "usage: imitate [CLIP.bvh|CLIP.csv] [--out DIR] [--velocity-fraction F] [--hold S] [--task-speed V] [--iterations N] [--walk] [--robot nao|g1|PROFILE.toml]"
     );
     ExitCode::from(2)
 }
@@ -90,6 +108,7 @@ fn usage() -> ExitCode {
 fn run(
     path: &Path,
     out: &Path,
+    profile: BipedProfile,
     config: ImitatorConfig,
     hold: f64,
 ) -> Result<(), Box<dyn std::error::Error>> {
@@ -98,12 +117,19 @@ fn run(
         support: clip.support_config(),
         ..config
     };
-    let mut imitator = Imitator::new(FootRootedModels::nao(), config)?;
+    let mut imitator = Imitator::new(profile, config)?;
     let mut recorder = MetricsRecorder::new(&imitator);
     let names: Vec<String> = imitator.variable_names().map(str::to_owned).collect();
     let mut joints = format!("time,{}\n", names.join(","));
     let mut samples = Vec::new();
+    // The plotted effectors (role names of EFFECTORS) and their robot frames.
+    let profile = imitator.profile().clone();
     let plotted = ["l_hand", "r_hand", "l_ankle"];
+    let frames = [
+        profile.hands[0].as_str(),
+        profile.hands[1].as_str(),
+        profile.foot(Side::Left).ankle.as_str(),
+    ];
     let mut frame = HumanFrame::new(0.0);
     let mut last: Option<HumanFrame> = None;
     let mut end = f64::INFINITY;
@@ -133,7 +159,7 @@ fn run(
         joints.push('\n');
 
         // World positions for the plots.
-        let model = imitator.models().rooted_at(r.root);
+        let model = profile.model(r.root);
         let mut data = model.new_data();
         model.forward_kinematics(&mut data, &r.q)?;
         let world = |p: nalgebra::Vector3<f64>| {
@@ -142,10 +168,11 @@ fn run(
         };
         let effectors = plotted
             .iter()
-            .map(|name| {
+            .zip(frames)
+            .map(|(name, frame)| {
                 let joint = EFFECTORS.iter().find(|(n, _)| n == name).map(|(_, j)| *j);
                 let robot = world(
-                    data.frame_placement(model.frame_id(name)?)
+                    data.frame_placement(model.frame_id(frame)?)
                         .translation
                         .vector,
                 );
@@ -153,16 +180,19 @@ fn run(
                 Ok((robot, reference))
             })
             .collect::<Result<Vec<_>, taskstack::model::ModelError>>()?;
-        let footprints = [(Foot::Right, r.right_sole), (Foot::Left, r.left_sole)]
+        let footprints = [(Side::Right, r.right_sole), (Side::Left, r.left_sole)]
             .into_iter()
             .filter_map(|(foot, sole)| {
-                let outline = foot
-                    .sole_outline()
-                    .map(|[x, y]| sole.transform_point(&nalgebra::Point3::new(x, y, 0.0)));
+                let outline: Vec<_> = profile
+                    .foot(foot)
+                    .outline
+                    .iter()
+                    .map(|&[x, y]| sole.transform_point(&nalgebra::Point3::new(x, y, 0.0)))
+                    .collect();
                 outline
                     .iter()
                     .all(|p| p.z.abs() <= CONTACT_HEIGHT)
-                    .then(|| (foot, outline.map(|p| [p.x, p.y])))
+                    .then(|| (foot, outline.iter().map(|p| [p.x, p.y]).collect()))
             })
             .collect();
         samples.push(plots::Sample {

@@ -4,7 +4,7 @@
 
 use std::fmt::Write as _;
 
-use taskstack::robots::nao::Foot;
+use taskstack::human::Side;
 
 /// What the plots need of one frame (world frame, metres).
 pub struct Sample {
@@ -13,7 +13,7 @@ pub struct Sample {
     pub effectors: Vec<([f64; 3], Option<[f64; 3]>)>,
     pub com: [f64; 2],
     /// World outline of each sole on the ground this frame.
-    pub footprints: Vec<(Foot, [[f64; 2]; 4])>,
+    pub footprints: Vec<(Side, Vec<[f64; 2]>)>,
     pub human: &'static str,
     pub robot: String,
 }
@@ -137,7 +137,7 @@ pub fn com_and_feet(samples: &[Sample]) -> String {
         h + 40.0
     );
     svg.push_str("\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n");
-    let mut drawn: Vec<[[f64; 2]; 4]> = Vec::new();
+    let mut drawn: Vec<Vec<[f64; 2]>> = Vec::new();
     for s in samples {
         for (foot, outline) in &s.footprints {
             let seen = drawn.iter().any(|d| {
@@ -148,8 +148,8 @@ pub fn com_and_feet(samples: &[Sample]) -> String {
             if seen {
                 continue;
             }
-            drawn.push(*outline);
-            let color = if *foot == Foot::Right {
+            drawn.push(outline.clone());
+            let color = if *foot == Side::Right {
                 "#d62728"
             } else {
                 "#1f77b4"

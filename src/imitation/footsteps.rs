@@ -34,11 +34,11 @@
 
 use nalgebra::{Rotation2, Vector2};
 
-use super::human::{HumanFrame, HumanJoint};
 use super::phase::SupportPhase;
-use super::scaler::{FootArea, SolePlacement};
-use super::support::{HumanSupport, Side};
-use crate::robots::nao::Foot;
+use super::support::HumanSupport;
+use crate::human::Side;
+use crate::human::{HumanFrame, HumanJoint};
+use crate::robots::{FootArea, SolePlacement};
 
 /// When the robot steps.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -59,8 +59,6 @@ pub struct FootstepConfig {
     /// foot down, even if it has not reached its target (5 mm, 2°): a target the legs cannot
     /// reach must not keep the robot on one leg. Default 2.
     pub swing_timeout: f64,
-    /// The robot's step envelope around its standing foot.
-    pub area: FootArea,
 }
 
 impl Default for FootstepConfig {
@@ -71,7 +69,6 @@ impl Default for FootstepConfig {
             heading: 0.087,
             stance_time: 0.3,
             swing_timeout: 2.0,
-            area: FootArea::nao(),
         }
     }
 }
@@ -133,13 +130,6 @@ fn shifting(phase: SupportPhase) -> bool {
     )
 }
 
-fn side(foot: Foot) -> Side {
-    match foot {
-        Foot::Right => Side::Right,
-        Foot::Left => Side::Left,
-    }
-}
-
 /// What the planner is doing.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Step {
@@ -147,7 +137,7 @@ enum Step {
     Idle,
     /// Stepping with this foot: shifting, lifting, carrying it to its target; the time (s) spent
     /// in single support with the human's foot down.
-    Swing(Foot, f64),
+    Swing(Side, f64),
     /// The swing foot is on its target and the human's foot is down: landing, back to DS.
     Landing,
 }
@@ -155,31 +145,33 @@ enum Step {
 /// Turns the human's footprints into robot steps (see the module docs).
 #[derive(Clone, Debug)]
 pub struct FootstepPlanner {
+    area: FootArea,
     config: FootstepConfig,
-    /// The human's last footprint of each foot (right, left), human world.
+    /// The human's last footprint of each foot (left, right), human world.
     human: [Option<GroundPose>; 2],
-    /// The starting footprints (right, left) of the human and of the robot, and the heading
+    /// The starting footprints (left, right) of the human and of the robot, and the heading
     /// difference of the starting stances (robot − human, rad).
     origin: Option<([GroundPose; 2], [GroundPose; 2], f64)>,
     /// How long the human has stood on one foot (s), and which foot is lifted.
-    stance: Option<(Foot, f64)>,
-    /// Which human feet (right, left) are on the ground at this frame.
+    stance: Option<(Side, f64)>,
+    /// Which human feet (left, right) are on the ground at this frame.
     down: [bool; 2],
     step: Step,
     /// The current swing target (robot world), while stepping.
     target: Option<GroundPose>,
     /// Feet off their targets at the last update (0, 1 or 2).
     off_target: usize,
-    /// Where the robot's feet stood when the current step began (right, left): the targets
+    /// Where the robot's feet stood when the current step began (left, right): the targets
     /// when the feet do not follow the human's.
     home: Option<[GroundPose; 2]>,
 }
 
 impl FootstepPlanner {
-    /// A planner with `config`.
-    pub fn new(config: FootstepConfig) -> Self {
+    /// A planner with `config` for a robot with the step envelope `area`.
+    pub fn new(config: FootstepConfig, area: FootArea) -> Self {
         Self {
             config,
+            area,
             human: [None; 2],
             origin: None,
             stance: None,
@@ -192,7 +184,7 @@ impl FootstepPlanner {
     }
 
     /// The swing foot and its target (robot world), while the robot steps.
-    pub fn target(&self) -> Option<(Foot, GroundPose)> {
+    pub fn target(&self) -> Option<(Side, GroundPose)> {
         match self.step {
             Step::Swing(foot, _) => Some((foot, self.target?)),
             Step::Idle | Step::Landing => None,
@@ -205,7 +197,7 @@ impl FootstepPlanner {
     }
 
     /// One frame. `human` is the detected human support, `ratio` the leg ratio, `feet` the
-    /// robot's sole poses (right, left; robot world) and `phase` its phase at the previous
+    /// robot's sole poses (left, right; robot world) and `phase` its phase at the previous
     /// frame, `dt` the frame's time step (s). Returns the support the phase machine should work
     /// toward.
     pub fn update(
@@ -219,27 +211,27 @@ impl FootstepPlanner {
     ) -> HumanSupport {
         self.observe(frame, human, dt);
         if self.origin.is_none()
-            && let [Some(r), Some(l)] = self.human
+            && let [Some(l), Some(r)] = self.human
         {
-            let heading = |[r, l]: [GroundPose; 2]| wrap(r.yaw + 0.5 * wrap(l.yaw - r.yaw));
-            self.origin = Some(([r, l], feet, wrap(heading(feet) - heading([r, l]))));
+            let heading = |[l, r]: [GroundPose; 2]| wrap(r.yaw + 0.5 * wrap(l.yaw - r.yaw));
+            self.origin = Some(([l, r], feet, wrap(heading(feet) - heading([l, r]))));
         }
         if self.step == Step::Idle || self.home.is_none() {
             self.home = Some(feet);
         }
         let targets = match self.home {
             Some(home) if !self.config.follow => home.map(Some),
-            _ => [Foot::Right, Foot::Left].map(|f| self.target_of(f, feet, ratio)),
+            _ => Side::BOTH.map(|f| self.target_of(f, feet, ratio)),
         };
-        let error = |f: Foot| -> Option<(f64, f64)> {
+        let error = |f: Side| -> Option<(f64, f64)> {
             let t = targets[f.index()]?;
             let d = feet[f.index()].relative(&t);
             Some((d.xy.norm(), d.yaw.abs()))
         };
         let config = self.config;
         let off =
-            |f: Foot| error(f).is_some_and(|(d, a)| d > config.distance || a > config.heading);
-        self.off_target = usize::from(off(Foot::Right)) + usize::from(off(Foot::Left));
+            |f: Side| error(f).is_some_and(|(d, a)| d > config.distance || a > config.heading);
+        self.off_target = usize::from(off(Side::Right)) + usize::from(off(Side::Left));
         match self.step {
             Step::Idle if phase == SupportPhase::Double => {
                 self.step = self.choose(off, error);
@@ -281,8 +273,8 @@ impl FootstepPlanner {
             Step::Idle | Step::Landing => {}
         }
         match self.step {
-            Step::Swing(Foot::Left, _) => HumanSupport::Right,
-            Step::Swing(Foot::Right, _) => HumanSupport::Left,
+            Step::Swing(Side::Left, _) => HumanSupport::Right,
+            Step::Swing(Side::Right, _) => HumanSupport::Left,
             Step::Idle | Step::Landing => HumanSupport::Double,
         }
     }
@@ -291,25 +283,25 @@ impl FootstepPlanner {
     /// its target.
     fn choose(
         &self,
-        off: impl Fn(Foot) -> bool,
-        error: impl Fn(Foot) -> Option<(f64, f64)>,
+        off: impl Fn(Side) -> bool,
+        error: impl Fn(Side) -> Option<(f64, f64)>,
     ) -> Step {
         if let Some((lifted, t)) = self.stance
             && t >= self.config.stance_time
         {
             return Step::Swing(lifted, 0.0);
         }
-        let cost = |f: Foot| {
+        let cost = |f: Side| {
             error(f).map_or(0.0, |(d, a)| {
                 d / self.config.distance + a / self.config.heading
             })
         };
-        match (off(Foot::Right), off(Foot::Left)) {
+        match (off(Side::Right), off(Side::Left)) {
             (false, false) => Step::Idle,
-            (true, false) => Step::Swing(Foot::Right, 0.0),
-            (false, true) => Step::Swing(Foot::Left, 0.0),
-            (true, true) if cost(Foot::Right) >= cost(Foot::Left) => Step::Swing(Foot::Right, 0.0),
-            (true, true) => Step::Swing(Foot::Left, 0.0),
+            (true, false) => Step::Swing(Side::Right, 0.0),
+            (false, true) => Step::Swing(Side::Left, 0.0),
+            (true, true) if cost(Side::Right) >= cost(Side::Left) => Step::Swing(Side::Right, 0.0),
+            (true, true) => Step::Swing(Side::Left, 0.0),
         }
     }
 
@@ -317,12 +309,12 @@ impl FootstepPlanner {
     fn observe(&mut self, frame: &HumanFrame, human: HumanSupport, dt: f64) {
         let down = match human {
             HumanSupport::Double => [true, true],
-            HumanSupport::Right => [true, false],
-            HumanSupport::Left => [false, true],
+            HumanSupport::Right => [false, true],
+            HumanSupport::Left => [true, false],
             HumanSupport::Airborne => [false, false],
         };
         self.down = down;
-        for foot in [Foot::Right, Foot::Left] {
+        for foot in Side::BOTH {
             if down[foot.index()]
                 && let Some(print) = footprint(frame, foot)
             {
@@ -330,8 +322,8 @@ impl FootstepPlanner {
             }
         }
         let lifted = match human {
-            HumanSupport::Right => Some(Foot::Left),
-            HumanSupport::Left => Some(Foot::Right),
+            HumanSupport::Right => Some(Side::Left),
+            HumanSupport::Left => Some(Side::Right),
             HumanSupport::Double | HumanSupport::Airborne => None,
         };
         self.stance = match (lifted, self.stance) {
@@ -343,7 +335,7 @@ impl FootstepPlanner {
 
     /// The target of `foot` (robot world): its scaled human footprint, clipped to the envelope
     /// around the robot's other foot.
-    fn target_of(&self, foot: Foot, feet: [GroundPose; 2], ratio: f64) -> Option<GroundPose> {
+    fn target_of(&self, foot: Side, feet: [GroundPose; 2], ratio: f64) -> Option<GroundPose> {
         let (human0, robot0, turn) = self.origin?;
         let (h0, r0) = (human0[foot.index()], robot0[foot.index()]);
         let print = self.human[foot.index()]?;
@@ -353,8 +345,8 @@ impl FootstepPlanner {
         };
         let other = feet[foot.other().index()];
         let local = other.relative(&scaled);
-        let clipped = self.config.area.clip(
-            side(foot),
+        let clipped = self.area.clip(
+            foot,
             SolePlacement {
                 xy: local.xy,
                 yaw: local.yaw,
@@ -368,10 +360,10 @@ impl FootstepPlanner {
 }
 
 /// The footprint of a human foot: ankle ground point and heading.
-fn footprint(frame: &HumanFrame, foot: Foot) -> Option<GroundPose> {
+fn footprint(frame: &HumanFrame, foot: Side) -> Option<GroundPose> {
     let (ankle, toe) = match foot {
-        Foot::Right => (HumanJoint::RAnkle, HumanJoint::RToe),
-        Foot::Left => (HumanJoint::LAnkle, HumanJoint::LToe),
+        Side::Right => (HumanJoint::RAnkle, HumanJoint::RToe),
+        Side::Left => (HumanJoint::LAnkle, HumanJoint::LToe),
     };
     let ankle = frame.get(ankle)?;
     let forward = match frame.get(toe) {
@@ -390,6 +382,15 @@ fn footprint(frame: &HumanFrame, foot: Foot) -> Option<GroundPose> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A step envelope 5 cm forward, 4 cm back, 9.5–12 cm to the side, ±0.15 rad.
+    const AREA: FootArea = FootArea {
+        x_min: -0.04,
+        x_max: 0.05,
+        lateral_min: 0.095,
+        lateral_max: 0.12,
+        yaw_max: 0.15,
+    };
 
     fn pose(x: f64, y: f64, yaw: f64) -> GroundPose {
         GroundPose {
@@ -420,18 +421,18 @@ mod tests {
 
     const FEET: [GroundPose; 2] = [
         GroundPose {
-            xy: Vector2::new(0.0, 0.0),
+            xy: Vector2::new(0.0, 0.1),
             yaw: 0.0,
         },
         GroundPose {
-            xy: Vector2::new(0.0, 0.1),
+            xy: Vector2::new(0.0, 0.0),
             yaw: 0.0,
         },
     ];
 
     #[test]
     fn a_human_step_forward_becomes_a_clipped_robot_step() {
-        let mut planner = FootstepPlanner::new(walking());
+        let mut planner = FootstepPlanner::new(walking(), AREA);
         let double = SupportPhase::Double;
         let dt = 0.01;
         // Standing: no step.
@@ -440,7 +441,7 @@ mod tests {
         assert_eq!(s, HumanSupport::Double);
         assert_eq!(planner.steps_pending(), 0);
         // The left foot lands 0.4 m ahead: 0.1 m for the robot at ratio 0.25, clipped to the
-        // NAO envelope's 0.05 m ahead of the right foot.
+        // envelope's 0.05 m ahead of the right foot.
         let moved = human([0.0, -0.1], [0.4, 0.1]);
         let s = planner.update(&moved, HumanSupport::Double, 0.25, FEET, double, dt);
         assert_eq!(
@@ -449,7 +450,7 @@ mod tests {
             "stand on the right foot to move the left"
         );
         let (foot, target) = planner.target().unwrap();
-        assert_eq!(foot, Foot::Left);
+        assert_eq!(foot, Side::Left);
         assert!(
             (target.xy - Vector2::new(0.05, 0.1)).norm() < 1e-12,
             "{target:?}"
@@ -457,7 +458,7 @@ mod tests {
         assert!(target.yaw.abs() < 1e-12);
         assert_eq!(planner.steps_pending(), 1);
         // Once the robot stands on the right foot with the left on its target, it lands.
-        let feet = [FEET[0], pose(0.05, 0.1, 0.0)];
+        let feet = [pose(0.05, 0.1, 0.0), FEET[1]];
         let s = planner.update(
             &moved,
             HumanSupport::Double,
@@ -479,7 +480,7 @@ mod tests {
         let s = planner.update(&together, HumanSupport::Double, 0.25, feet, double, dt);
         assert_eq!(s, HumanSupport::Left);
         let (foot, target) = planner.target().unwrap();
-        assert_eq!(foot, Foot::Right);
+        assert_eq!(foot, Side::Right);
         assert!(
             (target.xy - Vector2::new(0.1, 0.0)).norm() < 1e-12,
             "{target:?}"
@@ -489,7 +490,7 @@ mod tests {
     /// The human's toe-out is not copied: a foot that keeps its heading keeps the robot's.
     #[test]
     fn headings_are_relative_to_the_start() {
-        let mut planner = FootstepPlanner::new(walking());
+        let mut planner = FootstepPlanner::new(walking(), AREA);
         let mut frame = human([0.0, -0.1], [0.0, 0.1]);
         // Toes out by 0.3 rad on both feet.
         let v = |x: f64, y: f64| nalgebra::Vector3::new(x, y, 0.02);
@@ -516,7 +517,7 @@ mod tests {
     #[test]
     fn a_human_on_one_leg_is_followed_after_the_stance_time() {
         // Without walking: the foot is lifted in place.
-        let mut planner = FootstepPlanner::new(FootstepConfig::default());
+        let mut planner = FootstepPlanner::new(FootstepConfig::default(), AREA);
         let frame = human([0.0, -0.1], [0.0, 0.1]);
         let mut step = |human, phase, dt| planner.update(&frame, human, 0.25, FEET, phase, dt);
         step(HumanSupport::Double, SupportPhase::Double, 0.01);

@@ -7,11 +7,11 @@
 //!    the human support and what the robot achieved at the previous frame ([`Measurements`]).
 //! 3. **Model switch**: the phase's table names the sole the model is rooted at (`RFoot` or
 //!    `LFoot`). On a switch the new root's world placement is computed from the old model's forward
-//!    kinematics at the current `q` ([`nao::switch_support`]), so the robot does not move in the
+//!    kinematics at the current `q` (`ʷT_b = ʷT_a · ᵃT_b(q)`), so the robot does not move in the
 //!    world: the support foot does not slip. Both models share the variables, so `q` carries over.
 //! 4. **Scaling** ([`Scaler`], eq. 1) of the human frame into the support-sole frame, re-expressed in
 //!    the model root's frame when the two differ (during a take-off toward the foot that is not
-//!    the root yet); human joint angles ([`NaoJointAngles`]) for the joint-tracking task.
+//!    the root yet); human joint angles (the profile's [`HumanJointAngles`]) for the joint-tracking task.
 //! 5. **IK**: the phase's [`TaskTable`] is turned into the stack of a solver prepared for it: CoM
 //!    xy first, then the Cartesian tasks, then the gradient tasks (joint limits, human joints) in
 //!    the remaining null space, with the clamping loop. One Gauss–Newton step per frame
@@ -30,19 +30,20 @@ use nalgebra::{IsometryMatrix3, Rotation3, UnitQuaternion, Vector2, Vector3};
 use thiserror::Error;
 
 use super::footsteps::{FootstepConfig, FootstepPlanner, GroundPose};
-use super::human::{HumanFrame, HumanJoint};
 use super::phase::{
     Measurements, PhaseConfig, PhaseError, PhaseMachine, Settling, SupportPhase, TakeOff,
 };
-use super::scaler::{NAO_MAPPING, NaoJointAngles, RobotSkeleton, ScaleConfig, ScaleError, Scaler};
+use super::scaler::{RobotSkeleton, ScaleConfig, ScaleError, Scaler};
 use super::shaping::{ComReference, MotionLimits, SwingHeight};
-use super::support::{HumanSupport, Side, SupportConfig, SupportDetector, SupportError};
+use super::support::{HumanSupport, SupportConfig, SupportDetector, SupportError};
 use super::tables::{
     ComGoal, Gradient, GradientKind, OrientationTarget, PointTarget, TableError, Task, TaskTable,
     TaskTables,
 };
+use crate::human::{HumanFrame, HumanJoint, Side};
 use crate::model::{Axis, FrameId, Model, ModelData, ModelError};
-use crate::robots::nao::{self, Foot};
+use crate::robots::{BipedProfile, FootArea, HumanJointAngles, ProfileError};
+
 use crate::solver::driver::{DriverSettings, PositionDriver, StopReason, TaskModel};
 use crate::solver::{
     JointBounds, JointLimitAvoidance, JointTracking, LevelReport, Settings, Solver, SolverError,
@@ -62,6 +63,9 @@ pub enum ImitationError {
     /// The scaler refused its input.
     #[error(transparent)]
     Scale(#[from] ScaleError),
+    /// The robot profile is invalid, or its joint-angle map refused its input.
+    #[error(transparent)]
+    Profile(#[from] ProfileError),
     /// A task table is invalid.
     #[error(transparent)]
     Table(#[from] TableError),
@@ -91,45 +95,23 @@ pub enum ImitationError {
     },
 }
 
-/// A biped's kinematic model rooted at each sole: the same variables and named frames, two roots.
-#[derive(Debug, Clone)]
-pub struct FootRootedModels {
-    /// Rooted at the right sole (`RFoot`).
-    pub right: Model,
-    /// Rooted at the left sole (`LFoot`).
-    pub left: Model,
-}
-
-impl FootRootedModels {
-    /// The NAO H25 V5 from the embedded DH tables.
-    pub fn nao() -> Self {
-        Self {
-            right: nao::rfoot(),
-            left: nao::lfoot(),
-        }
-    }
-
-    /// The model rooted at `foot`.
-    pub fn rooted_at(&self, foot: Foot) -> &Model {
-        match foot {
-            Foot::Right => &self.right,
-            Foot::Left => &self.left,
-        }
-    }
-}
-
 /// Settings of the imitator. Defaults are the paper's where it gives them.
 #[derive(Debug, Clone)]
 pub struct ImitatorConfig {
     /// Support detection (default: optical motion capture).
     pub support: SupportConfig,
-    /// Scaling (default: the NAO's foot area).
-    pub scale: ScaleConfig,
+    /// Where a foot may be put down relative to the other; `None` (default): the profile's
+    /// [`BipedProfile::step_envelope`].
+    pub step_envelope: Option<FootArea>,
+    /// Human segments shorter than this (m) keep their previous direction in the scaler
+    /// (default 1e−9: only coincident points).
+    pub min_segment: f64,
     /// Phase machine: λ, ρ and the step-end tolerances.
     pub phase: PhaseConfig,
-    /// The task tables (default: [`TaskTables::executable`], Table I with the feet held fully
-    /// while they stand, the CoM at the middle of the contact area and an upright torso).
-    pub tables: TaskTables,
+    /// The task tables; `None` (default): [`TaskTables::executable`] for the profile, Table I
+    /// with the feet held fully while they stand, the CoM at the middle of the contact area and
+    /// an upright torso.
+    pub tables: Option<TaskTables>,
     /// Fraction of each joint's rated velocity the robot may use (paper: 0.1). With
     /// `upper_body_velocity_fraction` set, this applies to the legs only: the joints on the
     /// chain between the two soles, which carry the robot and close a loop in double support.
@@ -168,19 +150,19 @@ pub struct ImitatorConfig {
     /// [`Settings::scale_to_fit`] on: when the velocity limits bind, the whole step slows down
     /// uniformly instead of the clamping loop pinning joints the balance level needs.
     pub solver: Settings,
-    /// Initial posture (model variable order, rad); default NAOqi's StandInit-like posture with
-    /// both feet flat.
+    /// Initial posture (model variable order, rad); `None` (default): the profile's
+    /// [`BipedProfile::stand`].
     pub initial_q: Option<Vec<f64>>,
 }
 
 impl Default for ImitatorConfig {
     fn default() -> Self {
-        let phase = PhaseConfig::default();
         Self {
             support: SupportConfig::optical(),
-            scale: ScaleConfig::nao(),
-            tables: TaskTables::executable(&phase),
-            phase,
+            step_envelope: None,
+            min_segment: 1e-9,
+            tables: None,
+            phase: PhaseConfig::default(),
             velocity_fraction: 0.1,
             upper_body_velocity_fraction: Some(0.5),
             motion: MotionLimits::default(),
@@ -254,13 +236,6 @@ impl ImitatorConfig {
     }
 }
 
-/// The NAOqi StandInit-like posture (both feet flat: hip + knee + ankle pitch = 0), in the NAO
-/// variable order of [`nao::VARIABLES`].
-pub const NAO_STAND: [f64; 23] = [
-    0.0, 0.0, 1.4, 0.3, -1.39, -1.0, 0.0, 0.0, 0.0, -0.35, 0.7, -0.35, 0.0, 0.0, -0.35, 0.7, -0.35,
-    0.0, 1.4, -0.3, 1.39, 1.0, 0.0,
-];
-
 /// One robot output frame.
 #[derive(Debug, Clone)]
 pub struct RobotFrame {
@@ -273,7 +248,7 @@ pub struct RobotFrame {
     /// The robot's phase or transition step.
     pub phase: SupportPhase,
     /// The sole the model was rooted at.
-    pub root: Foot,
+    pub root: Side,
     /// World placement of the right sole.
     pub right_sole: IsometryMatrix3<f64>,
     /// World placement of the left sole.
@@ -342,14 +317,16 @@ struct PhaseSolver {
 
 /// The online imitator.
 pub struct Imitator {
-    models: FootRootedModels,
+    profile: BipedProfile,
+    /// Forward kinematics of the model rooted at each sole (`[left, right]`).
     data: [ModelData; 2],
     /// The sole frames of each model, resolved once: `soles[root][foot]`.
     soles: [[FrameId; 2]; 2],
     phases: Vec<PhaseSolver>,
     detector: SupportDetector,
     scaler: Scaler,
-    angles: NaoJointAngles,
+    /// The profile's human joint-angle map, if it has one.
+    angles: Option<Box<dyn HumanJointAngles>>,
     machine: PhaseMachine,
     bounds: JointBounds,
     velocity_fraction: f64,
@@ -364,7 +341,7 @@ pub struct Imitator {
     /// reference of the legs.
     stance: Vec<Option<f64>>,
     q: Vec<f64>,
-    root: Foot,
+    root: Side,
     world_t_root: IsometryMatrix3<f64>,
     phase: SupportPhase,
     measurements: Measurements,
@@ -399,12 +376,12 @@ fn axes_of(task: &Task) -> [Option<Axis>; 3] {
 impl PhaseSolver {
     fn new(
         table: &TaskTable,
-        models: &FootRootedModels,
+        profile: &BipedProfile,
         initial_q: &[f64],
         settings: Settings,
     ) -> Result<Self, ImitationError> {
         table.validate()?;
-        let model = models.rooted_at(table.model_root);
+        let model = profile.model(table.model_root);
         let mut rest = model.new_data();
         model.forward_kinematics(&mut rest, &vec![0.0; model.nv()])?;
         let mut initial = model.new_data();
@@ -447,29 +424,26 @@ impl PhaseSolver {
         }
         let solver = Solver::with_settings(&table.shape(model.nv()), settings)?;
         let driver = PositionDriver::new(&solver, DriverSettings::default())?;
-        let other = table.model_root.other();
-        let ankle_name = match other {
-            Foot::Right => "r_ankle",
-            Foot::Left => "l_ankle",
-        };
+        let other = profile.foot(table.model_root.other());
         Ok(Self {
             table: table.clone(),
             tasks,
             solver,
             driver,
-            other_ankle: model.frame_id(ankle_name)?,
-            other_sole: model.frame_id(other.sole())?,
+            other_ankle: model.frame_id(&other.ankle)?,
+            other_sole: model.frame_id(&other.sole)?,
         })
     }
 }
 
 impl Imitator {
-    /// An imitator for a biped's foot-rooted models. The models must have the NAO's variables
-    /// and named frames (the scaler's mapping and the joint-angle map are the NAO's).
-    pub fn new(models: FootRootedModels, config: ImitatorConfig) -> Result<Self, ImitationError> {
+    /// An imitator for the biped described by `profile` (checked with
+    /// [`BipedProfile::validate`]).
+    pub fn new(profile: BipedProfile, config: ImitatorConfig) -> Result<Self, ImitationError> {
         config.validate()?;
+        profile.validate()?;
         let fraction = config.velocity_fraction;
-        let model = &models.right;
+        let model = profile.model(Side::Right);
         let nv = model.nv();
         let lower: Vec<f64> = model.variables().iter().map(|v| v.lower).collect();
         let upper: Vec<f64> = model.variables().iter().map(|v| v.upper).collect();
@@ -484,11 +458,10 @@ impl Imitator {
                 }
                 .into());
             }
-            None if nv == NAO_STAND.len() => NAO_STAND.to_vec(),
-            None => vec![0.0; nv],
+            None => profile.stand.clone(),
         };
         position_bounds.clamp_position(&mut q);
-        let legs = sole_chain_variables(&models, &q)?;
+        let legs = sole_chain_variables(&profile, &q)?;
         let velocity: Vec<f64> = model
             .variables()
             .iter()
@@ -507,6 +480,10 @@ impl Imitator {
             .zip(&q)
             .map(|(&leg, &v)| leg.then_some(v))
             .collect();
+        let tables = match config.tables {
+            Some(tables) => tables,
+            None => TaskTables::executable(&config.phase, &profile),
+        };
         let phases = SupportPhase::ALL
             .iter()
             .map(|&phase| {
@@ -514,7 +491,7 @@ impl Imitator {
                     scale_to_fit: true,
                     ..config.solver
                 };
-                PhaseSolver::new(config.tables.table(phase), &models, &q, settings)
+                PhaseSolver::new(tables.table(phase), &profile, &q, settings)
             })
             .collect::<Result<Vec<_>, _>>()?;
         let max_tasks = phases.iter().map(|p| p.tasks.len()).max().unwrap_or(0);
@@ -523,26 +500,31 @@ impl Imitator {
             .map(|p| p.table.levels.len())
             .max()
             .unwrap_or(0);
-        let skeleton = RobotSkeleton::at_zero(&models.right, &NAO_MAPPING)?;
-        let angles = NaoJointAngles::new(&models.right)?;
-        let mut data = [models.right.new_data(), models.left.new_data()];
-        let sole_ids = |model: &Model| -> Result<[FrameId; 2], ModelError> {
-            Ok([
-                model.frame_id(Foot::Right.sole())?,
-                model.frame_id(Foot::Left.sole())?,
-            ])
+        let skeleton = RobotSkeleton::of(&profile)?;
+        let angles = profile.joint_angles.map(|build| build(model)).transpose()?;
+        let mut data = profile.models.clone().map(|m| m.new_data());
+        let sole_ids = |root: Side| -> Result<[FrameId; 2], ModelError> {
+            let model = profile.model(root);
+            let [left, right] = Side::BOTH.map(|foot| model.frame_id(&profile.foot(foot).sole));
+            Ok([left?, right?])
         };
-        let soles = [sole_ids(&models.right)?, sole_ids(&models.left)?];
-        models.right.forward_kinematics(&mut data[0], &q)?;
+        let soles = [sole_ids(Side::Left)?, sole_ids(Side::Right)?];
+        let right = Side::Right.index();
+        model.forward_kinematics(&mut data[right], &q)?;
+        let area = config.step_envelope.unwrap_or(profile.step_envelope);
+        let scale = ScaleConfig {
+            min_segment: config.min_segment,
+            ..ScaleConfig::new(area)
+        };
         let output = RobotFrame {
             time: 0.0,
             q: q.clone(),
             human_support: HumanSupport::Double,
             phase: SupportPhase::Double,
-            root: Foot::Right,
+            root: Side::Right,
             // The world is the right sole's frame at the start.
             right_sole: IsometryMatrix3::identity(),
-            left_sole: *data[0].frame_placement(soles[0][1]),
+            left_sole: *data[right].frame_placement(soles[right][Side::Left.index()]),
             com: Vector3::zeros(),
             // Sized for the largest table, so a user's bigger table is reported whole.
             task_errors: vec![0.0; max_tasks],
@@ -560,7 +542,7 @@ impl Imitator {
         };
         Ok(Self {
             detector: SupportDetector::new(config.support)?,
-            scaler: Scaler::new(skeleton, config.scale)?,
+            scaler: Scaler::new(skeleton, scale)?,
             angles,
             machine: PhaseMachine::new(config.phase)?,
             limits: JointLimitAvoidance::new(&position_bounds),
@@ -577,7 +559,7 @@ impl Imitator {
             data,
             soles,
             q,
-            root: Foot::Right,
+            root: Side::Right,
             world_t_root: IsometryMatrix3::identity(),
             phase: SupportPhase::Double,
             measurements: Measurements {
@@ -589,20 +571,20 @@ impl Imitator {
             },
             posture_settling: Settling::new(),
             previous_time: None,
-            footsteps: FootstepPlanner::new(config.footsteps),
+            footsteps: FootstepPlanner::new(config.footsteps, area),
             motion: config.motion,
             com_reference: None,
             swing: SwingHeight::at(0.0),
             orientation_rows: Mat::zeros(3, nv),
             output,
-            models,
+            profile,
         })
     }
 
-    /// Names of the joint angles of [`RobotFrame::q`] (NAOqi names for the NAO).
+    /// Names of the joint angles of [`RobotFrame::q`] (the model's variable names).
     pub fn variable_names(&self) -> impl Iterator<Item = &str> {
-        self.models
-            .right
+        self.profile
+            .model(Side::Right)
             .variables()
             .iter()
             .map(|v| v.name.as_str())
@@ -626,9 +608,9 @@ impl Imitator {
             .map(|t| t.task.name())
     }
 
-    /// The models.
-    pub fn models(&self) -> &FootRootedModels {
-        &self.models
+    /// The robot profile (models rooted at either sole, frames, feet).
+    pub fn profile(&self) -> &BipedProfile {
+        &self.profile
     }
 
     /// The joint bounds the output respects: position limits, and the rated velocities times
@@ -667,8 +649,8 @@ impl Imitator {
         };
         let human = self.detector.update(frame);
         let feet = [
-            ground_pose(&self.output.right_sole),
             ground_pose(&self.output.left_sole),
+            ground_pose(&self.output.right_sole),
         ];
         let wanted =
             self.footsteps
@@ -679,7 +661,9 @@ impl Imitator {
         let root = self.root.index();
 
         let scaled = *self.scaler.scale(frame, human)?;
-        self.angles.compute(&scaled, &mut self.human_q)?;
+        if let Some(angles) = &mut self.angles {
+            angles.compute(scaled.directions(), &mut self.human_q)?;
+        }
         for (human, stance) in self.human_q.iter_mut().zip(&self.stance) {
             if let Some(stance) = stance {
                 *human = *stance;
@@ -687,10 +671,10 @@ impl Imitator {
         }
         self.tracking.set_reference(&self.human_q)?;
         // The scaler's output frame is the sole of its stance; the model's is the root sole.
-        let root_t_base = if scaled.base() == side_of(self.root) {
+        let root_t_base = if scaled.base() == self.root {
             IsometryMatrix3::identity()
         } else {
-            *self.data[root].frame_placement(self.soles[root][foot_of(scaled.base()).index()])
+            *self.data[root].frame_placement(self.soles[root][scaled.base().index()])
         };
         for (out, (_, p)) in self.output.reference.iter_mut().zip(scaled.points()) {
             *out = p.map(|p| root_t_base.transform_point(&p.into()).coords);
@@ -712,7 +696,7 @@ impl Imitator {
                 yaw: world.yaw - ground_pose(&self.world_t_root).yaw,
             }
         });
-        let model = self.models.rooted_at(self.root);
+        let model = self.profile.model(self.root);
         let ps = &mut self.phases[phase.index()];
         // The velocity budget of the frame, split over its iterations.
         let step_dt = dt / self.iterations as f64;
@@ -772,9 +756,8 @@ impl Imitator {
         // so that the foot can become the support without tilting or sinking the world).
         let swing = phase.swing_foot().unwrap_or(self.root.other());
         let sole = data.frame_placement(self.soles[root][swing.index()]);
-        let corner_z = swing
-            .sole_outline()
-            .map(|[x, y]| sole.transform_point(&Vector3::new(x, y, 0.0).into()).z);
+        let outline = &self.profile.foot(swing).outline;
+        let [centre_x, _] = self.profile.sole_centre(swing);
         let lifting = matches!(
             phase,
             SupportPhase::DoubleToRight(TakeOff::LiftFoot)
@@ -784,6 +767,16 @@ impl Imitator {
             true => a.min(b),
             false if a.abs() >= b.abs() => a,
             false => b,
+        };
+        // The lowest (lifting) or farthest from the ground (landing) of the front corners and
+        // of the rear ones.
+        let height = |front: bool| {
+            outline
+                .iter()
+                .filter(|[x, _]| (*x >= centre_x) == front)
+                .map(|&[x, y]| sole.transform_point(&Vector3::new(x, y, 0.0).into()).z)
+                .reduce(pick)
+                .unwrap_or(0.0)
         };
         let posture_error = ps
             .tasks
@@ -806,16 +799,16 @@ impl Imitator {
             com_error,
             posture_error,
             posture_settled: self.posture_settling.update(posture_error, dt),
-            swing_toe_height: pick(corner_z[0], corner_z[1]),
-            swing_heel_height: pick(corner_z[2], corner_z[3]),
+            swing_toe_height: height(true),
+            swing_heel_height: height(false),
         };
 
         let world_t_root = self.world_t_root;
-        let placement = |foot: Foot| -> Result<IsometryMatrix3<f64>, ModelError> {
+        let placement = |foot: Side| -> Result<IsometryMatrix3<f64>, ModelError> {
             model.placement_in_world(data, &world_t_root, self.soles[root][foot.index()])
         };
-        out.right_sole = placement(Foot::Right)?;
-        out.left_sole = placement(Foot::Left)?;
+        out.right_sole = placement(Side::Right)?;
+        out.left_sole = placement(Side::Left)?;
         out.com = world_t_root
             .transform_point(&model.com(data)?.into())
             .coords;
@@ -860,7 +853,7 @@ impl Imitator {
         dt: f64,
     ) -> Result<(Vector2<f64>, f64), ImitationError> {
         let root = self.root.index();
-        let model = self.models.rooted_at(self.root);
+        let model = self.profile.model(self.root);
         let data = &self.data[root];
         let ps = &self.phases[phase.index()];
         let lift = ps.tasks.iter().find_map(|t| match t.task {
@@ -902,18 +895,20 @@ impl Imitator {
     }
 
     /// Re-roots the model at `foot` if it is not already, keeping the world placement.
-    fn switch_root(&mut self, foot: Foot) -> Result<(), ImitationError> {
+    fn switch_root(&mut self, foot: Side) -> Result<(), ImitationError> {
         let from = self.root.index();
-        let model = self.models.rooted_at(self.root);
+        let model = self.profile.model(self.root);
         model.forward_kinematics(&mut self.data[from], &self.q)?;
         if foot != self.root {
+            // ʷT_b = ʷT_a · ᵃT_b(q): the new root sole's world placement from the old model.
+            let sole = self.soles[from][foot.index()];
             self.world_t_root =
-                nao::switch_support(model, &self.data[from], &self.world_t_root, foot)?;
+                model.placement_in_world(&self.data[from], &self.world_t_root, sole)?;
             self.root = foot;
         }
         let to = self.root.index();
-        self.models
-            .rooted_at(self.root)
+        self.profile
+            .model(self.root)
             .forward_kinematics(&mut self.data[to], &self.q)?;
         Ok(())
     }
@@ -931,11 +926,11 @@ fn ground_pose(sole: &IsometryMatrix3<f64>) -> GroundPose {
 /// Which variables move the left sole relative to the right one (the legs, closing a loop in
 /// double support): the columns of the left sole's 6 × n Jacobian in the right-rooted model that
 /// are not zero at `q`.
-fn sole_chain_variables(models: &FootRootedModels, q: &[f64]) -> Result<Vec<bool>, ImitationError> {
-    let model = &models.right;
+fn sole_chain_variables(profile: &BipedProfile, q: &[f64]) -> Result<Vec<bool>, ImitationError> {
+    let model = profile.model(Side::Right);
     let mut data = model.new_data();
     model.forward_kinematics(&mut data, q)?;
-    let sole = model.frame_id(Foot::Left.sole())?;
+    let sole = model.frame_id(&profile.foot(Side::Left).sole)?;
     let mut jac = Mat::zeros(6, model.nv());
     model.point_jacobian(
         &data,
@@ -957,20 +952,6 @@ fn human_stance(frame: &HumanFrame) -> Option<(Vector2<f64>, f64)> {
     );
     let left = frame.get(HumanJoint::LHip)? - frame.get(HumanJoint::RHip)?;
     Some(((l + r).xy() * 0.5, (-left.x).atan2(left.y)))
-}
-
-fn side_of(foot: Foot) -> Side {
-    match foot {
-        Foot::Right => Side::Right,
-        Foot::Left => Side::Left,
-    }
-}
-
-fn foot_of(side: Side) -> Foot {
-    match side {
-        Side::Right => Foot::Right,
-        Side::Left => Foot::Left,
-    }
 }
 
 /// The `TaskModel` of one phase at one frame.

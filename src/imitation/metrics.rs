@@ -8,7 +8,7 @@
 //!   outline points are within [`CONTACT_HEIGHT`] of the floor.
 //! * **Executability**: joint-limit violations, and velocity-limit violations
 //!   (`|Δq|/Δt > fraction · v_max`), counted per joint and frame.
-//! * **Foot slip**: how far a standing foot moved in the world from where it stood at the start
+//! * **Side slip**: how far a standing foot moved in the world from where it stood at the start
 //!   of its stance, model switches included (m, and rad for its orientation). A foot stands
 //!   when it is the model root or when the phase keeps it on the ground (both feet in DS and in
 //!   the CoM steps of the transitions).
@@ -21,13 +21,12 @@
 
 use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 
-use super::human::HumanJoint;
 use super::imitator::{Imitator, RobotFrame};
 use super::phase::SupportPhase;
 use super::support::HumanSupport;
 use super::travel::{HandTrace, Stance, StepCounter, Travel, TravelRecorder, robot_stance};
+use crate::human::HumanJoint;
 use crate::model::{ModelData, ModelError};
-use crate::robots::nao::Foot;
 
 /// A foot is on the ground when its outline points are at most this high (m).
 pub const CONTACT_HEIGHT: f64 = 1e-3;
@@ -102,7 +101,8 @@ impl Series {
     }
 }
 
-/// The effectors whose tracking is measured, with the human joint their reference comes from.
+/// The effectors whose tracking is measured, by role name (the keys of the metrics; the robot
+/// frames are the profile's hands and ankles), with the human joint their reference comes from.
 pub const EFFECTORS: [(&str, HumanJoint); 4] = [
     ("l_hand", HumanJoint::LHand),
     ("r_hand", HumanJoint::RHand),
@@ -113,7 +113,7 @@ pub const EFFECTORS: [(&str, HumanJoint); 4] = [
 /// Tracking error of one effector.
 #[derive(Debug, Clone, PartialEq)]
 pub struct EffectorError {
-    /// Frame name.
+    /// Effector role name ([`EFFECTORS`]).
     pub name: &'static str,
     /// Over frames of single support where the effector was tracked (m).
     pub single_support: MeanMax,
@@ -183,7 +183,14 @@ pub struct ImitationMetrics {
 
 /// Accumulates [`ImitationMetrics`] frame by frame.
 pub struct MetricsRecorder {
+    /// Forward kinematics of the model rooted at each sole (`[left, right]`).
     data: [ModelData; 2],
+    /// The robot frames of [`EFFECTORS`], in that order.
+    effector_frames: [String; 4],
+    /// The contact area of each foot (`[left, right]`, sole frame, m).
+    outlines: [Vec<[f64; 2]>; 2],
+    /// Scratch: the grounded corners of this frame (world xy, m).
+    points: Vec<Vector2<f64>>,
     frames: usize,
     first_time: Option<f64>,
     last_time: f64,
@@ -237,7 +244,7 @@ fn effector_errors(single: &[Series], double: &[Series]) -> Vec<EffectorError> {
         .collect()
 }
 
-/// Which feet (right, left) stand on the floor in `phase`: the support, and both while the free
+/// Which feet (left, right) stand on the floor in `phase`: the support, and both while the free
 /// foot is on the ground (DS and the CoM steps of the transitions).
 fn standing_feet(phase: SupportPhase) -> [bool; 2] {
     use super::phase::{Landing, TakeOff};
@@ -249,10 +256,10 @@ fn standing_feet(phase: SupportPhase) -> [bool; 2] {
         | SupportPhase::LeftToDouble(Landing::ComToMiddle) => [true, true],
         SupportPhase::Right
         | SupportPhase::DoubleToRight(TakeOff::LiftFoot)
-        | SupportPhase::RightToDouble(Landing::LowerFoot) => [true, false],
+        | SupportPhase::RightToDouble(Landing::LowerFoot) => [false, true],
         SupportPhase::Left
         | SupportPhase::DoubleToLeft(TakeOff::LiftFoot)
-        | SupportPhase::LeftToDouble(Landing::LowerFoot) => [false, true],
+        | SupportPhase::LeftToDouble(Landing::LowerFoot) => [true, false],
     }
 }
 
@@ -262,7 +269,7 @@ pub fn convex_margin(points: &mut [Vector2<f64>], p: Vector2<f64>) -> f64 {
     // Andrew's monotone chain, lower then upper hull, counter-clockwise.
     points.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
     let cross = |o: Vector2<f64>, a: Vector2<f64>, b: Vector2<f64>| (a - o).perp(&(b - o));
-    let mut hull = [Vector2::zeros(); 16];
+    let mut hull = vec![Vector2::zeros(); 2 * points.len() + 1];
     let mut k = 0;
     for &pt in points.iter() {
         while k >= 2 && cross(hull[k - 2], hull[k - 1], pt) <= 0.0 {
@@ -309,9 +316,14 @@ fn rotation_angle(r: &nalgebra::Rotation3<f64>) -> f64 {
 impl MetricsRecorder {
     /// A recorder for the runs of `imitator`.
     pub fn new(imitator: &Imitator) -> Self {
-        let models = imitator.models();
+        let profile = imitator.profile();
+        let [lh, rh] = profile.hands.clone();
+        let [la, ra] = profile.feet.clone().map(|f| f.ankle);
         Self {
-            data: [models.right.new_data(), models.left.new_data()],
+            data: profile.models.clone().map(|m| m.new_data()),
+            effector_frames: [lh, rh, la, ra],
+            outlines: profile.feet.clone().map(|f| f.outline),
+            points: Vec::new(),
             frames: 0,
             first_time: None,
             last_time: 0.0,
@@ -351,7 +363,7 @@ impl MetricsRecorder {
 
     /// Records one frame, as returned by [`Imitator::step`].
     pub fn record(&mut self, imitator: &Imitator, frame: &RobotFrame) -> Result<(), ModelError> {
-        let root_model = imitator.models().rooted_at(frame.root);
+        let root_model = imitator.profile().model(frame.root);
         let data = &mut self.data[frame.root.index()];
         root_model.forward_kinematics(data, &frame.q)?;
 
@@ -359,7 +371,7 @@ impl MetricsRecorder {
         let table = imitator.table(frame.phase);
         let single = matches!(frame.phase, SupportPhase::Right | SupportPhase::Left);
         let double = frame.phase == SupportPhase::Double;
-        for (e, (name, joint)) in EFFECTORS.iter().enumerate() {
+        for (e, ((_, joint), name)) in EFFECTORS.iter().zip(&self.effector_frames).enumerate() {
             let tracked = table.levels.iter().flat_map(|l| &l.tasks).any(|t| {
                 matches!(t, super::tables::Task::Point { frame: f, target: super::tables::PointTarget::Scaled(j), .. }
                     if f == name && j == joint)
@@ -390,26 +402,20 @@ impl MetricsRecorder {
 
         // Support polygon from the feet on the ground (world frame = root frame moved by
         // world_t_root; heights are the same since the root sole is on the floor).
-        let mut points = [Vector2::zeros(); 8];
-        let mut count = 0;
-        for foot in [Foot::Right, Foot::Left] {
-            let sole = if foot == Foot::Right {
-                &frame.right_sole
-            } else {
-                &frame.left_sole
-            };
-            let outline = foot
-                .sole_outline()
-                .map(|[x, y]| sole.transform_point(&Vector3::new(x, y, 0.0).into()));
-            let grounded = outline.iter().all(|p| p.z.abs() <= CONTACT_HEIGHT);
+        self.points.clear();
+        for (outline, sole) in self
+            .outlines
+            .iter()
+            .zip([&frame.left_sole, &frame.right_sole])
+        {
+            let corner = |&[x, y]: &[f64; 2]| sole.transform_point(&Vector3::new(x, y, 0.0).into());
+            let grounded = outline.iter().all(|c| corner(c).z.abs() <= CONTACT_HEIGHT);
             if grounded {
-                for p in outline {
-                    points[count] = p.xy().coords;
-                    count += 1;
-                }
+                self.points
+                    .extend(outline.iter().map(|c| corner(c).xy().coords));
             }
         }
-        let margin = convex_margin(&mut points[..count], frame.com.xy());
+        let margin = convex_margin(&mut self.points, frame.com.xy());
         self.min_margin = self.min_margin.min(margin);
         if margin < 0.0 {
             self.outside += 1;
@@ -433,7 +439,7 @@ impl MetricsRecorder {
         }
 
         // Slip of the standing feet: how far each moved since its stance began.
-        let placement = [frame.right_sole, frame.left_sole];
+        let placement = [frame.left_sole, frame.right_sole];
         let standing = standing_feet(frame.phase);
         for foot in 0..2 {
             if !standing[foot] {
@@ -518,7 +524,12 @@ impl MetricsRecorder {
         let data = &self.data[frame.root.index()];
         let mut robot = [Vector3::zeros(); 2];
         let mut reference = [None; 2];
-        for (h, (name, joint)) in EFFECTORS[..2].iter().enumerate() {
+        for (h, ((_, joint), name)) in EFFECTORS
+            .iter()
+            .zip(&self.effector_frames)
+            .take(2)
+            .enumerate()
+        {
             let placement = data.frame_placement(model.frame_id(name)?);
             robot[h] = frame
                 .world_t_root

@@ -2,18 +2,16 @@
 //! to, and the detection of which of the human's feet support the body.
 //!
 //! A motion source (a BVH file, a Kinect stream; see [`crate::io`]) yields one
-//! [`human::HumanFrame`] per time step: named joint positions in metres in a right-handed frame
+//! [`crate::human::HumanFrame`] per time step: named joint positions in metres in a right-handed frame
 //! with z up. [`support::SupportDetector`] turns the stream of frames into a stream of
 //! [`support::HumanSupport`] phases (Poubel §III.A). [`phase::PhaseMachine`] turns those into the
 //! robot's [`phase::SupportPhase`] (DS, RS, LS and the two-step transitions of Table I), ending
 //! each transition step on measured conditions; [`tables::TaskTables`] says, per phase, which
 //! model root, equality levels and gradient tasks the IK solves (Table I as data).
-//! [`imitator::Imitator`] runs the whole pipeline frame by frame; [`batch`] runs it over many
-//! clips in parallel.
+//! [`imitator::Imitator`] runs the whole pipeline frame by frame; [`crate::batch`] runs it over
+//! many clips in parallel.
 
-pub mod batch;
 pub mod footsteps;
-pub mod human;
 pub mod imitator;
 pub mod metrics;
 pub mod phase;

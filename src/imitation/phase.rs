@@ -66,7 +66,7 @@
 use std::fmt;
 
 use super::support::HumanSupport;
-use crate::robots::nao::Foot;
+use crate::human::Side;
 
 /// The steps of a take-off (DS to a single support), in order.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -143,31 +143,31 @@ impl SupportPhase {
     }
 
     /// The sole the kinematic model is rooted at in this phase (the paper's choice, see the
-    /// module docs): `Foot::Left` in LS, "Lift RFoot" and "Lower RFoot", `Foot::Right` otherwise.
-    pub const fn model_root(self) -> Foot {
+    /// module docs): `Side::Left` in LS, "Lift RFoot" and "Lower RFoot", `Side::Right` otherwise.
+    pub const fn model_root(self) -> Side {
         match self {
             SupportPhase::Left
             | SupportPhase::DoubleToLeft(TakeOff::LiftFoot)
-            | SupportPhase::LeftToDouble(Landing::LowerFoot) => Foot::Left,
+            | SupportPhase::LeftToDouble(Landing::LowerFoot) => Side::Left,
             SupportPhase::Double
             | SupportPhase::Right
             | SupportPhase::DoubleToRight(_)
             | SupportPhase::DoubleToLeft(TakeOff::ComToFoot)
             | SupportPhase::RightToDouble(_)
-            | SupportPhase::LeftToDouble(Landing::ComToMiddle) => Foot::Right,
+            | SupportPhase::LeftToDouble(Landing::ComToMiddle) => Side::Right,
         }
     }
 
     /// The foot that leaves or reaches the ground in a transition (the left foot in DS ↔ RS, the
     /// right foot in DS ↔ LS), or the free foot in a single support; `None` in DS.
-    pub const fn swing_foot(self) -> Option<Foot> {
+    pub const fn swing_foot(self) -> Option<Side> {
         match self {
             SupportPhase::Double => None,
             SupportPhase::Right
             | SupportPhase::DoubleToRight(_)
-            | SupportPhase::RightToDouble(_) => Some(Foot::Left),
+            | SupportPhase::RightToDouble(_) => Some(Side::Left),
             SupportPhase::Left | SupportPhase::DoubleToLeft(_) | SupportPhase::LeftToDouble(_) => {
-                Some(Foot::Right)
+                Some(Side::Right)
             }
         }
     }
@@ -451,32 +451,32 @@ impl PhaseMachine {
 }
 
 /// Which foot the human stands on alone, if any (`None` for DS and airborne).
-fn human_single(human: HumanSupport) -> Option<Foot> {
+fn human_single(human: HumanSupport) -> Option<Side> {
     match human {
-        HumanSupport::Right => Some(Foot::Right),
-        HumanSupport::Left => Some(Foot::Left),
+        HumanSupport::Right => Some(Side::Right),
+        HumanSupport::Left => Some(Side::Left),
         HumanSupport::Double | HumanSupport::Airborne => None,
     }
 }
 
-fn take_off(support: Foot, step: TakeOff) -> SupportPhase {
+fn take_off(support: Side, step: TakeOff) -> SupportPhase {
     match support {
-        Foot::Right => SupportPhase::DoubleToRight(step),
-        Foot::Left => SupportPhase::DoubleToLeft(step),
+        Side::Right => SupportPhase::DoubleToRight(step),
+        Side::Left => SupportPhase::DoubleToLeft(step),
     }
 }
 
-fn landing(support: Foot, step: Landing) -> SupportPhase {
+fn landing(support: Side, step: Landing) -> SupportPhase {
     match support {
-        Foot::Right => SupportPhase::RightToDouble(step),
-        Foot::Left => SupportPhase::LeftToDouble(step),
+        Side::Right => SupportPhase::RightToDouble(step),
+        Side::Left => SupportPhase::LeftToDouble(step),
     }
 }
 
-fn single(support: Foot) -> SupportPhase {
+fn single(support: Side) -> SupportPhase {
     match support {
-        Foot::Right => SupportPhase::Right,
-        Foot::Left => SupportPhase::Left,
+        Side::Right => SupportPhase::Right,
+        Side::Left => SupportPhase::Left,
     }
 }
 
@@ -516,18 +516,18 @@ fn next_phase(
             Some(foot) => take_off(foot, TakeOff::ComToFoot),
             None => SupportPhase::Double,
         },
-        SupportPhase::Right => after_single(Foot::Right, wanted),
-        SupportPhase::Left => after_single(Foot::Left, wanted),
-        SupportPhase::DoubleToRight(step) => after_take_off(Foot::Right, step, wanted, &done),
-        SupportPhase::DoubleToLeft(step) => after_take_off(Foot::Left, step, wanted, &done),
-        SupportPhase::RightToDouble(step) => after_landing(Foot::Right, step, wanted, &done),
-        SupportPhase::LeftToDouble(step) => after_landing(Foot::Left, step, wanted, &done),
+        SupportPhase::Right => after_single(Side::Right, wanted),
+        SupportPhase::Left => after_single(Side::Left, wanted),
+        SupportPhase::DoubleToRight(step) => after_take_off(Side::Right, step, wanted, &done),
+        SupportPhase::DoubleToLeft(step) => after_take_off(Side::Left, step, wanted, &done),
+        SupportPhase::RightToDouble(step) => after_landing(Side::Right, step, wanted, &done),
+        SupportPhase::LeftToDouble(step) => after_landing(Side::Left, step, wanted, &done),
     }
 }
 
 /// Successor of single support on `support`: stay while the human stands on that foot alone,
 /// otherwise land the free foot (also when the human switched straight to the other foot).
-fn after_single(support: Foot, wanted: Option<Foot>) -> SupportPhase {
+fn after_single(support: Side, wanted: Option<Side>) -> SupportPhase {
     if wanted == Some(support) {
         single(support)
     } else {
@@ -536,7 +536,7 @@ fn after_single(support: Foot, wanted: Option<Foot>) -> SupportPhase {
 }
 
 /// Successor of a take-off step toward single support on `support`.
-fn after_take_off(support: Foot, step: TakeOff, wanted: Option<Foot>, done: &Done) -> SupportPhase {
+fn after_take_off(support: Side, step: TakeOff, wanted: Option<Side>, done: &Done) -> SupportPhase {
     let stays = wanted == Some(support);
     match step {
         TakeOff::ComToFoot if !stays => SupportPhase::Double,
@@ -548,7 +548,7 @@ fn after_take_off(support: Foot, step: TakeOff, wanted: Option<Foot>, done: &Don
 }
 
 /// Successor of a landing step from single support on `support`.
-fn after_landing(support: Foot, step: Landing, wanted: Option<Foot>, done: &Done) -> SupportPhase {
+fn after_landing(support: Side, step: Landing, wanted: Option<Side>, done: &Done) -> SupportPhase {
     let lifts_again = wanted == Some(support);
     match step {
         Landing::LowerFoot if lifts_again => take_off(support, TakeOff::LiftFoot),

@@ -40,7 +40,8 @@
 
 use nalgebra::{Matrix3, Vector2, Vector3};
 
-use super::human::{HumanFrame, HumanJoint};
+use crate::human::HumanFrame;
+use crate::human::Side;
 
 /// Which feet support the human in one frame.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -63,38 +64,6 @@ impl HumanSupport {
             (false, true) => HumanSupport::Right,
             (true, false) => HumanSupport::Left,
             (false, false) => HumanSupport::Airborne,
-        }
-    }
-}
-
-/// A side of the body (the human's own).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Side {
-    /// Left.
-    Left,
-    /// Right.
-    Right,
-}
-
-impl Side {
-    const fn ankle(self) -> HumanJoint {
-        match self {
-            Side::Left => HumanJoint::LAnkle,
-            Side::Right => HumanJoint::RAnkle,
-        }
-    }
-
-    const fn toe(self) -> HumanJoint {
-        match self {
-            Side::Left => HumanJoint::LToe,
-            Side::Right => HumanJoint::RToe,
-        }
-    }
-
-    const fn index(self) -> usize {
-        match self {
-            Side::Left => 0,
-            Side::Right => 1,
         }
     }
 }

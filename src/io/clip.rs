@@ -13,7 +13,7 @@ use thiserror::Error;
 
 use super::bvh::{BvhConfig, BvhError, BvhReader, CMU_MB_NAMES};
 use super::kinect::{KinectConfig, KinectError, KinectReader};
-use crate::imitation::human::HumanFrame;
+use crate::human::HumanFrame;
 use crate::imitation::support::SupportConfig;
 
 /// Error of either reader.

@@ -12,7 +12,7 @@
 //!
 //! Kinect camera space: metres, origin at the IR sensor, +X to the sensor's left, +Y up (relative
 //! to the sensor, which may be tilted), +Z away from the sensor. The subject faces the sensor, so
-//! it faces −Z with its left side towards −X. The human frame ([`crate::imitation::human`]) is
+//! it faces −Z with its left side towards −X. The human frame ([`crate::human`]) is
 //! `(x, y, z) = (−Z, −X, Y)`: the subject faces +x, +y is its left, z is up. This is a proper
 //! rotation (det = +1). Heights are relative to the sensor and a sensor tilt is not corrected;
 //! support detection fits the ground from the data, which absorbs both.
@@ -37,7 +37,7 @@ use std::path::Path;
 use nalgebra::Vector3;
 
 use super::read_line_capped;
-use crate::imitation::human::{HumanFrame, HumanJoint};
+use crate::human::{HumanFrame, HumanJoint};
 
 /// Values per line: timestamp + 25 × 4.
 pub const KINECT_FIELDS: usize = 1 + 4 * KINECT_JOINTS.len();

@@ -1,6 +1,6 @@
 //! Readers of human motion (DESIGN §1, layer `io`): BVH motion capture ([`bvh`]) and Microsoft
 //! Kinect v2 skeleton CSV ([`kinect`]). Both stream: a reader parses its header once and then
-//! yields one [`crate::imitation::human::HumanFrame`] at a time, so a live source and a file feed
+//! yields one [`crate::human::HumanFrame`] at a time, so a live source and a file feed
 //! the same pipeline. Both cap what a file may ask for (line length, joint count) so that hostile
 //! input is refused with a typed error instead of exhausting memory.
 
@@ -10,7 +10,7 @@ pub mod kinect;
 
 use std::io::{self, BufRead, Read};
 
-use crate::imitation::human::HumanFrame;
+use crate::human::HumanFrame;
 
 /// The iterator item of a reader with `read_frame(&mut HumanFrame) -> Result<bool, E>`: the next
 /// frame, `None` at the end, or the error.

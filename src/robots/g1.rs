@@ -20,7 +20,12 @@
 //! # Ok::<(), taskstack::model::ModelError>(())
 //! ```
 
-use crate::model::{Model, UrdfError, UrdfOptions};
+use nalgebra::{IsometryMatrix3, Translation3};
+
+use crate::human::{HumanJoint, Side};
+use crate::model::{Model, UrdfError, UrdfFrame, UrdfOptions};
+use crate::robots::profile_toml::with_fixed_link;
+use crate::robots::{BipedProfile, FootArea, FootFrames, RobotPoint};
 
 /// The URDF text (`robots/g1/g1_29dof_rev_1_0.urdf`, byte-identical to Unitree's).
 pub const URDF: &str = include_str!("../../robots/g1/g1_29dof_rev_1_0.urdf");
@@ -74,15 +79,136 @@ const SOLES: [(&str, &str); 2] = [
     ("right_sole", "right_ankle_roll_link"),
 ];
 
+/// Toe and heel points of each sole (`left_toe`, `left_heel`, …), on the sole's x axis (m, sole
+/// frame): the toe under the ball of the foot, the heel 1 cm inside the rear contact spheres.
+const TOE_HEEL: [(&str, f64); 2] = [("toe", 0.09), ("heel", -0.04)];
+
 /// The loader options of every G1 model rooted at the URDF link or sole `root_link` (`None`: the
-/// pelvis): variables in [`VARIABLES`] order, every link a named frame.
+/// pelvis): variables in [`VARIABLES`] order, every link a named frame, and the toe and heel
+/// points of both soles.
 pub fn urdf_options(root_link: Option<&str>) -> UrdfOptions {
+    let frames = SOLES
+        .iter()
+        .zip(["left", "right"])
+        .flat_map(|((sole, _), side)| {
+            TOE_HEEL.iter().map(move |(point, x)| UrdfFrame {
+                name: format!("{side}_{point}"),
+                link: (*sole).to_owned(),
+                placement: IsometryMatrix3::from(Translation3::new(*x, 0.0, 0.0)),
+            })
+        })
+        .collect();
     UrdfOptions {
         root_link: root_link.map(str::to_owned),
         variable_order: Some(VARIABLES.iter().map(|v| v.to_string()).collect()),
         link_frames: true,
+        frames,
         ..UrdfOptions::default()
     }
+}
+
+/// A standing posture (order of [`VARIABLES`], rad): knees bent 0.3 rad with hip and ankle pitch
+/// sharing the bend so that the soles stay flat (hip + knee + ankle pitch = 0), arms slightly
+/// out with the elbows bent.
+pub const STAND: [f64; 29] = [
+    -0.1, 0.0, 0.0, 0.3, -0.2, 0.0, // left leg
+    -0.1, 0.0, 0.0, 0.3, -0.2, 0.0, // right leg
+    0.0, 0.0, 0.0, // waist
+    0.2, 0.2, 0.0, 0.6, 0.0, 0.0, 0.0, // left arm
+    0.2, -0.2, 0.0, 0.6, 0.0, 0.0, 0.0, // right arm
+];
+
+/// Where the G1 may put a foot down relative to the other sole: x ∈ [−0.10, 0.15] m, lateral
+/// ∈ [0.20, 0.30] m, |yaw| ≤ 0.3 rad. The NAO's envelope scaled by the legs' length ratio
+/// (about 3), with the lateral bounds around the G1's 0.237 m stance width so that the feet
+/// (0.05 m wide) never cross.
+pub const STEP_ENVELOPE: FootArea = FootArea {
+    x_min: -0.10,
+    x_max: 0.15,
+    lateral_min: 0.20,
+    lateral_max: 0.30,
+    yaw_max: 0.3,
+};
+
+/// The links standing for the human's joints: hips at the hip-roll links (where the pitch and
+/// roll axes meet), knees, ankles at the ankle-roll links, shoulders at the shoulder-roll links,
+/// elbows, wrists at the wrist-roll links, hands at the rubber hands, the head at `head_link`.
+/// The G1 has no neck joint, so [`HumanJoint::Neck`] is not mapped.
+pub fn points() -> Vec<(HumanJoint, RobotPoint)> {
+    use HumanJoint::*;
+    let frame = |name: &str| RobotPoint::Frame(name.to_owned());
+    let pair = |part: &str| {
+        [Side::Left, Side::Right].map(|side| format!("{}_{part}", side.pick("left", "right")))
+    };
+    let mid = |part: &str| {
+        let [l, r] = pair(part);
+        RobotPoint::Midpoint(l, r)
+    };
+    let mut points = vec![
+        (MidHip, mid("hip_roll_link")),
+        (MidShoulder, mid("shoulder_roll_link")),
+        (Head, frame("head_link")),
+    ];
+    for (joints, part) in [
+        ([LHip, RHip], "hip_roll_link"),
+        ([LKnee, RKnee], "knee_link"),
+        ([LAnkle, RAnkle], "ankle_roll_link"),
+        ([LToe, RToe], "toe"),
+        ([LShoulder, RShoulder], "shoulder_roll_link"),
+        ([LElbow, RElbow], "elbow_link"),
+        ([LWrist, RWrist], "wrist_roll_link"),
+        ([LHand, RHand], "rubber_hand"),
+    ] {
+        for (joint, name) in joints.into_iter().zip(pair(part)) {
+            points.push((joint, RobotPoint::Frame(name)));
+        }
+    }
+    points
+}
+
+/// The G1's biped profile over models rooted at its left and right soles (`[left, right]`;
+/// [`profile`] uses the bundled URDF).
+///
+/// The tables hold the **pelvis** upright (its "torso" frame): the pelvis carries the upper body
+/// over the legs, as the NAO's rigid torso does; the waist joints follow the joint-tracking
+/// gradient toward [`STAND`]. The G1 has no human joint-angle map yet, so the arms' redundancy
+/// is also resolved toward [`STAND`].
+pub fn profile_with(models: [Model; 2]) -> BipedProfile {
+    let foot = |side: Side| {
+        let s = side.pick("left", "right");
+        let [[x_min, x_max], [y_min, y_max]] = SOLE_RECTANGLE;
+        FootFrames {
+            sole: format!("{s}_sole"),
+            ankle: format!("{s}_ankle_roll_link"),
+            toe: format!("{s}_toe"),
+            heel: format!("{s}_heel"),
+            outline: vec![
+                [x_max, y_max],
+                [x_max, y_min],
+                [x_min, y_min],
+                [x_min, y_max],
+            ],
+        }
+    };
+    BipedProfile {
+        name: "g1".to_owned(),
+        models,
+        feet: Side::BOTH.map(foot),
+        hands: [
+            "left_rubber_hand".to_owned(),
+            "right_rubber_hand".to_owned(),
+        ],
+        torso: "pelvis".to_owned(),
+        points: points(),
+        stand: STAND.to_vec(),
+        step_envelope: STEP_ENVELOPE,
+        joint_angles: None,
+    }
+}
+
+/// The Unitree G1's biped profile from the bundled URDF.
+pub fn profile() -> BipedProfile {
+    profile_with([left_sole(), right_sole()])
 }
 
 /// A G1 from URDF text (e.g. [`URDF`], or a variant with other masses), with the two sole links
@@ -94,19 +220,10 @@ pub fn urdf_options(root_link: Option<&str>) -> UrdfOptions {
 /// G1's 29 ([`UrdfError::UnknownVariable`] for a missing one, [`UrdfError::MissingVariable`] for
 /// an extra one).
 pub fn from_urdf_str(text: &str, root_link: Option<&str>) -> Result<Model, UrdfError> {
-    let soles: String = SOLES
-        .iter()
-        .map(|(sole, ankle)| {
-            format!(
-                r#"<link name="{sole}"/><joint name="{sole}_joint" type="fixed"><origin xyz="0 0 {z}" rpy="0 0 0"/><parent link="{ankle}"/><child link="{sole}"/></joint>"#,
-                z = -SOLE_DEPTH
-            )
-        })
-        .collect();
-    let Some(end) = text.rfind("</robot>") else {
-        return Err(UrdfError::Xml("no closing </robot> tag".to_owned()));
-    };
-    let text = format!("{}{soles}{}", &text[..end], &text[end..]);
+    let mut text = text.to_owned();
+    for (sole, ankle) in SOLES {
+        text = with_fixed_link(&text, sole, ankle, [0.0, 0.0, -SOLE_DEPTH])?;
+    }
     Model::from_urdf_str(&text, &urdf_options(root_link))
 }
 

@@ -1,4 +1,13 @@
-//! Built-in robots: models built from data files shipped with the crate.
+//! Robots: the biped profile the imitation reads ([`BipedProfile`]: models rooted at the soles,
+//! the frames standing for the human's joints, feet, standing posture, step envelope) and the
+//! built-in robots, the NAO and the Unitree G1, each with its profile.
 
 pub mod g1;
 pub mod nao;
+pub mod profile;
+pub mod profile_toml;
+
+pub use profile::{
+    BipedProfile, FootArea, FootFrames, HumanJointAngles, JointAnglesFactory, ProfileError,
+    RobotPoint, SolePlacement,
+};

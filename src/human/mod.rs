@@ -255,6 +255,102 @@ impl HumanFrame {
     }
 }
 
+/// The unit direction of each human segment (the segment ending at a joint, from its antecedent
+/// in the tree a scaler walks), in the frame the scaler outputs (a robot's support sole frame);
+/// `None` for a segment without a direction (MidHip, a joint the robot has no point for).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SegmentDirections([Option<Vector3<f64>>; HumanJoint::COUNT]);
+
+impl Default for SegmentDirections {
+    fn default() -> Self {
+        SegmentDirections([None; HumanJoint::COUNT])
+    }
+}
+
+impl SegmentDirections {
+    /// The direction of the segment ending at `joint` (unit vector), if any.
+    pub fn get(&self, joint: HumanJoint) -> Option<Vector3<f64>> {
+        self.0[joint.index()]
+    }
+
+    /// Sets the direction of the segment ending at `joint`.
+    pub fn set(&mut self, joint: HumanJoint, direction: Option<Vector3<f64>>) {
+        self.0[joint.index()] = direction;
+    }
+}
+
+/// A side of the body: the human's own left or right, and the robot's (a robot's left foot
+/// stands for the human's left foot). Per-side arrays in the crate are indexed by
+/// [`Side::index`]: `[left, right]`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Side {
+    /// Left.
+    Left,
+    /// Right.
+    Right,
+}
+
+impl Side {
+    /// Both sides in index order: `[Side::Left, Side::Right]`.
+    pub const BOTH: [Side; 2] = [Side::Left, Side::Right];
+
+    /// 0 for the left side, 1 for the right: the index of per-side arrays.
+    pub const fn index(self) -> usize {
+        match self {
+            Side::Left => 0,
+            Side::Right => 1,
+        }
+    }
+
+    /// The other side.
+    pub const fn other(self) -> Side {
+        match self {
+            Side::Left => Side::Right,
+            Side::Right => Side::Left,
+        }
+    }
+
+    /// This side's hip joint centre.
+    pub const fn hip(self) -> HumanJoint {
+        match self {
+            Side::Left => HumanJoint::LHip,
+            Side::Right => HumanJoint::RHip,
+        }
+    }
+
+    /// This side's knee.
+    pub const fn knee(self) -> HumanJoint {
+        match self {
+            Side::Left => HumanJoint::LKnee,
+            Side::Right => HumanJoint::RKnee,
+        }
+    }
+
+    /// This side's ankle.
+    pub const fn ankle(self) -> HumanJoint {
+        match self {
+            Side::Left => HumanJoint::LAnkle,
+            Side::Right => HumanJoint::RAnkle,
+        }
+    }
+
+    /// This side's toe.
+    pub const fn toe(self) -> HumanJoint {
+        match self {
+            Side::Left => HumanJoint::LToe,
+            Side::Right => HumanJoint::RToe,
+        }
+    }
+
+    /// `left` on the left side, `right` on the right.
+    pub fn pick<T>(self, left: T, right: T) -> T {
+        match self {
+            Side::Left => left,
+            Side::Right => right,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -35,7 +35,13 @@ use std::path::Path;
 
 use nalgebra::{IsometryMatrix3, Translation3};
 
+pub mod joint_angles;
+
+pub use joint_angles::JointAngles;
+
+use crate::human::{HumanJoint, Side};
 use crate::model::{Model, ModelData, ModelError, UrdfError, UrdfFrame, UrdfOptions};
+use crate::robots::{BipedProfile, FootArea, FootFrames, RobotPoint};
 
 /// The 23 IK variables (NAOqi joint names) in the order of `q` of every NAO model.
 pub const VARIABLES: [&str; 23] = [
@@ -98,109 +104,119 @@ pub const FRAMES: [(&str, &str, [f64; 3]); 23] = [
 pub const LOCKED_JOINTS: [&str; 2] = ["LHand", "RHand"];
 
 /// DH table of the NAO rooted at the right sole (`robots/nao_dh/nao_rfoot.toml`).
-pub const RFOOT_DH: &str = include_str!("../../robots/nao_dh/nao_rfoot.toml");
+pub const RFOOT_DH: &str = include_str!("../../../robots/nao_dh/nao_rfoot.toml");
 /// DH table of the NAO rooted at the left sole (`robots/nao_dh/nao_lfoot.toml`).
-pub const LFOOT_DH: &str = include_str!("../../robots/nao_dh/nao_lfoot.toml");
+pub const LFOOT_DH: &str = include_str!("../../../robots/nao_dh/nao_lfoot.toml");
 /// DH table of the NAO rooted at the torso (`robots/nao_dh/nao_torso.toml`).
-pub const TORSO_DH: &str = include_str!("../../robots/nao_dh/nao_torso.toml");
+pub const TORSO_DH: &str = include_str!("../../../robots/nao_dh/nao_torso.toml");
 
-/// A support foot.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Foot {
-    /// The right foot (model [`rfoot`], base frame `r_sole`).
-    Right,
-    /// The left foot (model [`lfoot`], base frame `l_sole`).
-    Left,
+/// The NAOqi StandInit-like posture (both feet flat: hip + knee + ankle pitch = 0), in the
+/// order of [`VARIABLES`] (rad).
+pub const STAND: [f64; 23] = [
+    0.0, 0.0, 1.4, 0.3, -1.39, -1.0, 0.0, 0.0, 0.0, -0.35, 0.7, -0.35, 0.0, 0.0, -0.35, 0.7, -0.35,
+    0.0, 1.4, -0.3, 1.39, 1.0, 0.0,
+];
+
+/// Where the NAO may put a foot down: x ∈ [−0.04, 0.05], lateral ∈ [0.095, 0.12], |yaw| ≤ 0.15.
+/// The lateral bounds come from its 0.1 m hip width (the feet stay 95 mm apart, uncrossed); the
+/// forward ones from stepping with the torso 20 mm below its standing height and the CoM over
+/// the stance foot: at 8 cm (NAOqi's largest step) the swing knee is straight when the foot
+/// lands, and double support with the feet that far apart leaves the legs no posture to hold
+/// the torso with.
+pub const STEP_ENVELOPE: FootArea = FootArea {
+    x_min: -0.04,
+    x_max: 0.05,
+    lateral_min: 0.095,
+    lateral_max: 0.12,
+    yaw_max: 0.15,
+};
+
+/// The sole's outline: the four foot pressure sensors (front left, front right, rear right,
+/// rear left: clockwise seen from above) in the sole frame, metres, from the URDF's
+/// `LFoot/FSR/*` and `RFoot/FSR/*` fixed joints (ankle offsets with z = −0.04511 dropped).
+/// Their convex hull is the support area the foot gives.
+pub fn sole_outline(side: Side) -> [[f64; 2]; 4] {
+    match side {
+        Side::Left => [
+            [0.07025, 0.0299],
+            [0.07025, -0.0231],
+            [-0.02965, -0.0191],
+            [-0.03025, 0.0299],
+        ],
+        Side::Right => [
+            [0.07025, 0.0231],
+            [0.07025, -0.0299],
+            [-0.02965, -0.0299],
+            [-0.03025, 0.0191],
+        ],
+    }
 }
 
-impl Foot {
-    /// Name of this foot's sole frame (`r_sole` or `l_sole`).
-    pub fn sole(self) -> &'static str {
-        match self {
-            Foot::Right => "r_sole",
-            Foot::Left => "l_sole",
-        }
-    }
+/// Name of the sole frame of `side` (`l_sole`, `r_sole`).
+pub fn sole(side: Side) -> &'static str {
+    side.pick("l_sole", "r_sole")
+}
 
-    /// 0 for the right foot, 1 for the left: the order of per-foot arrays (right, left).
-    pub const fn index(self) -> usize {
-        match self {
-            Foot::Right => 0,
-            Foot::Left => 1,
-        }
-    }
+/// The frames standing for the human's joints. The NAO's `head` frame is the neck joint
+/// (HeadYaw/HeadPitch), so it stands for the human Neck, and the `gaze` point for the Head. The
+/// NAO has no pelvis point apart from its hips, so [`HumanJoint::Pelvis`] is not mapped.
+pub fn points() -> Vec<(HumanJoint, RobotPoint)> {
+    use HumanJoint::*;
+    let frame = |name: &str| RobotPoint::Frame(name.to_owned());
+    let mid = |a: &str, b: &str| RobotPoint::Midpoint(a.to_owned(), b.to_owned());
+    vec![
+        (MidHip, mid("l_hip", "r_hip")),
+        (LHip, frame("l_hip")),
+        (RHip, frame("r_hip")),
+        (LKnee, frame("l_knee")),
+        (RKnee, frame("r_knee")),
+        (LAnkle, frame("l_ankle")),
+        (RAnkle, frame("r_ankle")),
+        (LToe, frame("l_toe")),
+        (RToe, frame("r_toe")),
+        (MidShoulder, mid("l_shoulder", "r_shoulder")),
+        (Neck, frame("head")),
+        (Head, frame("gaze")),
+        (LShoulder, frame("l_shoulder")),
+        (RShoulder, frame("r_shoulder")),
+        (LElbow, frame("l_elbow")),
+        (RElbow, frame("r_elbow")),
+        (LWrist, frame("l_wrist")),
+        (RWrist, frame("r_wrist")),
+        (LHand, frame("l_hand")),
+        (RHand, frame("r_hand")),
+    ]
+}
 
-    /// The other foot.
-    pub fn other(self) -> Foot {
-        match self {
-            Foot::Right => Foot::Left,
-            Foot::Left => Foot::Right,
+/// The NAO's biped profile over the given models rooted at the left and right soles (the
+/// embedded DH models in [`profile`]; the URDF ones for a cross-check).
+pub fn profile_with(models: [Model; 2]) -> BipedProfile {
+    let foot = |side: Side| {
+        let p = side.pick("l_", "r_");
+        FootFrames {
+            sole: sole(side).to_owned(),
+            ankle: format!("{p}ankle"),
+            toe: format!("{p}toe"),
+            heel: format!("{p}heel"),
+            outline: sole_outline(side).to_vec(),
         }
+    };
+    BipedProfile {
+        name: "nao".to_owned(),
+        models,
+        feet: Side::BOTH.map(foot),
+        hands: ["l_hand".to_owned(), "r_hand".to_owned()],
+        torso: "torso".to_owned(),
+        points: points(),
+        stand: STAND.to_vec(),
+        step_envelope: STEP_ENVELOPE,
+        joint_angles: Some(JointAngles::boxed),
     }
+}
 
-    /// The sole's outline: the four foot pressure sensors (front left, front right, rear right,
-    /// rear left: clockwise seen from above) in the sole frame, metres, from the URDF's
-    /// `LFoot/FSR/*` and `RFoot/FSR/*` fixed joints (ankle offsets with z = −0.04511 dropped).
-    /// Their convex hull is the support area this foot gives.
-    pub fn sole_outline(self) -> [[f64; 2]; 4] {
-        match self {
-            Foot::Left => [
-                [0.07025, 0.0299],
-                [0.07025, -0.0231],
-                [-0.02965, -0.0191],
-                [-0.03025, 0.0299],
-            ],
-            Foot::Right => [
-                [0.07025, 0.0231],
-                [0.07025, -0.0299],
-                [-0.02965, -0.0299],
-                [-0.03025, 0.0191],
-            ],
-        }
-    }
-
-    /// Centre of [`Foot::sole_outline`]'s bounding rectangle in the sole frame (m): the point
-    /// of the contact area farthest from its edges, (20.0, ∓3.4) mm for the right and left
-    /// foot. Where a standing robot keeps its centre of mass.
-    pub fn sole_centre(self) -> [f64; 2] {
-        let outline = self.sole_outline();
-        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-        for corner in outline {
-            for k in 0..2 {
-                lo[k] = lo[k].min(corner[k]);
-                hi[k] = hi[k].max(corner[k]);
-            }
-        }
-        [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])]
-    }
-
-    /// The point of the contact area (sole frame, m) at `margin` from its inner edge, on the
-    /// line through [`Foot::sole_centre`] across the foot: where a robot standing on this foot
-    /// alone keeps its centre of mass. Past the centre (contact area narrower than `2·margin`)
-    /// it is the centre.
-    pub fn stance_point(self, margin: f64) -> [f64; 2] {
-        let [x, y] = self.sole_centre();
-        let ys = self.sole_outline().map(|[_, y]| y);
-        let (inner, toward_centre) = match self {
-            Foot::Left => (ys.iter().copied().fold(f64::INFINITY, f64::min), 1.0),
-            Foot::Right => (ys.iter().copied().fold(f64::NEG_INFINITY, f64::max), -1.0),
-        };
-        let from_edge = inner + toward_centre * margin;
-        let y = if toward_centre * (y - from_edge) > 0.0 {
-            from_edge
-        } else {
-            y
-        };
-        [x, y]
-    }
-
-    /// The DH model rooted at this foot's sole.
-    pub fn model(self) -> Model {
-        match self {
-            Foot::Right => rfoot(),
-            Foot::Left => lfoot(),
-        }
-    }
+/// The NAO H25 V5's biped profile from the embedded DH tables.
+pub fn profile() -> BipedProfile {
+    profile_with([lfoot(), rfoot()])
 }
 
 fn embedded(text: &str, origin: &str) -> Model {
@@ -261,8 +277,8 @@ pub fn switch_support(
     model: &Model,
     data: &ModelData,
     world_t_base: &IsometryMatrix3<f64>,
-    new_support: Foot,
+    new_support: Side,
 ) -> Result<IsometryMatrix3<f64>, ModelError> {
-    let sole = model.frame_id(new_support.sole())?;
+    let sole = model.frame_id(sole(new_support))?;
     model.placement_in_world(data, world_t_base, sole)
 }

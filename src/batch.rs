@@ -1,7 +1,7 @@
 //! Batch retargeting: many clips, one output folder per clip, a summary of the batch.
 //!
-//! Each clip is an independent job: the models ([`FootRootedModels`]) are built once and cloned
-//! into each job, which then owns its [`Imitator`] (all the solver and kinematics workspaces) and
+//! Each clip is an independent job: the robot ([`BatchOptions::robot`], a [`BipedProfile`]) is
+//! built once and cloned into each job, which then owns its [`Imitator`] (all the solver and kinematics workspaces) and
 //! its [`MetricsRecorder`], so jobs share nothing mutable. With the cargo feature `parallel` (on by
 //! default) the jobs run on a rayon thread pool of [`BatchOptions::threads`] threads; without it
 //! they run one after the other, with the same API and the same results: a clip's output does not
@@ -9,7 +9,7 @@
 //!
 //! For a clip `name.bvh` (or `name.csv`) the job writes into `OUT/name/`:
 //!
-//! * `joints.csv`: a header `time,<23 NAOqi joint names>`, then per frame the time (s) and the
+//! * `joints.csv`: a header `time,<the robot's joint names>`, then per frame the time (s) and the
 //!   joint angles (rad), six decimals;
 //! * `metrics.json`: the [`ImitationMetrics`] of the run (lengths in m, angles in rad, times in
 //!   s, solve time in µs; a non-finite value is written as `null`).
@@ -25,11 +25,14 @@ use std::time::Instant;
 use serde_json::{Value, json};
 use thiserror::Error;
 
-use super::human::HumanFrame;
-use super::imitator::{FootRootedModels, ImitationError, Imitator, ImitatorConfig};
-use super::metrics::{EffectorError, ImitationMetrics, MeanMax, MetricsRecorder, Spread};
+use crate::human::HumanFrame;
+use crate::imitation::imitator::{ImitationError, Imitator, ImitatorConfig};
+use crate::imitation::metrics::{
+    EffectorError, ImitationMetrics, MeanMax, MetricsRecorder, Spread,
+};
 use crate::io::clip::{Clip, ClipError};
 use crate::model::ModelError;
+use crate::robots::{BipedProfile, nao};
 
 /// Errors of a batch or of one of its clips. Each names the clip file.
 #[derive(Debug, Error)]
@@ -91,14 +94,26 @@ pub enum BatchError {
     },
 }
 
-/// Options of a batch. The default: one thread per core, default imitator settings.
-#[derive(Debug, Clone, Default)]
+/// Options of a batch. The default: the NAO, one thread per core, default imitator settings.
+#[derive(Debug, Clone)]
 pub struct BatchOptions {
+    /// The robot every clip is retargeted to.
+    pub robot: BipedProfile,
     /// Worker threads; 0 means one per core. Ignored (always 1) without the `parallel` feature.
     pub threads: usize,
     /// Imitator settings shared by every clip, except `support`, which each clip replaces by the
     /// defaults of its kind of source ([`Clip::support_config`]: optical mocap or Kinect).
     pub imitator: ImitatorConfig,
+}
+
+impl Default for BatchOptions {
+    fn default() -> Self {
+        Self {
+            robot: nao::profile(),
+            threads: 0,
+            imitator: ImitatorConfig::default(),
+        }
+    }
 }
 
 /// What one clip's run gave.
@@ -219,12 +234,11 @@ pub fn retarget_all(
         }
         outputs.push(output);
     }
-    let models = FootRootedModels::nao();
     let start = Instant::now();
     let job = |(clip, output): (&PathBuf, &PathBuf)| ClipOutcome {
         clip: clip.clone(),
         output: output.clone(),
-        result: retarget_clip(models.clone(), &options.imitator, clip, output),
+        result: retarget_clip(options.robot.clone(), &options.imitator, clip, output),
     };
     let (clips, threads) = run_jobs(clips, &outputs, options.threads, job)?;
     Ok(BatchSummary {
@@ -277,10 +291,10 @@ where
     Ok((clips.iter().zip(outputs).map(job).collect(), 1))
 }
 
-/// Retargets one clip with `models` and writes `joints.csv` and `metrics.json` into `output`
+/// Retargets one clip to `robot` and writes `joints.csv` and `metrics.json` into `output`
 /// (created if needed). `config.support` is replaced by the clip's defaults.
 pub fn retarget_clip(
-    models: FootRootedModels,
+    robot: BipedProfile,
     config: &ImitatorConfig,
     clip: &Path,
     output: &Path,
@@ -295,7 +309,7 @@ pub fn retarget_clip(
         support: source.support_config(),
         ..config.clone()
     };
-    let mut imitator = Imitator::new(models, config).map_err(|source| BatchError::Imitation {
+    let mut imitator = Imitator::new(robot, config).map_err(|source| BatchError::Imitation {
         path: path(),
         frame: 0,
         source,

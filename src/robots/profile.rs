@@ -1,0 +1,355 @@
+//! A biped profile: what the imitation needs to know about a robot, as data.
+//!
+//! A [`BipedProfile`] holds the robot's kinematic model rooted at each sole, the frames that
+//! stand for the human's joints (the scaler's map, [`RobotPoint`]), the feet (sole frame, the
+//! ankle, toe and heel points the task tables hold, and the contact area), the hands and the
+//! torso the tables track, a standing posture, the step envelope ([`FootArea`]) and, optionally,
+//! a map from the human's segment directions to the robot's joint angles
+//! ([`HumanJointAngles`], used by the joint-tracking gradient). Velocity limits are the model's
+//! (`Variable::velocity`, from the URDF's `<limit velocity>` or the DH table); coupled joints are
+//! the model's too (the NAO's HipYawPitch is one variable driving both hips).
+//!
+//! Built in: [`crate::robots::nao::profile`] and [`crate::robots::g1::profile`]. Any other
+//! biped: a small TOML file next to its URDF ([`BipedProfile::from_toml_file`]; the format is
+//! documented in [`super::profile_toml`]), or a struct literal in code.
+//!
+//! Frames: every sole frame has z up out of the floor and x forward, at the contact plane; the
+//! models' bases are the soles. Per-side arrays are indexed by [`Side::index`] (`[left, right]`).
+
+use std::fmt;
+
+use nalgebra::{Rotation3, Vector2, Vector3};
+use thiserror::Error;
+
+use crate::human::{HumanJoint, SegmentDirections, Side};
+use crate::model::{Model, ModelError, UrdfError};
+
+/// A robot point that stands for a human joint: a named frame's origin, or the midpoint of two.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum RobotPoint {
+    /// Origin of the named frame.
+    Frame(String),
+    /// Midpoint of the origins of two named frames.
+    Midpoint(String, String),
+}
+
+impl RobotPoint {
+    /// The frame names this point is built from.
+    pub fn frames(&self) -> impl Iterator<Item = &str> {
+        let (a, b) = match self {
+            RobotPoint::Frame(a) => (a.as_str(), None),
+            RobotPoint::Midpoint(a, b) => (a.as_str(), Some(b.as_str())),
+        };
+        std::iter::once(a).chain(b)
+    }
+}
+
+/// One foot: the frames the task tables use and its contact area.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FootFrames {
+    /// The sole frame (on the contact plane, z up, x forward): the base of the model rooted at
+    /// this foot.
+    pub sole: String,
+    /// The ankle point (held over the sole while the foot stands, lifted while it swings).
+    pub ankle: String,
+    /// A point at the front of the sole (held on the ground while the foot stands).
+    pub toe: String,
+    /// A point at the back of the sole.
+    pub heel: String,
+    /// The contact area: a convex polygon in the sole frame (m, x forward, y left), at least
+    /// three corners.
+    pub outline: Vec<[f64; 2]>,
+}
+
+/// Where a foot may be put down, relative to the other (support) sole: the sole origin's
+/// forward offset `x` and its lateral offset towards the foot's own side (metres), and its yaw
+/// (radians). For the left foot relative to the right sole, lateral = y; mirrored for the right.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FootArea {
+    /// Smallest forward offset (metres).
+    pub x_min: f64,
+    /// Largest forward offset (metres).
+    pub x_max: f64,
+    /// Smallest lateral offset (metres), so the feet do not collide.
+    pub lateral_min: f64,
+    /// Largest lateral offset (metres).
+    pub lateral_max: f64,
+    /// Largest |yaw| of the foot relative to the support sole (radians).
+    pub yaw_max: f64,
+}
+
+impl FootArea {
+    /// The name and value of the first invalid bound: non-finite, `x_min > x_max`,
+    /// `lateral_min > lateral_max` or `yaw_max < 0`.
+    pub fn invalid_field(&self) -> Option<(&'static str, f64)> {
+        let fields = [
+            ("x_min", self.x_min),
+            ("x_max", self.x_max),
+            ("lateral_min", self.lateral_min),
+            ("lateral_max", self.lateral_max),
+            ("yaw_max", self.yaw_max),
+        ];
+        if let Some(&bad) = fields.iter().find(|(_, v)| !v.is_finite()) {
+            return Some(bad);
+        }
+        if self.x_min > self.x_max {
+            return Some(("x_min", self.x_min));
+        }
+        if self.lateral_min > self.lateral_max {
+            return Some(("lateral_min", self.lateral_min));
+        }
+        (self.yaw_max < 0.0).then_some(("yaw_max", self.yaw_max))
+    }
+}
+
+/// Placement of a sole on the ground relative to another sole: horizontal position (metres) and
+/// yaw (radians) in that sole's frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SolePlacement {
+    /// x, y of the sole origin (metres).
+    pub xy: Vector2<f64>,
+    /// Rotation about z (radians).
+    pub yaw: f64,
+}
+
+impl SolePlacement {
+    pub(crate) fn rotation(&self) -> Rotation3<f64> {
+        Rotation3::from_axis_angle(&Vector3::z_axis(), self.yaw)
+    }
+
+    /// The other sole seen from this one: the inverse rigid motion.
+    pub(crate) fn inverse(&self) -> SolePlacement {
+        let (s, c) = self.yaw.sin_cos();
+        let xy = self.xy;
+        SolePlacement {
+            xy: Vector2::new(-(c * xy.x + s * xy.y), s * xy.x - c * xy.y),
+            yaw: -self.yaw,
+        }
+    }
+}
+
+impl FootArea {
+    /// Clips the placement of the foot on `side` relative to the other sole.
+    pub fn clip(&self, side: Side, placement: SolePlacement) -> SolePlacement {
+        let sign = if side == Side::Left { 1.0 } else { -1.0 };
+        SolePlacement {
+            xy: Vector2::new(
+                placement.xy.x.clamp(self.x_min, self.x_max),
+                sign * (sign * placement.xy.y).clamp(self.lateral_min, self.lateral_max),
+            ),
+            yaw: placement.yaw.clamp(-self.yaw_max, self.yaw_max),
+        }
+    }
+}
+
+/// Errors of a joint-angle map and of a profile.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum ProfileError {
+    /// A model query failed (names the frame or variable).
+    #[error("robot model: {0}")]
+    Model(#[from] ModelError),
+    /// The robot description could not be loaded.
+    #[error("robot description: {0}")]
+    Urdf(#[from] UrdfError),
+    /// The profile file could not be read.
+    #[error("cannot read {path}: {message}")]
+    Io {
+        /// The file.
+        path: String,
+        /// What went wrong.
+        message: String,
+    },
+    /// The profile TOML is malformed (the message names the line and field).
+    #[error("profile {path}: {message}")]
+    Syntax {
+        /// The file, or `<text>`.
+        path: String,
+        /// The parser's message.
+        message: String,
+    },
+    /// A value of the profile is invalid (names the field).
+    #[error("profile field {field}: {reason}")]
+    Invalid {
+        /// The field, e.g. `feet.left.outline`.
+        field: String,
+        /// Why.
+        reason: String,
+    },
+    /// An output slice does not have one entry per model variable.
+    #[error("joint-angle output has {got} entries, the model has {expected} variables")]
+    WrongLength {
+        /// Number of variables of the model.
+        expected: usize,
+        /// Length of the given slice.
+        got: usize,
+    },
+}
+
+/// A map from the human's segment directions to the robot's joint angles: the reference of the
+/// joint-tracking gradient (Poubel eq. 8). Built once per model; `compute` must not allocate.
+pub trait HumanJointAngles: Send + Sync + fmt::Debug {
+    /// Writes the joint angles (model variable order, radians, inside the limits) that give the
+    /// robot's segments the human's `directions` (unit vectors in the support sole frame).
+    /// Variables the map does not set are set to 0 clipped to their limits.
+    ///
+    /// # Errors
+    /// [`ProfileError::WrongLength`] when `q` does not have one entry per variable.
+    fn compute(
+        &mut self,
+        directions: &SegmentDirections,
+        q: &mut [f64],
+    ) -> Result<(), ProfileError>;
+}
+
+/// Builds a robot's [`HumanJointAngles`] for one of its models.
+pub type JointAnglesFactory = fn(&Model) -> Result<Box<dyn HumanJointAngles>, ProfileError>;
+
+/// Everything the imitation needs to know about a biped (see the module docs).
+#[derive(Clone, Debug)]
+pub struct BipedProfile {
+    /// Short name (`"nao"`, `"g1"`), used in output file headers and messages.
+    pub name: String,
+    /// The model rooted at each sole (`[left, right]`): the same variables and named frames, the
+    /// base frame at [`FootFrames::sole`] of that side.
+    pub models: [Model; 2],
+    /// The feet, `[left, right]`.
+    pub feet: [FootFrames; 2],
+    /// The frames whose origins track the human's hands, `[left, right]`.
+    pub hands: [String; 2],
+    /// The torso frame: held upright (its z axis vertical) at its standing height.
+    pub torso: String,
+    /// Human joint → robot point, the scaler's map. MidHip, the hips, knees and ankles are
+    /// required; unmapped human joints are ignored.
+    pub points: Vec<(HumanJoint, RobotPoint)>,
+    /// The standing posture (model variable order, radians) with both soles flat on the floor:
+    /// the initial posture and the legs' joint-tracking reference.
+    pub stand: Vec<f64>,
+    /// Where a foot may be put down relative to the other.
+    pub step_envelope: FootArea,
+    /// The human-to-robot joint-angle map, or `None`: the joint-tracking gradient then pulls
+    /// toward [`BipedProfile::stand`].
+    pub joint_angles: Option<JointAnglesFactory>,
+}
+
+impl BipedProfile {
+    /// The model rooted at the sole of `side`.
+    pub fn model(&self, side: Side) -> &Model {
+        &self.models[side.index()]
+    }
+
+    /// The foot on `side`.
+    pub fn foot(&self, side: Side) -> &FootFrames {
+        &self.feet[side.index()]
+    }
+
+    /// Checks the profile against its models: both models have the same variables, every frame
+    /// the profile names exists in both, each model's base is its sole, the outlines have three
+    /// or more finite corners, the standing posture is finite and inside the limits, the step
+    /// envelope is valid. The error names the field.
+    pub fn validate(&self) -> Result<(), ProfileError> {
+        let invalid = |field: &str, reason: String| ProfileError::Invalid {
+            field: field.to_owned(),
+            reason,
+        };
+        let [left, right] = &self.models;
+        if left.variables() != right.variables() {
+            return Err(invalid(
+                "models",
+                "the two rooted models have different variables".into(),
+            ));
+        }
+        for model in &self.models {
+            for name in self.frame_names() {
+                model.frame_id(name)?;
+            }
+        }
+        for side in Side::BOTH {
+            let foot = self.foot(side);
+            let model = self.model(side);
+            let mut data = model.new_data();
+            model.forward_kinematics(&mut data, &self.stand)?;
+            let sole = data.frame_placement(model.frame_id(&foot.sole)?);
+            if sole.translation.vector.norm() > 1e-9
+                || (sole.rotation.matrix() - nalgebra::Matrix3::identity()).norm() > 1e-9
+            {
+                return Err(invalid(
+                    "models",
+                    format!(
+                        "the model rooted at the {side:?} foot does not have its base at {}",
+                        foot.sole
+                    ),
+                ));
+            }
+            let corners_ok =
+                foot.outline.len() >= 3 && foot.outline.iter().flatten().all(|c| c.is_finite());
+            if !corners_ok {
+                return Err(invalid(
+                    "feet.outline",
+                    "needs three or more finite corners (m)".into(),
+                ));
+            }
+        }
+        for (v, &q) in left.variables().iter().zip(&self.stand) {
+            if !(q >= v.lower && q <= v.upper) {
+                return Err(invalid(
+                    "stand",
+                    format!("{} = {q} rad is outside [{}, {}]", v.name, v.lower, v.upper),
+                ));
+            }
+        }
+        if let Some((field, value)) = self.step_envelope.invalid_field() {
+            return Err(invalid(
+                &format!("step_envelope.{field}"),
+                format!("{value} breaks min ≤ max, finite, yaw_max ≥ 0"),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Every frame name the profile uses.
+    fn frame_names(&self) -> impl Iterator<Item = &str> {
+        let feet = self
+            .feet
+            .iter()
+            .flat_map(|f| [&f.sole, &f.ankle, &f.toe, &f.heel].map(String::as_str));
+        let points = self.points.iter().flat_map(|(_, p)| p.frames());
+        feet.chain(self.hands.iter().map(String::as_str))
+            .chain(std::iter::once(self.torso.as_str()))
+            .chain(points)
+    }
+
+    /// Centre of the bounding rectangle of the contact area of `side` (sole frame, m): the
+    /// point of the area farthest from its edges for a rectangle-like sole; where a robot
+    /// standing on this foot keeps its centre of mass.
+    pub fn sole_centre(&self, side: Side) -> [f64; 2] {
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for corner in &self.foot(side).outline {
+            for k in 0..2 {
+                lo[k] = lo[k].min(corner[k]);
+                hi[k] = hi[k].max(corner[k]);
+            }
+        }
+        [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])]
+    }
+
+    /// The point of the contact area of `side` (sole frame, m) at `margin` from its inner edge
+    /// (the edge toward the other foot), on the line through [`BipedProfile::sole_centre`]
+    /// across the foot: where a robot standing on this foot alone keeps its centre of mass.
+    /// Past the centre (contact area narrower than `2·margin`) it is the centre.
+    pub fn stance_point(&self, side: Side, margin: f64) -> [f64; 2] {
+        let [x, y] = self.sole_centre(side);
+        let ys = self.foot(side).outline.iter().map(|[_, y]| *y);
+        let (inner, toward_centre) = match side {
+            Side::Left => (ys.fold(f64::INFINITY, f64::min), 1.0),
+            Side::Right => (ys.fold(f64::NEG_INFINITY, f64::max), -1.0),
+        };
+        let from_edge = inner + toward_centre * margin;
+        let y = if toward_centre * (y - from_edge) > 0.0 {
+            from_edge
+        } else {
+            y
+        };
+        [x, y]
+    }
+}

@@ -1,0 +1,272 @@
+//! A [`BipedProfile`] from a small TOML file next to the robot's URDF.
+//!
+//! Lengths in metres, angles in radians, frames as in the URDF (x forward, y left, z up). Every
+//! field but `variables`, `locked`, `stand` and `frames` is required; an unknown field is an
+//! error (it is a typo more often than not).
+//!
+//! ```toml
+//! name = "tiny"
+//! urdf = "tiny.urdf"                 # relative to this file
+//! variables = ["l_hip", "l_knee"]    # optional: the order of q (default: the URDF's joints)
+//! locked = { gripper = 0.0 }         # optional: joints fixed at a value
+//! hands = ["l_hand", "r_hand"]       # frames (links or `frames` below) tracking the hands
+//! torso = "base"                     # the frame held upright at its standing height
+//! stand = { l_knee = 0.3, r_knee = 0.3 }  # standing posture; joints not named are 0
+//!
+//! [feet.left]
+//! link = "l_foot"                    # the URDF link the sole hangs from
+//! sole = [0.0, 0.0, -0.02]           # sole origin in that link (on the floor, link's axes)
+//! ankle = "l_foot"                   # the ankle point
+//! toe = 0.06                         # toe and heel points on the sole's x axis
+//! heel = -0.03
+//! outline = [[0.08, 0.03], [0.08, -0.03], [-0.04, -0.03], [-0.04, 0.03]]  # contact area
+//!
+//! [feet.right]                       # the same for the right foot
+//! # …
+//!
+//! [step_envelope]                    # where a foot may go relative to the other sole
+//! x_min = -0.05
+//! x_max = 0.08
+//! lateral_min = 0.12
+//! lateral_max = 0.18
+//! yaw_max = 0.2
+//!
+//! [points]                           # human joint (HumanJoint::name) → frame or [frame, frame]
+//! MidHip = ["l_hip_link", "r_hip_link"]
+//! LHip = "l_hip_link"
+//! # … RHip, LKnee, RKnee, LAnkle, RAnkle are required; the others are optional
+//!
+//! [frames]                           # optional extra frames: a link and an offset
+//! l_hand = { link = "l_forearm", xyz = [0.1, 0.0, 0.0] }
+//! ```
+//!
+//! The soles become links named `left_sole` and `right_sole` (added to the URDF text before it
+//! is loaded), the toe and heel points frames named `left_toe`, `left_heel`, `right_toe`,
+//! `right_heel`. A profile loaded from a file has no human joint-angle map.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use nalgebra::{IsometryMatrix3, Translation3};
+use serde::Deserialize;
+
+use super::profile::{BipedProfile, FootArea, FootFrames, ProfileError, RobotPoint};
+use crate::human::{HumanJoint, Side};
+use crate::model::{Model, UrdfError, UrdfFrame, UrdfOptions};
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct File {
+    name: String,
+    urdf: String,
+    variables: Option<Vec<String>>,
+    #[serde(default)]
+    locked: BTreeMap<String, f64>,
+    hands: [String; 2],
+    torso: String,
+    #[serde(default)]
+    stand: BTreeMap<String, f64>,
+    feet: Feet,
+    step_envelope: Envelope,
+    points: BTreeMap<String, Point>,
+    #[serde(default)]
+    frames: BTreeMap<String, ExtraFrame>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Feet {
+    left: Foot,
+    right: Foot,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Foot {
+    link: String,
+    sole: [f64; 3],
+    ankle: String,
+    toe: f64,
+    heel: f64,
+    outline: Vec<[f64; 2]>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Envelope {
+    x_min: f64,
+    x_max: f64,
+    lateral_min: f64,
+    lateral_max: f64,
+    yaw_max: f64,
+}
+
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum Point {
+    Frame(String),
+    Midpoint([String; 2]),
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ExtraFrame {
+    link: String,
+    xyz: [f64; 3],
+}
+
+fn invalid(field: impl Into<String>, reason: impl Into<String>) -> ProfileError {
+    ProfileError::Invalid {
+        field: field.into(),
+        reason: reason.into(),
+    }
+}
+
+fn offset_frame(name: String, link: &str, [x, y, z]: [f64; 3]) -> UrdfFrame {
+    UrdfFrame {
+        name,
+        link: link.to_owned(),
+        placement: IsometryMatrix3::from(Translation3::new(x, y, z)),
+    }
+}
+
+/// `text` with a fixed link `name` added under `parent` at `xyz` (m), before `</robot>`.
+pub(crate) fn with_fixed_link(
+    text: &str,
+    name: &str,
+    parent: &str,
+    [x, y, z]: [f64; 3],
+) -> Result<String, UrdfError> {
+    let Some(end) = text.rfind("</robot>") else {
+        return Err(UrdfError::Xml("no closing </robot> tag".to_owned()));
+    };
+    Ok(format!(
+        r#"{}<link name="{name}"/><joint name="{name}_joint" type="fixed"><origin xyz="{x} {y} {z}" rpy="0 0 0"/><parent link="{parent}"/><child link="{name}"/></joint>{}"#,
+        &text[..end],
+        &text[end..]
+    ))
+}
+
+impl BipedProfile {
+    /// Loads a profile from a TOML file (format in [`crate::robots::profile_toml`]); the URDF
+    /// path in it is relative to the file. The profile is validated.
+    ///
+    /// # Errors
+    /// The file or the URDF cannot be read ([`ProfileError::Io`], [`ProfileError::Urdf`]),
+    /// malformed TOML or an unknown field ([`ProfileError::Syntax`], naming line and field), a
+    /// value out of range or a frame missing from the model ([`ProfileError::Invalid`],
+    /// [`ProfileError::Model`]).
+    pub fn from_toml_file(path: impl AsRef<Path>) -> Result<Self, ProfileError> {
+        let path = path.as_ref();
+        let read = |p: &Path| {
+            std::fs::read_to_string(p).map_err(|e| ProfileError::Io {
+                path: p.display().to_string(),
+                message: e.to_string(),
+            })
+        };
+        let text = read(path)?;
+        let file = parse(&text, &path.display().to_string())?;
+        let urdf_path = path.parent().unwrap_or(Path::new("")).join(&file.urdf);
+        build(file, &read(&urdf_path)?)
+    }
+
+    /// [`BipedProfile::from_toml_file`] from the profile's text and its URDF's text (the
+    /// profile's `urdf` field is ignored).
+    pub fn from_toml_str(profile: &str, urdf: &str) -> Result<Self, ProfileError> {
+        build(parse(profile, "<text>")?, urdf)
+    }
+}
+
+fn parse(text: &str, path: &str) -> Result<File, ProfileError> {
+    toml::from_str(text).map_err(|e: toml::de::Error| ProfileError::Syntax {
+        path: path.to_owned(),
+        message: e.to_string(),
+    })
+}
+
+fn build(file: File, urdf: &str) -> Result<BipedProfile, ProfileError> {
+    let feet = [&file.feet.left, &file.feet.right];
+    let mut text = urdf.to_owned();
+    let mut frames: Vec<UrdfFrame> = Vec::new();
+    for (side, foot) in Side::BOTH.into_iter().zip(feet) {
+        let sole = format!("{}_sole", side.pick("left", "right"));
+        text = with_fixed_link(&text, &sole, &foot.link, foot.sole)?;
+        for (point, x) in [("toe", foot.toe), ("heel", foot.heel)] {
+            let name = format!("{}_{point}", side.pick("left", "right"));
+            frames.push(offset_frame(name, &sole, [x, 0.0, 0.0]));
+        }
+    }
+    for (name, f) in &file.frames {
+        frames.push(offset_frame(name.clone(), &f.link, f.xyz));
+    }
+    let options = |root: &str| UrdfOptions {
+        root_link: Some(root.to_owned()),
+        locked_joints: file.locked.iter().map(|(j, v)| (j.clone(), *v)).collect(),
+        variable_order: file.variables.clone(),
+        frames: frames.clone(),
+        link_frames: true,
+    };
+    let models = [
+        Model::from_urdf_str(&text, &options("left_sole"))?,
+        Model::from_urdf_str(&text, &options("right_sole"))?,
+    ];
+    let stand = standing_posture(&models[0], &file.stand)?;
+    let points = file
+        .points
+        .into_iter()
+        .map(|(joint, point)| {
+            let joint = HumanJoint::from_name(&joint)
+                .ok_or_else(|| invalid(format!("points.{joint}"), "not a human joint name"))?;
+            let point = match point {
+                Point::Frame(f) => RobotPoint::Frame(f),
+                Point::Midpoint([a, b]) => RobotPoint::Midpoint(a, b),
+            };
+            Ok((joint, point))
+        })
+        .collect::<Result<Vec<_>, ProfileError>>()?;
+    let foot = |side: Side, f: &Foot| {
+        let s = side.pick("left", "right");
+        FootFrames {
+            sole: format!("{s}_sole"),
+            ankle: f.ankle.clone(),
+            toe: format!("{s}_toe"),
+            heel: format!("{s}_heel"),
+            outline: f.outline.clone(),
+        }
+    };
+    let e = file.step_envelope;
+    let profile = BipedProfile {
+        name: file.name,
+        models,
+        feet: [foot(Side::Left, feet[0]), foot(Side::Right, feet[1])],
+        hands: file.hands,
+        torso: file.torso,
+        points,
+        stand,
+        step_envelope: FootArea {
+            x_min: e.x_min,
+            x_max: e.x_max,
+            lateral_min: e.lateral_min,
+            lateral_max: e.lateral_max,
+            yaw_max: e.yaw_max,
+        },
+        joint_angles: None,
+    };
+    profile.validate()?;
+    Ok(profile)
+}
+
+/// The standing posture: the named joints at their values, the others at 0.
+fn standing_posture(
+    model: &Model,
+    named: &BTreeMap<String, f64>,
+) -> Result<Vec<f64>, ProfileError> {
+    let mut q = vec![0.0; model.nv()];
+    for (joint, &value) in named {
+        let i = model
+            .variable_index(joint)
+            .map_err(|_| invalid(format!("stand.{joint}"), "not a variable of the model"))?;
+        q[i] = value;
+    }
+    Ok(q)
+}
