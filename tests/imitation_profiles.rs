@@ -1,0 +1,129 @@
+//! Imitation of other bipeds than the NAO: the Unitree G1 (built-in profile) on every bundled
+//! clip, and a synthetic biped described only by a URDF and a profile TOML written for this test
+//! (`tests/data/tiny_biped/`), with the invariants the NAO's runs keep: joint angles finite and
+//! within their limits, steps within the velocity limits, the CoM over the feet on the ground, the
+//! support foot not slipping across model switches.
+
+use taskstack::human::HumanFrame;
+use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
+use taskstack::imitation::metrics::{ImitationMetrics, MetricsRecorder};
+use taskstack::io::clip::Clip;
+use taskstack::robots::{BipedProfile, ProfileError, g1};
+
+const MOCAP: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/mocap/");
+const TINY: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/tiny_biped/");
+
+/// Imitates `clip` with `profile` and checks every frame's joint angles against the bounds.
+fn imitate(profile: BipedProfile, clip: &str) -> ImitationMetrics {
+    let mut source = Clip::open(format!("{MOCAP}{clip}")).unwrap();
+    let config = ImitatorConfig {
+        support: source.support_config(),
+        ..ImitatorConfig::default()
+    };
+    let mut imitator = Imitator::new(profile, config).unwrap();
+    let mut recorder = MetricsRecorder::new(&imitator);
+    let mut frame = HumanFrame::new(0.0);
+    while source.read_frame(&mut frame).unwrap() {
+        let r = imitator.step(&frame).unwrap().clone();
+        assert!(r.q.iter().all(|q| q.is_finite()), "{clip} at {} s", r.time);
+        recorder.record(&imitator, &r).unwrap();
+    }
+    recorder.finish()
+}
+
+fn assert_executable(m: &ImitationMetrics, clip: &str) {
+    assert_eq!(m.joint_limit_violations, 0, "{clip}");
+    assert_eq!(m.velocity_limit_violations, 0, "{clip}");
+    assert_eq!(
+        m.frames_com_outside, 0,
+        "{clip}: CoM left the support polygon"
+    );
+    assert!(
+        m.min_com_margin > 0.005,
+        "{clip}: CoM margin {}",
+        m.min_com_margin
+    );
+    // The support foot is the model's root: it moves only through model switches.
+    assert!(
+        m.max_support_slip < 1e-4,
+        "{clip}: slip {}",
+        m.max_support_slip
+    );
+    assert!(
+        m.max_support_turn < 1e-3,
+        "{clip}: turn {}",
+        m.max_support_turn
+    );
+    assert!(
+        m.max_held_foot_slip < 1e-3,
+        "{clip}: {}",
+        m.max_held_foot_slip
+    );
+}
+
+fn clips() -> Vec<String> {
+    let mut clips: Vec<String> = std::fs::read_dir(MOCAP)
+        .unwrap()
+        .filter_map(|e| e.ok()?.file_name().into_string().ok())
+        .filter(|n| n.ends_with(".bvh") || n.ends_with(".csv"))
+        .collect();
+    clips.sort();
+    assert!(clips.len() >= 8);
+    clips
+}
+
+#[test]
+fn g1_imitates_every_bundled_clip_within_its_limits() {
+    let profile = g1::profile();
+    let mut single_support = 0;
+    for clip in clips() {
+        let m = imitate(profile.clone(), &clip);
+        assert_executable(&m, &clip);
+        single_support += m.robot_support_changes;
+    }
+    // The G1 follows the human onto one leg on the clips that have a long stance.
+    assert!(single_support >= 2, "{single_support}");
+}
+
+#[test]
+fn a_biped_described_by_a_profile_file_imitates_without_crate_changes() {
+    let profile = BipedProfile::from_toml_file(format!("{TINY}tiny_biped.toml")).unwrap();
+    assert_eq!(profile.name, "tiny_biped");
+    assert_eq!(profile.models[0].nv(), 18);
+    for clip in [
+        "cmu_05_12_slow_dance_tendu_arms_high.bvh",
+        "kinect2_labanotation_ges01_wavehand.csv",
+    ] {
+        let m = imitate(profile.clone(), clip);
+        assert_executable(&m, clip);
+    }
+}
+
+#[test]
+fn profile_errors_name_the_field() {
+    let urdf = std::fs::read_to_string(format!("{TINY}tiny_biped.urdf")).unwrap();
+    let toml = std::fs::read_to_string(format!("{TINY}tiny_biped.toml")).unwrap();
+    let load = |text: &str| BipedProfile::from_toml_str(text, &urdf).unwrap_err();
+
+    let err = load(&toml.replace("torso = ", "torsoo = "));
+    assert!(matches!(err, ProfileError::Syntax { .. }), "{err}");
+    assert!(err.to_string().contains("torsoo"), "{err}");
+
+    let err = load(&toml.replace("LElbow =", "LeftElbow ="));
+    assert!(err.to_string().contains("points.LeftElbow"), "{err}");
+
+    let err = load(&toml.replace("LKnee = \"l_shank\"", "LKnee = \"l_shin\""));
+    assert!(err.to_string().contains("l_shin"), "{err}");
+
+    let err = load(&toml.replace("l_knee = 0.4", "l_knee = 3.0"));
+    assert!(err.to_string().contains("l_knee"), "{err}");
+
+    let err = load(&toml.replace("lateral_min = 0.08", "lateral_min = 0.2"));
+    assert!(
+        err.to_string().contains("step_envelope.lateral_min"),
+        "{err}"
+    );
+
+    let missing = BipedProfile::from_toml_file(format!("{TINY}nowhere.toml")).unwrap_err();
+    assert!(matches!(missing, ProfileError::Io { .. }), "{missing}");
+}
