@@ -1,5 +1,6 @@
-//! `Imitator::step` on real clips: frames of double support (CMU 02_10, standing gestures) and of
-//! a walk with right and left single supports (CMU 07_04), streamed from memory in a loop.
+//! `Imitator::step` on real clips, for the NAO and the Unitree G1: frames of double support (CMU
+//! 02_10, standing gestures) and of a walk with right and left single supports (CMU 07_04),
+//! streamed from memory in a loop.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
@@ -7,7 +8,7 @@ use taskstack::human::HumanFrame;
 use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
 use taskstack::imitation::phase::SupportPhase;
 use taskstack::io::clip::Clip;
-use taskstack::robots::nao;
+use taskstack::robots::{BipedProfile, g1, nao};
 
 fn frames(name: &str) -> Vec<HumanFrame> {
     let path = format!("{}/tests/data/mocap/{name}", env!("CARGO_MANIFEST_DIR"));
@@ -15,16 +16,20 @@ fn frames(name: &str) -> Vec<HumanFrame> {
 }
 
 fn bench(c: &mut Criterion) {
-    for (label, clip) in [
+    let robots: [(&str, fn() -> BipedProfile); 2] = [("nao", nao::profile), ("g1", g1::profile)];
+    for ((label, clip), (robot, profile)) in [
         (
             "double_support_02_10",
             "cmu_02_10_wash_self_standing_arm_gestures.bvh",
         ),
         ("walk_07_04", "cmu_07_04_slow_walk.bvh"),
-    ] {
+    ]
+    .into_iter()
+    .flat_map(|clip| robots.map(|robot| (clip, robot)))
+    {
         let frames = frames(clip);
         let duration = frames.last().unwrap().time - frames[0].time + 1.0 / 120.0;
-        let mut imitator = Imitator::new(nao::profile(), ImitatorConfig::default()).unwrap();
+        let mut imitator = Imitator::new(profile(), ImitatorConfig::default()).unwrap();
         // Warm up on the whole clip once, and count the phases the bench will see.
         let mut single = 0;
         for f in &frames {
@@ -32,12 +37,12 @@ fn bench(c: &mut Criterion) {
             single += usize::from(matches!(p, SupportPhase::Right | SupportPhase::Left));
         }
         eprintln!(
-            "{label}: {} frames, {single} in single support on the first pass",
+            "{robot} {label}: {} frames, {single} in single support on the first pass",
             frames.len()
         );
         let mut i = 0;
         let mut lap = 1.0;
-        c.bench_function(&format!("imitator_step/{label}"), |b| {
+        c.bench_function(&format!("imitator_step/{robot}/{label}"), |b| {
             b.iter(|| {
                 // Replay the clip with increasing times so the imitator sees a continuous stream.
                 let mut frame = frames[i];
