@@ -15,8 +15,11 @@ fn frames(name: &str) -> Vec<HumanFrame> {
     Clip::open(path).unwrap().collect::<Result<_, _>>().unwrap()
 }
 
+/// A robot by name, and how to build its profile.
+type Robot = (&'static str, fn() -> BipedProfile);
+
 fn bench(c: &mut Criterion) {
-    let robots: [(&str, fn() -> BipedProfile); 2] = [("nao", nao::profile), ("g1", g1::profile)];
+    let robots: [Robot; 2] = [("nao", nao::profile), ("g1", g1::profile)];
     for ((label, clip), (robot, profile)) in [
         (
             "double_support_02_10",
