@@ -502,7 +502,7 @@ impl Imitator {
             .unwrap_or(0);
         let skeleton = RobotSkeleton::of(&profile)?;
         let angles = profile.joint_angles.map(|build| build(model)).transpose()?;
-        let mut data = profile.models.clone().map(|m| m.new_data());
+        let mut data = profile.models.each_ref().map(Model::new_data);
         let sole_ids = |root: Side| -> Result<[FrameId; 2], ModelError> {
             let model = profile.model(root);
             let [left, right] = Side::BOTH.map(|foot| model.frame_id(&profile.foot(foot).sole));

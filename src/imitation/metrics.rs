@@ -318,11 +318,11 @@ impl MetricsRecorder {
     pub fn new(imitator: &Imitator) -> Self {
         let profile = imitator.profile();
         let [lh, rh] = profile.hands.clone();
-        let [la, ra] = profile.feet.clone().map(|f| f.ankle);
+        let [la, ra] = profile.feet.each_ref().map(|f| f.ankle.clone());
         Self {
-            data: profile.models.clone().map(|m| m.new_data()),
+            data: profile.models.each_ref().map(crate::model::Model::new_data),
             effector_frames: [lh, rh, la, ra],
-            outlines: profile.feet.clone().map(|f| f.outline),
+            outlines: profile.feet.each_ref().map(|f| f.outline.clone()),
             points: Vec::new(),
             frames: 0,
             first_time: None,
