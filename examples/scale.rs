@@ -71,7 +71,7 @@ fn parse_args() -> Result<Args, String> {
 /// Every frame of the clip, and the support detector settings that suit its source.
 fn read_clip(path: &Path) -> Result<(Vec<HumanFrame>, SupportConfig), String> {
     let clip = Clip::open(path).map_err(|e| e.to_string())?;
-    let support = clip.support_config();
+    let support = SupportConfig::for_capture(clip.capture());
     let frames = clip
         .collect::<Result<Vec<_>, _>>()
         .map_err(|e| e.to_string())?;

@@ -30,6 +30,7 @@ use crate::imitation::imitator::{ImitationError, Imitator, ImitatorConfig};
 use crate::imitation::metrics::{
     EffectorError, ImitationMetrics, MeanMax, MetricsRecorder, Spread,
 };
+use crate::imitation::support::SupportConfig;
 use crate::io::clip::{Clip, ClipError};
 use crate::model::ModelError;
 use crate::robots::{BipedProfile, nao};
@@ -102,7 +103,7 @@ pub struct BatchOptions {
     /// Worker threads; 0 means one per core. Ignored (always 1) without the `parallel` feature.
     pub threads: usize,
     /// Imitator settings shared by every clip, except `support`, which each clip replaces by the
-    /// defaults of its kind of source ([`Clip::support_config`]: optical mocap or Kinect).
+    /// defaults of its kind of source ([`SupportConfig::for_capture`] of [`Clip::capture`]: optical mocap or Kinect).
     pub imitator: ImitatorConfig,
 }
 
@@ -306,7 +307,7 @@ pub fn retarget_clip(
         source,
     })?;
     let config = ImitatorConfig {
-        support: source.support_config(),
+        support: SupportConfig::for_capture(source.capture()),
         ..config.clone()
     };
     let mut imitator = Imitator::new(robot, config).map_err(|source| BatchError::Imitation {

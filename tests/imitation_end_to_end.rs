@@ -14,6 +14,7 @@ use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
 use taskstack::imitation::metrics::{ImitationMetrics, MetricsRecorder};
 use taskstack::imitation::phase::SupportPhase;
 use taskstack::imitation::shaping::MotionLimits;
+use taskstack::imitation::support::SupportConfig;
 use taskstack::io::clip::Clip;
 use taskstack::robots::nao;
 
@@ -56,7 +57,7 @@ fn run_held(
 ) -> (ImitationMetrics, Vec<SupportPhase>) {
     let mut clip = Clip::open(clip_path(name)).unwrap();
     let config = ImitatorConfig {
-        support: clip.support_config(),
+        support: SupportConfig::for_capture(clip.capture()),
         ..config
     };
     let mut imitator = Imitator::new(nao::profile(), config).unwrap();
@@ -276,7 +277,7 @@ fn overridden_tables_are_solved_and_reported_whole() {
     ] {
         let mut clip = Clip::open(clip_path(name)).unwrap();
         let config = ImitatorConfig {
-            support: clip.support_config(),
+            support: SupportConfig::for_capture(clip.capture()),
             ..config.clone()
         };
         let mut imitator = Imitator::new(nao::profile(), config).unwrap();

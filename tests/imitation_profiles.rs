@@ -7,6 +7,7 @@
 use taskstack::human::HumanFrame;
 use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
 use taskstack::imitation::metrics::{ImitationMetrics, MetricsRecorder};
+use taskstack::imitation::support::SupportConfig;
 use taskstack::io::clip::Clip;
 use taskstack::robots::{BipedProfile, ProfileError, g1};
 
@@ -17,7 +18,7 @@ const TINY: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/tiny_biped/"
 fn imitate(profile: BipedProfile, clip: &str) -> ImitationMetrics {
     let mut source = Clip::open(format!("{MOCAP}{clip}")).unwrap();
     let config = ImitatorConfig {
-        support: source.support_config(),
+        support: SupportConfig::for_capture(source.capture()),
         ..ImitatorConfig::default()
     };
     let mut imitator = Imitator::new(profile, config).unwrap();

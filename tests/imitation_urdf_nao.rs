@@ -8,6 +8,7 @@ use taskstack::human::HumanFrame;
 use taskstack::human::Side;
 use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
 use taskstack::imitation::phase::SupportPhase;
+use taskstack::imitation::support::SupportConfig;
 use taskstack::io::clip::Clip;
 use taskstack::robots::BipedProfile;
 use taskstack::robots::nao;
@@ -17,7 +18,7 @@ fn run(profile: BipedProfile, clip: &str) -> Vec<(Vec<f64>, SupportPhase)> {
     let path = format!("{}/tests/data/mocap/{clip}", env!("CARGO_MANIFEST_DIR"));
     let mut clip = Clip::open(path).unwrap();
     let config = ImitatorConfig {
-        support: clip.support_config(),
+        support: SupportConfig::for_capture(clip.capture()),
         ..ImitatorConfig::default()
     };
     let mut imitator = Imitator::new(profile, config).unwrap();

@@ -26,6 +26,7 @@ use taskstack::human::HumanFrame;
 use taskstack::human::Side;
 use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
 use taskstack::imitation::metrics::{CONTACT_HEIGHT, EFFECTORS, ImitationMetrics, MetricsRecorder};
+use taskstack::imitation::support::SupportConfig;
 use taskstack::io::clip::Clip;
 use taskstack::robots::{BipedProfile, g1, nao};
 
@@ -114,7 +115,7 @@ fn run(
 ) -> Result<(), Box<dyn std::error::Error>> {
     let mut clip = Clip::open(path)?;
     let config = ImitatorConfig {
-        support: clip.support_config(),
+        support: SupportConfig::for_capture(clip.capture()),
         ..config
     };
     let mut imitator = Imitator::new(profile, config)?;

@@ -193,6 +193,17 @@ impl HumanJoint {
     }
 }
 
+/// The kind of system a motion was captured with. Readers say which (`crate::io::clip::Clip`)
+/// so that consumers can pick thresholds suited to its rate and noise (e.g. the support
+/// detector's `SupportConfig::for_capture`) without the reader knowing about them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum CaptureSystem {
+    /// Marker-based optical motion capture (CMU: 120 Hz, millimetre noise).
+    Optical,
+    /// A depth camera's skeleton tracker (Kinect v2: 30 Hz, centimetre noise).
+    DepthCamera,
+}
+
 /// One instant of human motion: a timestamp and the position of every [`HumanJoint`], each
 /// possibly missing. Fixed-size storage; copying or filling a frame never allocates.
 ///

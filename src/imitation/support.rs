@@ -40,8 +40,7 @@
 
 use nalgebra::{Matrix3, Vector2, Vector3};
 
-use crate::human::HumanFrame;
-use crate::human::Side;
+use crate::human::{CaptureSystem, HumanFrame, Side};
 
 /// Which feet support the human in one frame.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -126,6 +125,15 @@ impl SupportConfig {
             ground_radius: 0.75,
             ground_slope_ridge: 0.05,
             ground_sample_interval: 0.1,
+        }
+    }
+
+    /// The defaults for motion captured with `system`: [`SupportConfig::optical`] or
+    /// [`SupportConfig::kinect`].
+    pub const fn for_capture(system: CaptureSystem) -> Self {
+        match system {
+            CaptureSystem::Optical => Self::optical(),
+            CaptureSystem::DepthCamera => Self::kinect(),
         }
     }
 

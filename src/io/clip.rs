@@ -1,6 +1,6 @@
 //! A motion clip of either supported format, chosen by file extension: `.csv` is a Kinect v2
 //! recording, anything else BVH (CMU conventions: ×0.056444 to metres, Y up, CMU-MB or CMU-MAX
-//! names). Streams frames and says which support-detection defaults suit the source.
+//! names). Streams frames and says which kind of capture system the source is.
 //!
 //! The CMU MotionBuilder-friendly release (CMU-MB names) prepends a synthetic T-pose as frame 0
 //! (`tests/data/mocap/README.md` in the repository); [`Clip`] skips it, so the first frame is captured motion.
@@ -13,8 +13,7 @@ use thiserror::Error;
 
 use super::bvh::{BvhConfig, BvhError, BvhReader, CMU_MB_NAMES};
 use super::kinect::{KinectConfig, KinectError, KinectReader};
-use crate::human::HumanFrame;
-use crate::imitation::support::SupportConfig;
+use crate::human::{CaptureSystem, HumanFrame};
 
 /// Error of either reader.
 #[derive(Debug, Error)]
@@ -36,7 +35,7 @@ enum Source {
 /// A clip being read, one frame at a time.
 pub struct Clip {
     source: Source,
-    support: SupportConfig,
+    capture: CaptureSystem,
 }
 
 impl Clip {
@@ -49,7 +48,7 @@ impl Clip {
         if is_csv {
             return Ok(Self {
                 source: Source::Kinect(KinectReader::open(path, KinectConfig::default())?),
-                support: SupportConfig::kinect(),
+                capture: CaptureSystem::DepthCamera,
             });
         }
         let mut reader = BvhReader::open(path, BvhConfig::cmu())?;
@@ -63,13 +62,14 @@ impl Clip {
         }
         Ok(Self {
             source: Source::Bvh(Box::new(reader)),
-            support: SupportConfig::optical(),
+            capture: CaptureSystem::Optical,
         })
     }
 
-    /// Support-detection defaults for this kind of source (optical mocap or Kinect).
-    pub fn support_config(&self) -> SupportConfig {
-        self.support
+    /// The system the clip was captured with (optical mocap for BVH, a depth camera for Kinect
+    /// CSV), for thresholds that depend on it (`SupportConfig::for_capture`).
+    pub fn capture(&self) -> CaptureSystem {
+        self.capture
     }
 
     /// Reads the next frame into `out`; `Ok(false)` at the end of the clip.
