@@ -1,14 +1,10 @@
 //! The whole `solve` frame on the NAO benchmark problems (`tests/data/bench/problem_*.json`):
 //! targets set + all driver iterations + stop test, warm-started from the previous frame, cycling
-//! through the file's frames. Same code as the `solve` example.
-
-#[path = "../examples/solve/problem.rs"]
-#[allow(dead_code)] // the example uses more of it than the bench
-mod problem;
+//! through the file's frames. Same code as the `solve` example (`taskstack::problem`).
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use problem::{Problem, Runner};
 use std::hint::black_box;
+use taskstack::problem::{Problem, Runner};
 
 fn bench(c: &mut Criterion) {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/bench");

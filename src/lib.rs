@@ -7,6 +7,7 @@ pub mod human;
 pub mod imitation;
 pub mod io;
 pub mod model;
+pub mod problem;
 pub mod robots;
 pub mod solver;
 pub mod tasks;

@@ -3,11 +3,7 @@
 //! the 1e-4 m tolerance; on the stress files the top level holds on every frame while lower levels
 //! give way; no iterate leaves the joint limits.
 
-#[path = "../examples/solve/problem.rs"]
-#[allow(dead_code)]
-mod problem;
-
-use problem::{Problem, Runner};
+use taskstack::problem::{Problem, Runner};
 use taskstack::solver::driver::StopReason;
 
 fn load(name: &str) -> Problem {

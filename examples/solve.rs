@@ -9,12 +9,11 @@
 //! With `--repeats R` the whole run is repeated R times from `q_init`; timing statistics pool all
 //! runs, the per-frame results are the last run's.
 
-mod problem;
-
+use std::collections::BTreeMap;
 use std::process::ExitCode;
 
-use problem::{Problem, Runner, per_task, percentiles};
 use serde_json::json;
+use taskstack::problem::{Problem, Runner};
 use taskstack::solver::driver::StopReason;
 
 fn usage() -> ExitCode {
@@ -28,8 +27,8 @@ fn main() -> ExitCode {
     while let Some(arg) = args.next() {
         match arg.as_str() {
             "--frames" => match args.next().and_then(|v| v.parse().ok()) {
-                Some(n) => frames = Some(n),
-                None => return usage(),
+                Some(n) if n > 0 => frames = Some(n),
+                _ => return usage(),
             },
             "--repeats" => match args.next().and_then(|v| v.parse().ok()) {
                 Some(r) if r > 0 => repeats = r,
@@ -116,4 +115,20 @@ fn run(
     });
     println!("{out}");
     Ok(())
+}
+
+/// Median, 99th percentile and maximum of `values` (sorted in place; not empty).
+fn percentiles(values: &mut [f64]) -> (f64, f64, f64) {
+    values.sort_by(f64::total_cmp);
+    let at = |p: f64| values[((values.len() - 1) as f64 * p).round() as usize];
+    (at(0.5), at(0.99), values[values.len() - 1])
+}
+
+/// Per-task statistics in a JSON object keyed by task name.
+fn per_task(names: &[&str], values: impl Fn(usize) -> f64) -> BTreeMap<String, f64> {
+    names
+        .iter()
+        .enumerate()
+        .map(|(i, n)| (n.to_string(), values(i)))
+        .collect()
 }
