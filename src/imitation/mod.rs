@@ -11,10 +11,14 @@
 //! [`imitator::Imitator`] runs the whole pipeline frame by frame; [`crate::batch`] runs it over
 //! many clips in parallel.
 
+pub mod config;
+pub mod error;
 pub mod footsteps;
 pub mod imitator;
 pub mod metrics;
+pub mod output;
 pub mod phase;
+mod phase_solver;
 pub mod scaler;
 pub mod shaping;
 pub mod support;

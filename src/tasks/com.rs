@@ -44,6 +44,28 @@ impl ComTask {
     }
 }
 
+/// The first `target.len()` (2: the ground projection, or 3) rows of the centre of mass at
+/// `target` (base frame, m): the CoM Jacobian rows into `jacobian` and `e = c* − c(q)` into
+/// `error`, for the forward kinematics in `data`. The rows of [`ComTask`], for task models that
+/// build their own stacks.
+///
+/// # Errors
+/// [`ModelError`] when `data` has no kinematics or the model has no mass.
+pub fn com_rows(
+    model: &Model,
+    data: &ModelData,
+    target: &[f64],
+    jacobian: MatMut<'_, f64>,
+    error: &mut [f64],
+) -> Result<(), ModelError> {
+    model.com_jacobian_rows(data, target.len(), jacobian)?;
+    let c = model.com(data)?;
+    for (r, t) in target.iter().enumerate() {
+        error[r] = t - c[r];
+    }
+    Ok(())
+}
+
 impl Task for ComTask {
     fn name(&self) -> &str {
         "com"
@@ -61,12 +83,13 @@ impl Task for ComTask {
         jacobian: MatMut<'_, f64>,
         error: &mut [f64],
     ) -> Result<(), ModelError> {
-        model.com_jacobian_rows(data, self.rows, jacobian)?;
-        let c = model.com(data)?;
-        for r in 0..self.rows {
-            error[r] = self.target[r] - c[r];
-        }
-        Ok(())
+        com_rows(
+            model,
+            data,
+            &self.target.as_slice()[..self.rows],
+            jacobian,
+            error,
+        )
     }
 
     fn as_any_mut(&mut self) -> &mut dyn Any {

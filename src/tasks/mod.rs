@@ -47,10 +47,10 @@ use thiserror::Error;
 use crate::model::{Model, ModelData, ModelError};
 use crate::solver::{JointBounds, SolverError};
 
-pub use com::ComTask;
-pub use orientation::OrientationTask;
+pub use com::{ComTask, com_rows};
+pub use orientation::{OrientationTask, orientation_rows};
 pub use pose::PoseTask;
-pub use position::PositionTask;
+pub use position::{FramePoint, PositionTask, point_rows};
 pub use posture::PostureTask;
 pub use set::TaskSet;
 

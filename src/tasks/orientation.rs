@@ -39,8 +39,14 @@ impl OrientationTask {
     }
 }
 
-/// The three orientation rows of `frame` toward `target` (see [`OrientationTask`]).
-pub(super) fn orientation_rows(
+/// The three orientation rows of `frame` toward `target` (base frame): the angular-velocity
+/// Jacobian into `jacobian` and the rotation vector `e = log(R* R(q)ᵀ)` (rad) into `error`, for
+/// the forward kinematics in `data`. The rows of [`OrientationTask`], for task models that
+/// build their own stacks.
+///
+/// # Errors
+/// [`ModelError`] when `data` has no kinematics or the frame is not in `model`.
+pub fn orientation_rows(
     model: &Model,
     data: &ModelData,
     frame: FrameId,

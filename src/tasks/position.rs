@@ -8,13 +8,55 @@ use nalgebra::Vector3;
 use super::{Task, TaskError, finite_target};
 use crate::model::{Axis, FrameId, Model, ModelData, ModelError};
 
+/// A point fixed in a frame: the frame and the point's offset from its origin (m, in the frame's
+/// axes).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FramePoint {
+    /// The frame the point moves with.
+    pub frame: FrameId,
+    /// Offset from the frame's origin, in the frame's axes (m).
+    pub offset: Vector3<f64>,
+}
+
+/// The rows of `point` at `target` (base frame, m) on `axes`, in that order: the point's
+/// Jacobian rows (`axes.len() × nv`) into `jacobian` and `e = x* − x(q)` into `error`, for the
+/// forward kinematics in `data`. The rows of [`PositionTask`], for task models that build their
+/// own stacks.
+///
+/// # Errors
+/// [`ModelError`] when `data` has no kinematics or the frame is not in `model`.
+pub fn point_rows(
+    model: &Model,
+    data: &ModelData,
+    point: &FramePoint,
+    axes: &[Axis],
+    target: &Vector3<f64>,
+    mut jacobian: MatMut<'_, f64>,
+    error: &mut [f64],
+) -> Result<(), ModelError> {
+    let FramePoint { frame, offset } = point;
+    let x = model.point_position(data, *frame, offset)?;
+    // All three axes in order: one walk of the chain instead of three.
+    let xyz = axes == [Axis::X, Axis::Y, Axis::Z];
+    if xyz {
+        model.point_jacobian(data, *frame, offset, jacobian.as_mut())?;
+    }
+    for (r, &axis) in axes.iter().enumerate() {
+        if !xyz {
+            let row = jacobian.as_mut().subrows_mut(r, 1);
+            model.point_jacobian_row(data, *frame, offset, axis, row)?;
+        }
+        error[r] = target[axis as usize] - x[axis as usize];
+    }
+    Ok(())
+}
+
 /// A point of a named frame at a target position in the base frame (metres), on all three axes
 /// or on some ([`PositionTask::axes`]): one row per axis, `e = x* − x(q)`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PositionTask {
     name: String,
-    frame: FrameId,
-    offset: Vector3<f64>,
+    point: FramePoint,
     axes: Vec<Axis>,
     /// Target position in the base frame (m); only the constrained axes are read.
     pub target: Vector3<f64>,
@@ -29,8 +71,10 @@ impl PositionTask {
         finite_target(frame, target.as_slice())?;
         Ok(Self {
             name: frame.to_owned(),
-            frame: model.frame_id(frame)?,
-            offset: Vector3::zeros(),
+            point: FramePoint {
+                frame: model.frame_id(frame)?,
+                offset: Vector3::zeros(),
+            },
             axes: vec![Axis::X, Axis::Y, Axis::Z],
             target,
         })
@@ -42,7 +86,7 @@ impl PositionTask {
     /// [`TaskError::NonFiniteTarget`] for a NaN or infinite offset.
     pub fn with_offset(mut self, offset: Vector3<f64>) -> Result<Self, TaskError> {
         finite_target(&self.name, offset.as_slice())?;
-        self.offset = offset;
+        self.point.offset = offset;
         Ok(self)
     }
 
@@ -73,28 +117,18 @@ impl Task for PositionTask {
         model: &Model,
         data: &ModelData,
         _q: &[f64],
-        mut jacobian: MatMut<'_, f64>,
+        jacobian: MatMut<'_, f64>,
         error: &mut [f64],
     ) -> Result<(), ModelError> {
-        let x = model.point_position(data, self.frame, &self.offset)?;
-        // All three axes in order: one walk of the chain instead of three.
-        let xyz = self.axes == [Axis::X, Axis::Y, Axis::Z];
-        if xyz {
-            model.point_jacobian(data, self.frame, &self.offset, jacobian.as_mut())?;
-        }
-        for (r, &axis) in self.axes.iter().enumerate() {
-            if !xyz {
-                model.point_jacobian_row(
-                    data,
-                    self.frame,
-                    &self.offset,
-                    axis,
-                    jacobian.as_mut().subrows_mut(r, 1),
-                )?;
-            }
-            error[r] = self.target[axis as usize] - x[axis as usize];
-        }
-        Ok(())
+        point_rows(
+            model,
+            data,
+            &self.point,
+            &self.axes,
+            &self.target,
+            jacobian,
+            error,
+        )
     }
 
     fn as_any_mut(&mut self) -> &mut dyn Any {

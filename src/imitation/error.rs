@@ -1,0 +1,57 @@
+//! The imitator's error: everything that can go wrong building an [`Imitator`](super::imitator::Imitator)
+//! or stepping it, each part's error wrapped.
+
+use thiserror::Error;
+
+use super::phase::PhaseError;
+use super::scaler::ScaleError;
+use super::support::SupportError;
+use super::tables::TableError;
+use crate::model::ModelError;
+use crate::robots::ProfileError;
+use crate::solver::SolverError;
+
+/// Errors of the imitator.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum ImitationError {
+    /// A model query failed (a frame the tables name is missing from the model, …).
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    /// The solver refused its input.
+    #[error(transparent)]
+    Solver(#[from] SolverError),
+    /// The scaler refused its input.
+    #[error(transparent)]
+    Scale(#[from] ScaleError),
+    /// The robot profile is invalid, or its joint-angle map refused its input.
+    #[error(transparent)]
+    Profile(#[from] ProfileError),
+    /// A task table is invalid.
+    #[error(transparent)]
+    Table(#[from] TableError),
+    /// Invalid phase-machine configuration.
+    #[error(transparent)]
+    Phase(#[from] PhaseError),
+    /// Invalid support-detection configuration.
+    #[error(transparent)]
+    Support(#[from] SupportError),
+    /// A configuration value out of range.
+    #[error("invalid {name} = {value}: {reason}")]
+    InvalidParameter {
+        /// Parameter name.
+        name: &'static str,
+        /// The value.
+        value: f64,
+        /// The valid range.
+        reason: &'static str,
+    },
+    /// Frame times must increase.
+    #[error("frame time {time} s does not follow the previous frame's {previous} s")]
+    TimeGoesBack {
+        /// This frame's time (s).
+        time: f64,
+        /// The previous frame's time (s).
+        previous: f64,
+    },
+}

@@ -1,0 +1,102 @@
+//! What the imitator gives per frame ([`RobotFrame`]).
+
+use nalgebra::{IsometryMatrix3, Vector2, Vector3};
+
+use super::phase::SupportPhase;
+use super::support::HumanSupport;
+use crate::human::{HumanJoint, Side};
+use crate::solver::driver::StopReason;
+use crate::solver::{LevelReport, SolveReport};
+
+/// One robot output frame.
+#[derive(Debug, Clone)]
+pub struct RobotFrame {
+    /// Time of the human frame (s).
+    pub time: f64,
+    /// Joint angles in the model's variable order (rad); names in [`Imitator::variable_names`].
+    pub q: Vec<f64>,
+    /// The human's support at this frame.
+    pub human_support: HumanSupport,
+    /// The robot's phase or transition step.
+    pub phase: SupportPhase,
+    /// The sole the model was rooted at.
+    pub root: Side,
+    /// World placement of the right sole.
+    pub right_sole: IsometryMatrix3<f64>,
+    /// World placement of the left sole.
+    pub left_sole: IsometryMatrix3<f64>,
+    /// Whole-body centre of mass in the world frame (m).
+    pub com: Vector3<f64>,
+    /// Error norm of each task of the phase's table after the step, in stack order (m).
+    pub task_errors: Vec<f64>,
+    /// Number of tasks of this phase (the first entries of `task_errors`).
+    pub task_count: usize,
+    /// Per-level outcome of the last solve (first `level_count` entries).
+    pub levels: Vec<LevelReport>,
+    /// Number of levels of this phase.
+    pub level_count: usize,
+    /// Joints clamped in the last solve (variable indices; first `clamped_count` entries).
+    pub clamped: Vec<usize>,
+    /// Number of clamped joints.
+    pub clamped_count: usize,
+    /// Why the per-frame iteration stopped.
+    pub stop: StopReason,
+    /// The scaled human reference of this frame, in the model root's frame (m): the targets of
+    /// the `Scaled` tasks come from here.
+    pub reference: [Option<Vector3<f64>>; HumanJoint::COUNT],
+    /// World placement of the model root (the support sole) this frame.
+    pub world_t_root: IsometryMatrix3<f64>,
+    /// Wall time of the step (µs): detection, scaling, IK.
+    pub micros: f64,
+    /// Where the human stands: the midpoint of the ankles on the ground plane (human world
+    /// frame, m) and the heading of the hips (rad about z, 0 facing +x); `None` when the frame
+    /// lacks the ankles or hips. Not scaled: see `leg_ratio`.
+    pub human_stance: Option<(Vector2<f64>, f64)>,
+    /// Robot leg length / human leg length, the scale from the human's world to the robot's.
+    pub leg_ratio: f64,
+}
+
+impl RobotFrame {
+    /// The frame before the first step: posture `q` with the right sole at the world origin
+    /// and the left sole at `left_sole`; room for `[tasks, levels]` task errors and level
+    /// reports (the largest table's), so that stepping never allocates.
+    pub(super) fn at_start(
+        q: &[f64],
+        left_sole: IsometryMatrix3<f64>,
+        [tasks, levels]: &[usize; 2],
+    ) -> Self {
+        RobotFrame {
+            time: 0.0,
+            q: q.to_vec(),
+            human_support: HumanSupport::Double,
+            phase: SupportPhase::Double,
+            root: Side::Right,
+            // The world is the right sole's frame at the start.
+            right_sole: IsometryMatrix3::identity(),
+            left_sole,
+            com: Vector3::zeros(),
+            task_errors: vec![0.0; *tasks],
+            task_count: 0,
+            levels: vec![LevelReport::default(); *levels],
+            level_count: 0,
+            clamped: vec![0; q.len()],
+            clamped_count: 0,
+            stop: StopReason::Converged,
+            reference: [None; HumanJoint::COUNT],
+            world_t_root: IsometryMatrix3::identity(),
+            micros: 0.0,
+            human_stance: None,
+            leg_ratio: 1.0,
+        }
+    }
+
+    /// Copies the per-level outcome and the clamped joints of a solve.
+    pub(super) fn record_solve(&mut self, report: &SolveReport) {
+        let levels = report.levels();
+        self.level_count = levels.len().min(self.levels.len());
+        self.levels[..self.level_count].copy_from_slice(&levels[..self.level_count]);
+        let clamped = report.clamped_joints();
+        self.clamped_count = clamped.len().min(self.clamped.len());
+        self.clamped[..self.clamped_count].copy_from_slice(&clamped[..self.clamped_count]);
+    }
+}

@@ -1,0 +1,441 @@
+//! The per-phase solver of the imitator: a phase's task table resolved against the model rooted
+//! at its support sole ([`PhaseSolver`]), and the task model the position-level driver evaluates
+//! at each iteration: the table's rows, written with the ready-made rows of [`crate::tasks`]
+//! toward the frame's shaped references ([`FrameTargets`]), then the gradient tasks.
+
+use faer::{Mat, MatMut};
+use nalgebra::{Rotation3, Vector2, Vector3};
+
+use super::error::ImitationError;
+use super::footsteps::GroundPose;
+use super::tables::{
+    Axes, ComGoal, Gradient, GradientKind, OrientationTarget, PointTarget, Task, TaskTable,
+};
+use crate::human::HumanJoint;
+use crate::model::{Axis, FrameId, Model, ModelData};
+use crate::robots::BipedProfile;
+use crate::solver::driver::{DriverReport, DriverSettings, PositionDriver, TaskModel};
+use crate::solver::{
+    JointBounds, JointLimitAvoidance, JointTracking, Settings, SolveReport, Solver, TaskStack,
+};
+use crate::tasks::{FramePoint, com_rows, orientation_rows, point_rows};
+
+/// A task of a table, resolved against a model: frame, axes, where its rows are.
+#[derive(Debug, Clone)]
+struct ResolvedTask {
+    task: Task,
+    /// The tracked point (the frame's origin for orientation tasks); `None` for the CoM.
+    point: Option<FramePoint>,
+    /// The tracked axes of a point task, in row order (first `rows` entries).
+    axes: [Axis; 3],
+    rows: usize,
+    level: usize,
+    row: usize,
+    /// Height of the point above the ground when its foot is flat (q = 0), m.
+    rest_height: f64,
+    /// Position of the point in the initial posture, root frame (m).
+    standing: Vector3<f64>,
+    /// Held target (the point's position when the step began), m, root frame.
+    held: Vector3<f64>,
+    /// Held heading (yaw of the frame's x axis when the step began), rad, root frame.
+    held_yaw: f64,
+}
+
+/// What the tasks of a phase aim at in one frame, in the model root's frame.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct FrameTargets<'a> {
+    /// The scaled human (m): the targets of the `Scaled` points.
+    pub(super) reference: &'a [Option<Vector3<f64>>; HumanJoint::COUNT],
+    /// The shaped CoM ground projection (m).
+    pub(super) com: Vector2<f64>,
+    /// The shaped swing height (m) that replaces the lift of `Held` targets.
+    pub(super) swing_lift: f64,
+    /// The swing foot's target footprint, while the robot steps.
+    pub(super) footstep: Option<GroundPose>,
+    /// Largest error (m) a task following the scaled human asks for in one iteration.
+    pub(super) tracking_step: f64,
+}
+
+/// The gradient criteria of the imitator, shared by every phase.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Criteria<'a> {
+    pub(super) limits: &'a JointLimitAvoidance,
+    pub(super) tracking: &'a JointTracking,
+}
+
+/// Everything one phase needs: its table resolved, a solver and a driver sized for it.
+#[derive(Debug)]
+pub(super) struct PhaseSolver {
+    pub(super) table: TaskTable,
+    tasks: Vec<ResolvedTask>,
+    solver: Solver,
+    driver: PositionDriver,
+    other_ankle: FrameId,
+    other_sole: FrameId,
+    /// 3 × nv scratch for the orientation rows of 2-row tasks.
+    orientation_rows: Mat<f64>,
+}
+
+/// The tracked axes of `axes` in row order, padded with z.
+fn axis_list(axes: Axes) -> [Axis; 3] {
+    let picked = [(axes.x, Axis::X), (axes.y, Axis::Y), (axes.z, Axis::Z)];
+    let mut out = [Axis::Z; 3];
+    for (slot, (_, a)) in out.iter_mut().zip(picked.iter().filter(|(on, _)| *on)) {
+        *slot = *a;
+    }
+    out
+}
+
+impl PhaseSolver {
+    /// `table` resolved against the profile's model rooted at its support sole; standing targets
+    /// from `initial_q`.
+    pub(super) fn new(
+        table: &TaskTable,
+        profile: &BipedProfile,
+        initial_q: &[f64],
+        settings: Settings,
+    ) -> Result<Self, ImitationError> {
+        table.validate()?;
+        let model = profile.model(table.model_root);
+        let mut rest = model.new_data();
+        model.forward_kinematics(&mut rest, &vec![0.0; model.nv()])?;
+        let mut initial = model.new_data();
+        model.forward_kinematics(&mut initial, initial_q)?;
+        let mut tasks = Vec::new();
+        for (level, l) in table.levels.iter().enumerate() {
+            let mut row = 0;
+            for task in &l.tasks {
+                let (point, axes) = match task {
+                    Task::ComXY(_) => (None, Axes::XY),
+                    Task::Point {
+                        frame,
+                        offset,
+                        axes,
+                        ..
+                    } => (Some((frame, Vector3::from(*offset))), *axes),
+                    Task::Orientation { frame, .. } => (Some((frame, Vector3::zeros())), Axes::XY),
+                };
+                let point = match point {
+                    Some((frame, offset)) => Some(FramePoint {
+                        frame: model.frame_id(frame)?,
+                        offset,
+                    }),
+                    None => None,
+                };
+                let (rest_height, standing) = match &point {
+                    Some(p) => (
+                        model.point_position(&rest, p.frame, &p.offset)?.z,
+                        model.point_position(&initial, p.frame, &p.offset)?,
+                    ),
+                    None => (0.0, Vector3::zeros()),
+                };
+                tasks.push(ResolvedTask {
+                    axes: axis_list(axes),
+                    rows: task.rows(),
+                    task: task.clone(),
+                    point,
+                    level,
+                    row,
+                    rest_height,
+                    standing,
+                    held: Vector3::zeros(),
+                    held_yaw: 0.0,
+                });
+                row += task.rows();
+            }
+        }
+        let solver = Solver::with_settings(&table.shape(model.nv()), settings)?;
+        let driver = PositionDriver::new(&solver, DriverSettings::default())?;
+        let other = profile.foot(table.model_root.other());
+        Ok(Self {
+            table: table.clone(),
+            tasks,
+            solver,
+            driver,
+            other_ankle: model.frame_id(&other.ankle)?,
+            other_sole: model.frame_id(&other.sole)?,
+            orientation_rows: Mat::zeros(3, model.nv()),
+        })
+    }
+
+    /// Number of tasks (entries of the driver's task errors).
+    pub(super) fn task_count(&self) -> usize {
+        self.tasks.len()
+    }
+
+    /// The task names, in stack order.
+    pub(super) fn task_names(&self) -> impl Iterator<Item = String> + '_ {
+        self.tasks.iter().map(|t| t.task.name())
+    }
+
+    /// The last solve's report (levels, clamped joints).
+    pub(super) fn report(&self) -> &SolveReport {
+        self.solver.report()
+    }
+
+    /// At the start of a step: the held targets become the points' current positions and the
+    /// frames' current headings, from the forward kinematics in `data`.
+    pub(super) fn hold(&mut self, data: &ModelData) {
+        for task in &mut self.tasks {
+            if let Some(p) = &task.point {
+                let placement = data.frame_placement(p.frame);
+                task.held = placement.transform_point(&p.offset.into()).coords;
+                let x = placement.rotation * Vector3::x();
+                task.held_yaw = x.y.atan2(x.x);
+            }
+        }
+    }
+
+    /// The lift (m) of the table's held point, the swing foot's, if it has one.
+    pub(super) fn lift(&self) -> Option<f64> {
+        self.tasks.iter().find_map(|t| match t.task {
+            Task::Point {
+                target: PointTarget::Held { lift },
+                ..
+            } => Some(lift),
+            _ => None,
+        })
+    }
+
+    /// The table's CoM goal in the root frame (m), from the forward kinematics in `data`; `None`
+    /// when the table has no CoM task.
+    pub(super) fn com_goal(&self, data: &ModelData) -> Option<Vector2<f64>> {
+        self.tasks.iter().find_map(|t| match t.task {
+            Task::ComXY(goal) => Some(com_goal(goal, data, self.other_ankle, self.other_sole)),
+            _ => None,
+        })
+    }
+
+    /// The CoM task's error in `errors` (stack order, m), 0 without a CoM task.
+    pub(super) fn com_error(&self, errors: &[f64]) -> f64 {
+        let com = self
+            .tasks
+            .iter()
+            .position(|t| matches!(t.task, Task::ComXY(_)));
+        com.and_then(|i| errors.get(i)).copied().unwrap_or(0.0)
+    }
+
+    /// The largest error of an upright-posture task in `errors` (stack order, rad), 0 without one.
+    pub(super) fn posture_error(&self, errors: &[f64]) -> f64 {
+        let upright = |t: &ResolvedTask| {
+            matches!(
+                t.task,
+                Task::Orientation {
+                    target: OrientationTarget::Upright { .. },
+                    ..
+                }
+            )
+        };
+        self.tasks
+            .iter()
+            .zip(errors)
+            .filter(|(t, _)| upright(t))
+            .fold(0.0, |worst: f64, (_, e)| worst.max(*e))
+    }
+
+    /// Runs the driver from `q` (updated in place) with `settings`, the model's forward
+    /// kinematics kept in `data`: after the call `data` holds the final `q`'s.
+    #[allow(clippy::too_many_arguments)] // the frame's inputs, each from a different owner
+    pub(super) fn run(
+        &mut self,
+        model: &Model,
+        data: &mut ModelData,
+        targets: FrameTargets<'_>,
+        criteria: Criteria<'_>,
+        q: &mut [f64],
+        bounds: &JointBounds,
+        settings: DriverSettings,
+    ) -> Result<&DriverReport, ImitationError> {
+        self.driver.set_settings(settings)?;
+        let mut tasks = PhaseTasks {
+            model,
+            data,
+            tasks: &self.tasks,
+            targets,
+            orientation_rows: &mut self.orientation_rows,
+            gradients: &self.table.gradients,
+            criteria,
+        };
+        self.driver.run(&mut self.solver, &mut tasks, q, bounds)
+    }
+}
+
+/// The `TaskModel` of one phase at one frame.
+struct PhaseTasks<'a> {
+    model: &'a Model,
+    data: &'a mut ModelData,
+    tasks: &'a [ResolvedTask],
+    targets: FrameTargets<'a>,
+    orientation_rows: &'a mut Mat<f64>,
+    gradients: &'a [Gradient],
+    criteria: Criteria<'a>,
+}
+
+/// `goal` in the root frame (m), from the current forward kinematics in `data`.
+fn com_goal(
+    goal: ComGoal,
+    data: &ModelData,
+    other_ankle: FrameId,
+    other_sole: FrameId,
+) -> Vector2<f64> {
+    let other = data.frame_placement(other_ankle).translation.vector;
+    let sole = data.frame_placement(other_sole);
+    let on_other = |[x, y]: [f64; 2]| {
+        sole.transform_point(&Vector3::new(x, y, 0.0).into())
+            .coords
+            .xy()
+    };
+    match goal {
+        ComGoal::SupportAnkle => Vector2::zeros(),
+        ComGoal::SupportFootCentre { lambda } => Vector2::new(lambda, 0.0),
+        ComGoal::MidAnkles => other.xy() * 0.5,
+        ComGoal::OtherFootCentre { lambda } => {
+            let forward = sole.rotation * Vector3::x();
+            other.xy() + lambda * forward.xy()
+        }
+        ComGoal::SupportPoint(p) => Vector2::from(p),
+        ComGoal::OtherPoint(p) => on_other(p),
+        ComGoal::BetweenPoints { support, other } => {
+            (Vector2::from(support) + on_other(other)) * 0.5
+        }
+    }
+}
+
+/// Flat (z up) with heading `yaw` (rad about z).
+fn flat(yaw: f64) -> Rotation3<f64> {
+    Rotation3::from_axis_angle(&Vector3::z_axis(), yaw)
+}
+
+impl TaskModel for PhaseTasks<'_> {
+    type Error = ImitationError;
+
+    fn max_task_error(&self, task: usize) -> Option<f64> {
+        let follows_human = matches!(
+            self.tasks.get(task)?.task,
+            Task::Point {
+                target: PointTarget::Scaled(_),
+                ..
+            }
+        );
+        follows_human.then_some(self.targets.tracking_step)
+    }
+
+    fn evaluate(&mut self, q: &[f64], stack: &mut TaskStack) -> Result<(), ImitationError> {
+        self.model.forward_kinematics(self.data, q)?;
+        for task in self.tasks {
+            let mut level = stack.level_mut(task.level);
+            let (jacobian, target) = level.rows_mut(task.row, task.rows);
+            self.write(task, jacobian, target)?;
+        }
+        stack.clear_gradient();
+        for g in self.gradients {
+            match g.kind {
+                GradientKind::JointLimits => {
+                    stack.add_gradient(g.kappa, self.criteria.limits, q)?
+                }
+                GradientKind::HumanJoints => {
+                    stack.add_gradient(g.kappa, self.criteria.tracking, q)?
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+impl PhaseTasks<'_> {
+    /// The Jacobian rows and error of `task`.
+    fn write(
+        &mut self,
+        task: &ResolvedTask,
+        jacobian: MatMut<'_, f64>,
+        error: &mut [f64],
+    ) -> Result<(), ImitationError> {
+        let (model, data) = (self.model, &*self.data);
+        let Some(point) = &task.point else {
+            let com = self.targets.com;
+            return Ok(com_rows(model, data, &[com.x, com.y], jacobian, error)?);
+        };
+        match task.task {
+            Task::Point { target, .. } => {
+                let goal = self.point_goal(task, target, point)?;
+                let axes = &task.axes[..task.rows];
+                point_rows(model, data, point, axes, &goal, jacobian, error)?;
+            }
+            Task::Orientation {
+                target: OrientationTarget::HeldFlat,
+                ..
+            } => orientation_rows(
+                model,
+                data,
+                point.frame,
+                &flat(task.held_yaw),
+                jacobian,
+                error,
+            )?,
+            Task::Orientation {
+                target: OrientationTarget::Footstep,
+                ..
+            } => {
+                let yaw = self.targets.footstep.map_or(task.held_yaw, |f| f.yaw);
+                orientation_rows(model, data, point.frame, &flat(yaw), jacobian, error)?;
+            }
+            Task::Orientation {
+                target: OrientationTarget::Upright { lean },
+                ..
+            } => self.upright_rows(point.frame, lean, jacobian, error)?,
+            Task::ComXY(_) => unreachable!("a CoM task has no point"),
+        }
+        Ok(())
+    }
+
+    /// Two rows turning the frame's z axis onto the vertical leaned by `lean` rad about x (toward
+    /// +y for lean > 0): the horizontal rows of the angular-velocity Jacobian, and the horizontal
+    /// part of the rotation vector `z × up` (rad, small-angle).
+    fn upright_rows(
+        &mut self,
+        frame: FrameId,
+        lean: f64,
+        mut jacobian: MatMut<'_, f64>,
+        error: &mut [f64],
+    ) -> Result<(), ImitationError> {
+        let rows = self.orientation_rows.as_mut();
+        self.model.orientation_jacobian(self.data, frame, rows)?;
+        jacobian.copy_from(self.orientation_rows.as_ref().subrows(0, 2));
+        let up = Vector3::new(0.0, lean.sin(), lean.cos());
+        let rotation = &self.data.frame_placement(frame).rotation;
+        let tilt = (rotation * Vector3::z()).cross(&up);
+        error[..2].copy_from_slice(&[tilt.x, tilt.y]);
+        Ok(())
+    }
+
+    /// Where a point task's point goes this frame (root frame, m).
+    fn point_goal(
+        &self,
+        task: &ResolvedTask,
+        target: PointTarget,
+        point: &FramePoint,
+    ) -> Result<Vector3<f64>, ImitationError> {
+        let targets = &self.targets;
+        Ok(match target {
+            // Missing references (never after the scaler) hold the current position.
+            PointTarget::Scaled(joint) => match targets.reference[joint.index()] {
+                Some(p) => p,
+                None => self
+                    .model
+                    .point_position(self.data, point.frame, &point.offset)?,
+            },
+            // A lifted or lowered foot follows the shaped swing height; a foot on the ground
+            // (lift 0 outside a landing) has swing height 0.
+            PointTarget::Held { .. } => Vector3::new(
+                task.held.x,
+                task.held.y,
+                task.rest_height + targets.swing_lift,
+            ),
+            PointTarget::Standing { lower } => task.standing - Vector3::z() * lower,
+            PointTarget::Footstep { lift } => {
+                let xy = targets.footstep.map_or(task.held.xy(), |f| f.xy);
+                Vector3::new(xy.x, xy.y, task.rest_height + lift)
+            }
+        })
+    }
+}
