@@ -32,7 +32,6 @@ use crate::imitation::metrics::{
 };
 use crate::imitation::support::SupportConfig;
 use crate::io::clip::{Clip, ClipError};
-use crate::model::ModelError;
 use crate::robots::{BipedProfile, nao};
 
 /// Errors of a batch or of one of its clips. Each names the clip file.
@@ -56,16 +55,6 @@ pub enum BatchError {
         frame: usize,
         /// The imitator's error.
         source: ImitationError,
-    },
-    /// The metrics of a frame could not be computed.
-    #[error("{}: frame {frame}: metrics: {source}", path.display())]
-    Metrics {
-        /// The clip file.
-        path: PathBuf,
-        /// Index of the frame.
-        frame: usize,
-        /// The model's error.
-        source: ModelError,
     },
     /// Reading a folder or writing an output file failed.
     #[error("{}: {source}", path.display())]
@@ -341,15 +330,7 @@ pub fn retarget_clip(
             let _ = write!(joints, ",{q:.6}");
         }
         joints.push('\n');
-        // `record` borrows the imitator too: the frame is read again through a second borrow.
-        let robot = robot.clone();
-        recorder
-            .record(&imitator, &robot)
-            .map_err(|source| BatchError::Metrics {
-                path: path(),
-                frame: index,
-                source,
-            })?;
+        recorder.record(robot);
         index += 1;
     }
     let metrics = recorder.finish();

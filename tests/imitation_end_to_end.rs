@@ -73,7 +73,7 @@ fn run_held(
             r.time
         );
         assert!(r.com.iter().all(|c| c.is_finite()));
-        recorder.record(imitator, &r).unwrap();
+        recorder.record(&r);
         phases.push(r.phase);
     };
     while clip.read_frame(&mut frame).unwrap() {

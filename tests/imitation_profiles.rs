@@ -27,7 +27,7 @@ fn imitate(profile: BipedProfile, clip: &str) -> ImitationMetrics {
     while source.read_frame(&mut frame).unwrap() {
         let r = imitator.step(&frame).unwrap().clone();
         assert!(r.q.iter().all(|q| q.is_finite()), "{clip} at {} s", r.time);
-        recorder.record(&imitator, &r).unwrap();
+        recorder.record(&r);
     }
     recorder.finish()
 }

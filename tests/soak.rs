@@ -234,7 +234,7 @@ fn soak(clips: &[Vec<HumanFrame>], passes: usize) -> Soak {
                 for q in &r.q {
                     hasher.write_u64(q.to_bits());
                 }
-                recorder.record(&imitator, &r).unwrap();
+                recorder.record(&r);
                 previous = Some(r);
                 out.frames += 1;
             }

@@ -123,14 +123,9 @@ fn run(
     let names: Vec<String> = imitator.variable_names().map(str::to_owned).collect();
     let mut joints = format!("time,{}\n", names.join(","));
     let mut samples = Vec::new();
-    // The plotted effectors (role names of EFFECTORS) and their robot frames.
     let profile = imitator.profile().clone();
-    let plotted = ["l_hand", "r_hand", "l_ankle"];
-    let frames = [
-        profile.hands[0].as_str(),
-        profile.hands[1].as_str(),
-        profile.foot(Side::Left).ankle.as_str(),
-    ];
+    // The plotted effectors: the first three of EFFECTORS (hands, left ankle).
+    let plotted: Vec<&str> = EFFECTORS[..3].iter().map(|(name, _)| *name).collect();
     let mut frame = HumanFrame::new(0.0);
     let mut last: Option<HumanFrame> = None;
     let mut end = f64::INFINITY;
@@ -151,8 +146,7 @@ fn run(
             frame = *held;
         }
         let r = imitator.step(&frame)?;
-        let r = r.clone();
-        recorder.record(&imitator, &r)?;
+        recorder.record(r);
         let _ = write!(joints, "{:.6}", r.time);
         for q in &r.q {
             let _ = write!(joints, ",{q:.6}");
@@ -160,27 +154,17 @@ fn run(
         joints.push('\n');
 
         // World positions for the plots.
-        let model = profile.model(r.root);
-        let mut data = model.new_data();
-        model.forward_kinematics(&mut data, &r.q)?;
-        let world = |p: nalgebra::Vector3<f64>| {
-            let w = r.world_t_root.transform_point(&p.into());
+        let world = |p: &nalgebra::Vector3<f64>| {
+            let w = r.world_t_root.transform_point(&(*p).into());
             [w.x, w.y, w.z]
         };
-        let effectors = plotted
+        let effectors = EFFECTORS[..plotted.len()]
             .iter()
-            .zip(frames)
-            .map(|(name, frame)| {
-                let joint = EFFECTORS.iter().find(|(n, _)| n == name).map(|(_, j)| *j);
-                let robot = world(
-                    data.frame_placement(model.frame_id(frame)?)
-                        .translation
-                        .vector,
-                );
-                let reference = joint.and_then(|j| r.reference[j.index()]).map(world);
-                Ok((robot, reference))
+            .zip(&r.effectors)
+            .map(|((_, joint), robot)| {
+                (world(robot), r.reference[joint.index()].as_ref().map(world))
             })
-            .collect::<Result<Vec<_>, taskstack::model::ModelError>>()?;
+            .collect();
         let footprints = [(Side::Right, r.right_sole), (Side::Left, r.left_sole)]
             .into_iter()
             .filter_map(|(foot, sole)| {

@@ -43,7 +43,7 @@ use crate::solver::{JointBounds, JointLimitAvoidance, JointTracking, Settings, S
 
 pub use super::config::ImitatorConfig;
 pub use super::error::ImitationError;
-pub use super::output::RobotFrame;
+pub use super::output::{EFFECTORS, RobotFrame};
 
 /// The online imitator.
 pub struct Imitator {
@@ -52,6 +52,8 @@ pub struct Imitator {
     data: [ModelData; 2],
     /// The sole frames of each model, resolved once: `soles[root][foot]`.
     soles: [[FrameId; 2]; 2],
+    /// The frames of [`EFFECTORS`] in each model: `effectors[root]`.
+    effectors: [[FrameId; 4]; 2],
     phases: Vec<PhaseSolver>,
     detector: SupportDetector,
     scaler: Scaler,
@@ -159,6 +161,24 @@ fn sole_frames(profile: &BipedProfile) -> Result<[[FrameId; 2]; 2], ModelError> 
     Ok([sole_ids(Side::Left)?, sole_ids(Side::Right)?])
 }
 
+/// The frames of [`EFFECTORS`] (hands, ankles) in the model rooted at each sole: `[root]`.
+fn effector_frames(profile: &BipedProfile) -> Result<[[FrameId; 4]; 2], ModelError> {
+    let [left_hand, right_hand] = &profile.hands;
+    let [left_ankle, right_ankle] = profile.feet.each_ref().map(|f| f.ankle.as_str());
+    let names = [
+        left_hand.as_str(),
+        right_hand.as_str(),
+        left_ankle,
+        right_ankle,
+    ];
+    let ids = |root: Side| -> Result<[FrameId; 4], ModelError> {
+        let model = profile.model(root);
+        let [a, b, c, d] = names.map(|name| model.frame_id(name));
+        Ok([a?, b?, c?, d?])
+    };
+    Ok([ids(Side::Left)?, ids(Side::Right)?])
+}
+
 /// A solver per phase (in [`SupportPhase::ALL`] order) for `tables`.
 fn phase_solvers(
     tables: &TaskTables,
@@ -204,6 +224,7 @@ impl Imitator {
         let angles = profile.joint_angles.map(|build| build(model)).transpose()?;
         let mut data = profile.models.each_ref().map(Model::new_data);
         let soles = sole_frames(&profile)?;
+        let effectors = effector_frames(&profile)?;
         let right = Side::Right.index();
         model.forward_kinematics(&mut data[right], &q)?;
         let left_sole = *data[right].frame_placement(soles[right][Side::Left.index()]);
@@ -231,6 +252,7 @@ impl Imitator {
             phases,
             data,
             soles,
+            effectors,
             q,
             root: Side::Right,
             world_t_root: IsometryMatrix3::identity(),
@@ -512,6 +534,10 @@ impl Imitator {
         out.human_support = human;
         out.human_stance = human_stance(frame);
         out.leg_ratio = self.scaler.leg_ratio();
+        for (position, &id) in out.effectors.iter_mut().zip(&self.effectors[root]) {
+            *position = data.frame_placement(id).translation.vector;
+        }
+        out.pending_steps = self.footsteps.steps_pending();
         out.phase = phase;
         out.root = self.root;
         out.world_t_root = world_t_root;

@@ -24,9 +24,9 @@ use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 use super::imitator::{Imitator, RobotFrame};
 use super::phase::SupportPhase;
 use super::support::HumanSupport;
+use super::tables::{PointTarget, Task};
 use super::travel::{HandTrace, Stance, StepCounter, Travel, TravelRecorder, robot_stance};
-use crate::human::HumanJoint;
-use crate::model::{ModelData, ModelError};
+use crate::solver::JointBounds;
 
 /// A foot is on the ground when its outline points are at most this high (m).
 pub const CONTACT_HEIGHT: f64 = 1e-3;
@@ -101,14 +101,7 @@ impl Series {
     }
 }
 
-/// The effectors whose tracking is measured, by role name (the keys of the metrics; the robot
-/// frames are the profile's hands and ankles), with the human joint their reference comes from.
-pub const EFFECTORS: [(&str, HumanJoint); 4] = [
-    ("l_hand", HumanJoint::LHand),
-    ("r_hand", HumanJoint::RHand),
-    ("l_ankle", HumanJoint::LAnkle),
-    ("r_ankle", HumanJoint::RAnkle),
-];
+pub use super::output::EFFECTORS;
 
 /// Tracking error of one effector.
 #[derive(Debug, Clone, PartialEq)]
@@ -182,11 +175,13 @@ pub struct ImitationMetrics {
 }
 
 /// Accumulates [`ImitationMetrics`] frame by frame.
+#[derive(Debug, Clone)]
 pub struct MetricsRecorder {
-    /// Forward kinematics of the model rooted at each sole (`[left, right]`).
-    data: [ModelData; 2],
-    /// The robot frames of [`EFFECTORS`], in that order.
-    effector_frames: [String; 4],
+    /// Per phase ([`SupportPhase::index`]), whether its table tracks each of [`EFFECTORS`]
+    /// toward the scaled human.
+    tracked: [[bool; 4]; SupportPhase::COUNT],
+    /// The imitator's joint bounds (position and velocity).
+    bounds: JointBounds,
     /// The contact area of each foot (`[left, right]`, sole frame, m).
     outlines: [Vec<[f64; 2]>; 2],
     /// Scratch: the grounded corners of this frame (world xy, m).
@@ -314,14 +309,32 @@ fn rotation_angle(r: &nalgebra::Rotation3<f64>) -> f64 {
 }
 
 impl MetricsRecorder {
-    /// A recorder for the runs of `imitator`.
+    /// A recorder for the runs of `imitator`: its tables (which effectors each phase tracks),
+    /// joint bounds and feet are read once here.
     pub fn new(imitator: &Imitator) -> Self {
         let profile = imitator.profile();
-        let [lh, rh] = profile.hands.clone();
-        let [la, ra] = profile.feet.each_ref().map(|f| f.ankle.clone());
+        let [lh, rh] = &profile.hands;
+        let [la, ra] = profile.feet.each_ref().map(|f| &f.ankle);
+        let frames = [lh, rh, la, ra];
+        let tracked = SupportPhase::ALL.map(|phase| {
+            let tasks: Vec<&Task> = imitator
+                .table(phase)
+                .levels
+                .iter()
+                .flat_map(|l| &l.tasks)
+                .collect();
+            let mut tracked = [false; 4];
+            for (t, ((_, joint), name)) in tracked.iter_mut().zip(EFFECTORS.iter().zip(frames)) {
+                *t = tasks.iter().any(|task| {
+                    matches!(task, Task::Point { frame, target: PointTarget::Scaled(j), .. }
+                        if frame == name && j == joint)
+                });
+            }
+            tracked
+        });
         Self {
-            data: profile.models.each_ref().map(crate::model::Model::new_data),
-            effector_frames: [lh, rh, la, ra],
+            tracked,
+            bounds: imitator.bounds().clone(),
             outlines: profile.feet.each_ref().map(|f| f.outline.clone()),
             points: Vec::new(),
             frames: 0,
@@ -362,55 +375,73 @@ impl MetricsRecorder {
     }
 
     /// Records one frame, as returned by [`Imitator::step`].
-    pub fn record(&mut self, imitator: &Imitator, frame: &RobotFrame) -> Result<(), ModelError> {
-        let root_model = imitator.profile().model(frame.root);
-        let data = &mut self.data[frame.root.index()];
-        root_model.forward_kinematics(data, &frame.q)?;
+    pub fn record(&mut self, frame: &RobotFrame) {
+        self.record_tracking(frame);
+        if !self.travel.clip_ended() {
+            self.trace_hands(frame);
+        }
+        self.record_balance(frame);
+        self.record_limits(frame);
+        let standing = standing_feet(frame.phase);
+        self.record_slip(frame, standing);
 
-        // Tracking, against the references of the tasks this phase tracks.
-        let table = imitator.table(frame.phase);
+        // Travel and steps.
+        let human = frame
+            .human_stance
+            .map(|(point, heading)| Stance { point, heading });
+        let robot = robot_stance(&frame.right_sole, &frame.left_sole);
+        let double = frame.phase == SupportPhase::Double;
+        self.travel
+            .record(human, frame.leg_ratio, robot, double, frame.time);
+        let human_off = frame.human_support != HumanSupport::Double;
+        self.human_steps.record(human_off, frame.time);
+        self.robot_steps
+            .record(!(standing[0] && standing[1]), frame.time);
+        self.pending = frame.pending_steps;
+
+        self.record_supports(frame);
+        self.first_time.get_or_insert(frame.time);
+        self.last_time = frame.time;
+        self.last_q.clear();
+        self.last_q.extend_from_slice(&frame.q);
+        self.times.push(frame.micros);
+        self.frames += 1;
+    }
+
+    /// Tracking errors of the effectors the phase tracks, against their scaled references.
+    fn record_tracking(&mut self, frame: &RobotFrame) {
         let single = matches!(frame.phase, SupportPhase::Right | SupportPhase::Left);
         let double = frame.phase == SupportPhase::Double;
-        for (e, ((_, joint), name)) in EFFECTORS.iter().zip(&self.effector_frames).enumerate() {
-            let tracked = table.levels.iter().flat_map(|l| &l.tasks).any(|t| {
-                matches!(t, super::tables::Task::Point { frame: f, target: super::tables::PointTarget::Scaled(j), .. }
-                    if f == name && j == joint)
-            });
-            if !tracked || !(single || double) {
-                continue;
-            }
-            let (Some(reference), Ok(id)) =
-                (frame.reference[joint.index()], root_model.frame_id(name))
-            else {
+        if !(single || double) {
+            return;
+        }
+        let tracked = self.tracked[frame.phase.index()];
+        let in_clip = !self.travel.clip_ended();
+        let (all, clip) = match single {
+            true => (&mut self.single, &mut self.single_clip),
+            false => (&mut self.double, &mut self.double_clip),
+        };
+        for (e, (_, joint)) in EFFECTORS.iter().enumerate() {
+            let Some(reference) = frame.reference[joint.index()].filter(|_| tracked[e]) else {
                 continue;
             };
-            let error = (data.frame_placement(id).translation.vector - reference).norm();
-            let in_clip = !self.travel.clip_ended();
-            let (all, clip) = if single {
-                (&mut self.single, &mut self.single_clip)
-            } else {
-                (&mut self.double, &mut self.double_clip)
-            };
+            let error = (frame.effectors[e] - reference).norm();
             all[e].push(error);
             if in_clip {
                 clip[e].push(error);
             }
         }
-        if !self.travel.clip_ended() {
-            self.trace_hands(root_model, frame)?;
-        }
+    }
 
-        // Support polygon from the feet on the ground (world frame = root frame moved by
-        // world_t_root; heights are the same since the root sole is on the floor).
+    /// The CoM's margin inside the support polygon of the feet on the ground (world frame =
+    /// root frame moved by `world_t_root`; heights are the same since the root sole is on the
+    /// floor).
+    fn record_balance(&mut self, frame: &RobotFrame) {
         self.points.clear();
-        for (outline, sole) in self
-            .outlines
-            .iter()
-            .zip([&frame.left_sole, &frame.right_sole])
-        {
+        let soles = [&frame.left_sole, &frame.right_sole];
+        for (outline, sole) in self.outlines.iter().zip(soles) {
             let corner = |&[x, y]: &[f64; 2]| sole.transform_point(&Vector3::new(x, y, 0.0).into());
-            let grounded = outline.iter().all(|c| corner(c).z.abs() <= CONTACT_HEIGHT);
-            if grounded {
+            if outline.iter().all(|c| corner(c).z.abs() <= CONTACT_HEIGHT) {
                 self.points
                     .extend(outline.iter().map(|c| corner(c).xy().coords));
             }
@@ -420,9 +451,11 @@ impl MetricsRecorder {
         if margin < 0.0 {
             self.outside += 1;
         }
+    }
 
-        // Limits.
-        let bounds = imitator.bounds();
+    /// Joint-limit and velocity-limit violations.
+    fn record_limits(&mut self, frame: &RobotFrame) {
+        let bounds = &self.bounds;
         for (i, &q) in frame.q.iter().enumerate() {
             if q < bounds.lower()[i] || q > bounds.upper()[i] || !q.is_finite() {
                 self.joint_violations += 1;
@@ -437,10 +470,11 @@ impl MetricsRecorder {
                 }
             }
         }
+    }
 
-        // Slip of the standing feet: how far each moved since its stance began.
+    /// Slip of the `standing` feet: how far each moved since its stance began.
+    fn record_slip(&mut self, frame: &RobotFrame, standing: [bool; 2]) {
         let placement = [frame.left_sole, frame.right_sole];
-        let standing = standing_feet(frame.phase);
         for foot in 0..2 {
             if !standing[foot] {
                 self.anchors[foot] = None;
@@ -458,22 +492,10 @@ impl MetricsRecorder {
             *max_slip = max_slip.max(slip);
             *max_turn = max_turn.max(turn);
         }
+    }
 
-        // Travel and steps.
-        let human = frame
-            .human_stance
-            .map(|(point, heading)| Stance { point, heading });
-        let robot = robot_stance(&frame.right_sole, &frame.left_sole);
-        let double = frame.phase == SupportPhase::Double;
-        self.travel
-            .record(human, frame.leg_ratio, robot, double, frame.time);
-        let human_off = frame.human_support != HumanSupport::Double;
-        self.human_steps.record(human_off, frame.time);
-        self.robot_steps
-            .record(!(standing[0] && standing[1]), frame.time);
-        self.pending = imitator.pending_steps();
-
-        // Support changes and transitions.
+    /// Changes of the human's support and of the robot's continuous phase; transition times.
+    fn record_supports(&mut self, frame: &RobotFrame) {
         if frame.human_support != HumanSupport::Airborne {
             if self.last_human.is_some_and(|h| h != frame.human_support) {
                 self.human_changes += 1;
@@ -491,53 +513,25 @@ impl MetricsRecorder {
             self.sequence.extend(origin);
         }
         match continuous_name(frame.phase) {
-            Some(name) => {
-                if self.sequence.last() != Some(&name) {
-                    self.sequence.push(name);
-                    if let Some(start) = self.transition_start.take() {
-                        self.transitions.push(frame.time - start);
-                    }
+            Some(name) if self.sequence.last() != Some(&name) => {
+                self.sequence.push(name);
+                if let Some(start) = self.transition_start.take() {
+                    self.transitions.push(frame.time - start);
                 }
             }
+            Some(_) => {}
             None => {
-                if self.transition_start.is_none() {
-                    self.transition_start = Some(self.last_time);
-                }
+                self.transition_start.get_or_insert(self.last_time);
             }
         }
-
-        self.first_time.get_or_insert(frame.time);
-        self.last_time = frame.time;
-        self.last_q.clear();
-        self.last_q.extend_from_slice(&frame.q);
-        self.times.push(frame.micros);
-        self.frames += 1;
-        Ok(())
     }
 
     /// Adds this frame's hands and their references (world frame) to the lag trace.
-    fn trace_hands(
-        &mut self,
-        model: &crate::model::Model,
-        frame: &RobotFrame,
-    ) -> Result<(), ModelError> {
-        let data = &self.data[frame.root.index()];
-        let mut robot = [Vector3::zeros(); 2];
-        let mut reference = [None; 2];
-        for (h, ((_, joint), name)) in EFFECTORS
-            .iter()
-            .zip(&self.effector_frames)
-            .take(2)
-            .enumerate()
-        {
-            let placement = data.frame_placement(model.frame_id(name)?);
-            robot[h] = frame
-                .world_t_root
-                .transform_point(&placement.translation.vector.into())
-                .coords;
-            reference[h] = frame.reference[joint.index()]
-                .map(|p| frame.world_t_root.transform_point(&p.into()).coords);
-        }
+    fn trace_hands(&mut self, frame: &RobotFrame) {
+        let world = |p: &Vector3<f64>| frame.world_t_root.transform_point(&(*p).into()).coords;
+        let robot = [world(&frame.effectors[0]), world(&frame.effectors[1])];
+        let reference = [EFFECTORS[0].1, EFFECTORS[1].1]
+            .map(|joint| frame.reference[joint.index()].as_ref().map(world));
         let kind = match frame.phase {
             SupportPhase::Right | SupportPhase::Left => 1,
             SupportPhase::Double => 2,
@@ -545,7 +539,6 @@ impl MetricsRecorder {
         };
         self.hands.times.push(frame.time);
         self.hands.samples.push((robot, reference, kind));
-        Ok(())
     }
 
     /// The metrics of the frames recorded so far.

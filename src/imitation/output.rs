@@ -8,6 +8,16 @@ use crate::human::{HumanJoint, Side};
 use crate::solver::driver::StopReason;
 use crate::solver::{LevelReport, SolveReport};
 
+/// The effectors whose positions each [`RobotFrame`] reports and whose tracking the metrics
+/// measure, by role name (the robot frames are the profile's hands and feet's ankles), with the
+/// human joint their reference comes from: the order of [`RobotFrame::effectors`].
+pub const EFFECTORS: [(&str, HumanJoint); 4] = [
+    ("l_hand", HumanJoint::LHand),
+    ("r_hand", HumanJoint::RHand),
+    ("l_ankle", HumanJoint::LAnkle),
+    ("r_ankle", HumanJoint::RAnkle),
+];
+
 /// One robot output frame.
 #[derive(Debug, Clone)]
 pub struct RobotFrame {
@@ -54,6 +64,13 @@ pub struct RobotFrame {
     pub human_stance: Option<(Vector2<f64>, f64)>,
     /// Robot leg length / human leg length, the scale from the human's world to the robot's.
     pub leg_ratio: f64,
+    /// Positions of the robot's hands and ankles (the frames of the profile's `hands` and of its
+    /// feet's `ankle`) in the model root's frame (m), in [`EFFECTORS`] order: compare with
+    /// `reference` of the same human joint.
+    pub effectors: [Vector3<f64>; 4],
+    /// Feet not on their targets after this frame: the steps the robot still has to take
+    /// (0, 1 or 2).
+    pub pending_steps: usize,
 }
 
 impl RobotFrame {
@@ -87,6 +104,8 @@ impl RobotFrame {
             micros: 0.0,
             human_stance: None,
             leg_ratio: 1.0,
+            effectors: [Vector3::zeros(); 4],
+            pending_steps: 0,
         }
     }
 
