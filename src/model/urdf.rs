@@ -357,7 +357,50 @@ fn check_joint(joint: &urdf_rs::Joint) -> Result<Checked, UrdfError> {
     })
 }
 
+/// Builds the model of `robot` under `options`: checks links and joints, resolves which joints
+/// are variables, walks the tree from the root folding rigidly attached links into bodies, and
+/// adds the frames.
 fn build(robot: &urdf_rs::Robot, options: &UrdfOptions) -> Result<Model, UrdfError> {
+    let link_index = check_links(robot)?;
+    let graph = JointGraph::of(robot, &link_index)?;
+    let drives = resolve_drives(robot, &graph.checked, &graph.joint_index, options)?;
+    let (variables, drives) = number_variables(robot, drives, options)?;
+    let root = match &options.root_link {
+        Some(name) => *link_index
+            .get(name.as_str())
+            .ok_or_else(|| UrdfError::UnknownRootLink(name.clone()))?,
+        None => graph.only_root()?,
+    };
+    let walk = walk_tree(robot, &graph, &drives, root)?;
+    let mut joints = walk.joints;
+    let masses = fold_masses(robot, &walk.bodies, &walk.placed);
+    let body_link = |b: usize| Link {
+        name: robot.links[walk.bodies[b]].name.clone(),
+        mass: masses.mass[b],
+        com: masses.com[b],
+        inertia: Some(masses.inertia[b]),
+    };
+    for (k, joint) in joints.iter_mut().enumerate() {
+        joint.link = body_link(k + 1);
+    }
+    let frames = frame_specs(robot, options, &link_index, &walk.bodies, &walk.placed)?;
+    let spec = TreeSpec {
+        name: robot.name.clone(),
+        base: body_link(0),
+        variables,
+        joints,
+        frames,
+    };
+    // Links, joints and variables were checked above and the walk only emits a tree, so in
+    // practice only duplicate frame names reach this point; every issue still maps to its name.
+    spec.clone()
+        .build()
+        .map_err(|issue| tree_issue_error(&spec, issue))
+}
+
+/// Every link's index by name, after checking names are unique and inertial values are finite
+/// with a non-negative mass.
+fn check_links(robot: &urdf_rs::Robot) -> Result<HashMap<&str, usize>, UrdfError> {
     let mut link_index: HashMap<&str, usize> = HashMap::new();
     for (i, link) in robot.links.iter().enumerate() {
         if link_index.insert(link.name.as_str(), i).is_some() {
@@ -372,77 +415,103 @@ fn build(robot: &urdf_rs::Robot, options: &UrdfOptions) -> Result<Model, UrdfErr
                 mass: inertial.mass.value,
             });
         }
-        finite(
-            || format!("link `{name}` inertial origin"),
-            &inertial.origin.xyz.0,
-        )?;
-        finite(
-            || format!("link `{name}` inertial origin"),
-            &inertial.origin.rpy.0,
-        )?;
+        let origin = || format!("link `{name}` inertial origin");
+        finite(origin, &inertial.origin.xyz.0)?;
+        finite(origin, &inertial.origin.rpy.0)?;
         let i = &inertial.inertia;
-        finite(
-            || format!("link `{name}` inertia"),
-            &[i.ixx, i.ixy, i.ixz, i.iyy, i.iyz, i.izz],
-        )?;
+        let values = [i.ixx, i.ixy, i.ixz, i.iyy, i.iyz, i.izz];
+        finite(|| format!("link `{name}` inertia"), &values)?;
     }
-    let mut joint_index: HashMap<&str, usize> = HashMap::new();
-    let mut parent_joint: Vec<Option<usize>> = vec![None; robot.links.len()];
-    let mut ends = Vec::with_capacity(robot.joints.len());
-    let mut checked = Vec::with_capacity(robot.joints.len());
-    for (j, joint) in robot.joints.iter().enumerate() {
-        if joint_index.insert(joint.name.as_str(), j).is_some() {
-            return Err(UrdfError::DuplicateJoint(joint.name.clone()));
-        }
-        let find = |link: &str| {
-            link_index
-                .get(link)
-                .copied()
-                .ok_or_else(|| UrdfError::UnknownJointLink {
-                    joint: joint.name.clone(),
-                    link: link.to_owned(),
-                })
+    Ok(link_index)
+}
+
+/// The joints of a URDF as a graph over its links, each joint checked.
+struct JointGraph<'r> {
+    joint_index: HashMap<&'r str, usize>,
+    /// The joint whose child each link is, if any.
+    parent_joint: Vec<Option<usize>>,
+    /// (parent link, child link) of each joint.
+    ends: Vec<(usize, usize)>,
+    checked: Vec<Checked>,
+}
+
+impl<'r> JointGraph<'r> {
+    fn of(robot: &'r urdf_rs::Robot, link_index: &HashMap<&str, usize>) -> Result<Self, UrdfError> {
+        let mut graph = JointGraph {
+            joint_index: HashMap::new(),
+            parent_joint: vec![None; robot.links.len()],
+            ends: Vec::with_capacity(robot.joints.len()),
+            checked: Vec::with_capacity(robot.joints.len()),
         };
-        let (parent, child) = (find(&joint.parent.link)?, find(&joint.child.link)?);
-        if let Some(first) = parent_joint[child].replace(j) {
-            return Err(UrdfError::TwoParents {
-                link: joint.child.link.clone(),
-                first: robot.joints[first].name.clone(),
-                second: joint.name.clone(),
-            });
+        for (j, joint) in robot.joints.iter().enumerate() {
+            if graph.joint_index.insert(joint.name.as_str(), j).is_some() {
+                return Err(UrdfError::DuplicateJoint(joint.name.clone()));
+            }
+            let find = |link: &str| {
+                link_index
+                    .get(link)
+                    .copied()
+                    .ok_or_else(|| UrdfError::UnknownJointLink {
+                        joint: joint.name.clone(),
+                        link: link.to_owned(),
+                    })
+            };
+            let (parent, child) = (find(&joint.parent.link)?, find(&joint.child.link)?);
+            if let Some(first) = graph.parent_joint[child].replace(j) {
+                return Err(UrdfError::TwoParents {
+                    link: joint.child.link.clone(),
+                    first: robot.joints[first].name.clone(),
+                    second: joint.name.clone(),
+                });
+            }
+            graph.ends.push((parent, child));
+            graph.checked.push(check_joint(joint)?);
         }
-        ends.push((parent, child));
-        checked.push(check_joint(joint)?);
+        Ok(graph)
     }
 
-    let drives = resolve_drives(robot, &checked, &joint_index, options)?;
-    let (variables, drives) = number_variables(robot, drives, options)?;
-
-    let root = match &options.root_link {
-        Some(name) => *link_index
-            .get(name.as_str())
-            .ok_or_else(|| UrdfError::UnknownRootLink(name.clone()))?,
-        None => {
-            let roots: Vec<usize> = (0..robot.links.len())
-                .filter(|&l| parent_joint[l].is_none())
-                .collect();
-            match roots[..] {
-                [r] => r,
-                _ => return Err(UrdfError::NoUniqueRoot(roots.len())),
-            }
+    /// The one link that is no joint's child.
+    fn only_root(&self) -> Result<usize, UrdfError> {
+        let roots: Vec<usize> = (0..self.parent_joint.len())
+            .filter(|&l| self.parent_joint[l].is_none())
+            .collect();
+        match roots[..] {
+            [r] => Ok(r),
+            _ => Err(UrdfError::NoUniqueRoot(roots.len())),
         }
-    };
+    }
+}
 
-    // Walk the undirected link graph from the root. Per URDF link: its body (the model link it is
-    // rigidly part of, by index into `bodies`) and the placement of its URDF frame in that body.
+/// The tree of bodies found by walking the link graph from the root.
+struct TreeWalk {
+    /// The URDF link that names each body (body 0 is the root).
+    bodies: Vec<usize>,
+    /// The joint of each body after the root, its link still massless.
+    joints: Vec<JointSpec>,
+    /// Per URDF link: its body and the placement of the link's frame in that body.
+    placed: Vec<(usize, IsometryMatrix3<f64>)>,
+}
+
+/// Walks the undirected link graph from `root`: a joint driven by a variable starts a new body
+/// (its direction reversed when walked from child to parent), a locked or fixed one folds its
+/// far link into the near body.
+fn walk_tree(
+    robot: &urdf_rs::Robot,
+    graph: &JointGraph<'_>,
+    drives: &[Drive],
+    root: usize,
+) -> Result<TreeWalk, UrdfError> {
     let mut adjacent: Vec<Vec<usize>> = vec![Vec::new(); robot.links.len()];
-    for (j, &(p, c)) in ends.iter().enumerate() {
+    for (j, &(p, c)) in graph.ends.iter().enumerate() {
         adjacent[p].push(j);
         adjacent[c].push(j);
     }
     let mut body_of: Vec<Option<(usize, IsometryMatrix3<f64>)>> = vec![None; robot.links.len()];
-    let mut bodies: Vec<usize> = vec![root]; // URDF link that names each body
-    let mut joints: Vec<JointSpec> = Vec::new();
+    let mut walk = TreeWalk {
+        bodies: vec![root],
+        joints: Vec::new(),
+        placed: Vec::with_capacity(robot.links.len()),
+    };
     body_of[root] = Some((0, IsometryMatrix3::identity()));
     let mut stack = vec![root];
     let mut used_joint = vec![false; robot.joints.len()];
@@ -454,65 +523,105 @@ fn build(robot: &urdf_rs::Robot, options: &UrdfOptions) -> Result<Model, UrdfErr
             if std::mem::replace(&mut used_joint[j], true) {
                 continue;
             }
-            let (p, c) = ends[j];
+            let (p, c) = graph.ends[j];
             let forward = p == u;
             let v = if forward { c } else { p };
             if body_of[v].is_some() {
                 return Err(UrdfError::NotATree(robot.links[v].name.clone()));
             }
-            let Checked { kind, axis, origin } = &checked[j];
-            let placed = match drives[j] {
-                Drive::Locked(value) => {
-                    let u_t_v = origin * motion(*kind, axis, value);
-                    let u_t_v = if forward { u_t_v } else { u_t_v.inverse() };
-                    (body, body_t_u * u_t_v)
-                }
-                Drive::Variable {
-                    variable,
-                    multiplier,
-                    offset,
-                } => {
-                    let sign = if forward { 1.0 } else { -1.0 };
-                    joints.push(JointSpec {
-                        name: robot.joints[j].name.clone(),
-                        antecedent: robot.links[bodies[body]].name.clone(),
-                        link: Link {
-                            name: robot.links[v].name.clone(),
-                            mass: 0.0,
-                            com: Vector3::zeros(),
-                            inertia: None,
-                        },
-                        placement: if forward { body_t_u * origin } else { body_t_u },
-                        axis: *axis,
-                        kind: *kind,
-                        variable: Some(variable),
-                        multiplier: sign * multiplier,
-                        offset: sign * offset,
-                    });
-                    bodies.push(v);
-                    let new_t_v = if forward {
-                        IsometryMatrix3::identity()
-                    } else {
-                        origin.inverse()
-                    };
-                    (bodies.len() - 1, new_t_v)
-                }
-            };
+            let placed = walk.cross(
+                robot,
+                j,
+                &graph.checked[j],
+                drives[j],
+                (body, body_t_u),
+                v,
+                forward,
+            );
             body_of[v] = Some(placed);
             stack.push(v);
         }
     }
-    let mut placed_links = Vec::with_capacity(robot.links.len());
     for (link, placed) in robot.links.iter().zip(&body_of) {
-        placed_links.push(placed.ok_or_else(|| UrdfError::NotATree(link.name.clone()))?);
+        walk.placed
+            .push(placed.ok_or_else(|| UrdfError::NotATree(link.name.clone()))?);
     }
+    Ok(walk)
+}
 
-    // Masses folded into bodies: m = Σ m_k, c = Σ m_k c_k / m (body frame), and the inertia about
-    // c by the parallel-axis theorem: I = Σ R_k I_k R_kᵀ + m_k (|d_k|² 1 − d_k d_kᵀ), d_k = c_k − c.
+impl TreeWalk {
+    /// Crosses joint `j` from the link placed at `(body, body_t_u)` to link `v` (`forward`:
+    /// from the joint's parent to its child): returns `v`'s body and placement in it.
+    #[allow(clippy::too_many_arguments)] // one step of the walk: the joint and both of its sides
+    fn cross(
+        &mut self,
+        robot: &urdf_rs::Robot,
+        j: usize,
+        checked: &Checked,
+        drive: Drive,
+        (body, body_t_u): (usize, IsometryMatrix3<f64>),
+        v: usize,
+        forward: bool,
+    ) -> (usize, IsometryMatrix3<f64>) {
+        let Checked { kind, axis, origin } = checked;
+        let (variable, multiplier, offset) = match drive {
+            Drive::Locked(value) => {
+                let u_t_v = origin * motion(*kind, axis, value);
+                let u_t_v = if forward { u_t_v } else { u_t_v.inverse() };
+                return (body, body_t_u * u_t_v);
+            }
+            Drive::Variable {
+                variable,
+                multiplier,
+                offset,
+            } => (variable, multiplier, offset),
+        };
+        let sign = if forward { 1.0 } else { -1.0 };
+        self.joints.push(JointSpec {
+            name: robot.joints[j].name.clone(),
+            antecedent: robot.links[self.bodies[body]].name.clone(),
+            link: Link {
+                name: robot.links[v].name.clone(),
+                mass: 0.0,
+                com: Vector3::zeros(),
+                inertia: None,
+            },
+            placement: if forward { body_t_u * origin } else { body_t_u },
+            axis: *axis,
+            kind: *kind,
+            variable: Some(variable),
+            multiplier: sign * multiplier,
+            offset: sign * offset,
+        });
+        self.bodies.push(v);
+        let new_t_v = if forward {
+            IsometryMatrix3::identity()
+        } else {
+            origin.inverse()
+        };
+        (self.bodies.len() - 1, new_t_v)
+    }
+}
+
+/// Mass, centre of mass and inertia about it of each body (body frame).
+struct BodyMasses {
+    mass: Vec<f64>,
+    com: Vec<Vector3<f64>>,
+    inertia: Vec<Matrix3<f64>>,
+}
+
+/// The links' masses folded into their bodies: m = Σ m_k, c = Σ m_k c_k / m (body frame), and the
+/// inertia about c by the parallel-axis theorem: I = Σ R_k I_k R_kᵀ + m_k (|d_k|² 1 − d_k d_kᵀ),
+/// d_k = c_k − c.
+fn fold_masses(
+    robot: &urdf_rs::Robot,
+    bodies: &[usize],
+    placed: &[(usize, IsometryMatrix3<f64>)],
+) -> BodyMasses {
     let mut mass = vec![0.0; bodies.len()];
     let mut moment = vec![Vector3::zeros(); bodies.len()];
     let mut com_of_link = Vec::with_capacity(robot.links.len());
-    for (link, &(body, body_t_link)) in robot.links.iter().zip(&placed_links) {
+    for (link, &(body, body_t_link)) in robot.links.iter().zip(placed) {
         let m = link.inertial.mass.value;
         let c = body_t_link.transform_point(&Vector3::from(link.inertial.origin.xyz.0).into());
         mass[body] += m;
@@ -520,17 +629,13 @@ fn build(robot: &urdf_rs::Robot, options: &UrdfOptions) -> Result<Model, UrdfErr
         com_of_link.push(c.coords);
     }
     let com: Vec<Vector3<f64>> = (0..bodies.len())
-        .map(|b| {
-            if mass[b] > 0.0 {
-                moment[b] / mass[b]
-            } else {
-                Vector3::zeros()
-            }
+        .map(|b| match mass[b] > 0.0 {
+            true => moment[b] / mass[b],
+            false => Vector3::zeros(),
         })
         .collect();
     let mut inertia = vec![Matrix3::zeros(); bodies.len()];
-    for ((link, &(body, body_t_link)), c) in robot.links.iter().zip(&placed_links).zip(&com_of_link)
-    {
+    for ((link, &(body, body_t_link)), c) in robot.links.iter().zip(placed).zip(&com_of_link) {
         let i = &link.inertial.inertia;
         let own = Matrix3::new(
             i.ixx, i.ixy, i.ixz, //
@@ -543,19 +648,21 @@ fn build(robot: &urdf_rs::Robot, options: &UrdfOptions) -> Result<Model, UrdfErr
             + (Matrix3::identity() * d.norm_squared() - d * d.transpose())
                 * link.inertial.mass.value;
     }
-    let body_link = |b: usize| Link {
-        name: robot.links[bodies[b]].name.clone(),
-        mass: mass[b],
-        com: com[b],
-        inertia: Some(inertia[b]),
-    };
-    for (k, joint) in joints.iter_mut().enumerate() {
-        joint.link = body_link(k + 1);
-    }
+    BodyMasses { mass, com, inertia }
+}
 
+/// The named frames: every URDF link's (with `options.link_frames`) and the extra frames of
+/// `options`, each on its body.
+fn frame_specs(
+    robot: &urdf_rs::Robot,
+    options: &UrdfOptions,
+    link_index: &HashMap<&str, usize>,
+    bodies: &[usize],
+    placed: &[(usize, IsometryMatrix3<f64>)],
+) -> Result<Vec<FrameSpec>, UrdfError> {
     let mut frames = Vec::new();
     if options.link_frames {
-        for (link, &(body, body_t_link)) in robot.links.iter().zip(&placed_links) {
+        for (link, &(body, body_t_link)) in robot.links.iter().zip(placed) {
             frames.push(FrameSpec {
                 name: link.name.clone(),
                 link: robot.links[bodies[body]].name.clone(),
@@ -566,7 +673,7 @@ fn build(robot: &urdf_rs::Robot, options: &UrdfOptions) -> Result<Model, UrdfErr
     for frame in &options.frames {
         let &(body, body_t_link) = link_index
             .get(frame.link.as_str())
-            .map(|&l| &placed_links[l])
+            .map(|&l| &placed[l])
             .ok_or_else(|| UrdfError::UnknownFrameLink {
                 frame: frame.name.clone(),
                 link: frame.link.clone(),
@@ -577,17 +684,12 @@ fn build(robot: &urdf_rs::Robot, options: &UrdfOptions) -> Result<Model, UrdfErr
             placement: body_t_link * frame.placement,
         });
     }
+    Ok(frames)
+}
 
-    let spec = TreeSpec {
-        name: robot.name.clone(),
-        base: body_link(0),
-        variables,
-        joints,
-        frames,
-    };
-    // Links, joints and variables were checked above and the walk only emits a tree, so in
-    // practice only duplicate frame names reach this point; every issue still maps to its name.
-    spec.clone().build().map_err(|issue| match issue {
+/// The URDF error naming what a tree-building issue of `spec` is about.
+fn tree_issue_error(spec: &TreeSpec, issue: TreeIssue) -> UrdfError {
+    match issue {
         TreeIssue::DuplicateFrame(i) => UrdfError::DuplicateFrame(spec.frames[i].name.clone()),
         TreeIssue::UnknownFrameLink(i) => UrdfError::UnknownFrameLink {
             frame: spec.frames[i].name.clone(),
@@ -601,7 +703,7 @@ fn build(robot: &urdf_rs::Robot, options: &UrdfOptions) -> Result<Model, UrdfErr
         TreeIssue::DuplicateVariable(i) | TreeIssue::UnusedVariable(i) => {
             UrdfError::UnknownVariable(spec.variables[i].name.clone())
         }
-    })
+    }
 }
 
 /// Per joint: locked value or (for now) the index of the free URDF joint that drives it.
