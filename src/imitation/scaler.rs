@@ -58,7 +58,7 @@ use thiserror::Error;
 
 use super::support::HumanSupport;
 use crate::human::{HumanFrame, HumanJoint, SegmentDirections, Side};
-use crate::model::{Model, ModelError};
+use crate::model::{Model, ModelData, ModelError};
 use crate::robots::{BipedProfile, FootArea, RobotPoint, SolePlacement};
 
 const COUNT: usize = HumanJoint::COUNT;
@@ -120,6 +120,40 @@ pub struct RobotSkeleton {
     leg_length: f64,
 }
 
+/// The position (m, model root frame) of each mapped human joint's robot point, for the forward
+/// kinematics in `data`. Errors: unknown frames, a joint mapped twice, a leg joint or MidHip
+/// unmapped.
+fn reference_points(
+    model: &Model,
+    data: &ModelData,
+    points: &[(HumanJoint, RobotPoint)],
+) -> Result<[Option<Vector3<f64>>; COUNT], ScaleError> {
+    let origin = |name: &str| -> Result<Vector3<f64>, ModelError> {
+        Ok(data
+            .frame_placement(model.frame_id(name)?)
+            .translation
+            .vector)
+    };
+    let mut reference = [None; COUNT];
+    for (joint, point) in points {
+        let joint = *joint;
+        if reference[joint.index()].is_some() {
+            return Err(ScaleError::DuplicateJoint(joint.name()));
+        }
+        reference[joint.index()] = Some(match point {
+            RobotPoint::Frame(a) => origin(a)?,
+            RobotPoint::Midpoint(a, b) => (origin(a)? + origin(b)?) * 0.5,
+        });
+    }
+    use HumanJoint::*;
+    for joint in [MidHip, LHip, RHip, LKnee, RKnee, LAnkle, RAnkle] {
+        if reference[joint.index()].is_none() {
+            return Err(ScaleError::MissingJoint(joint.name()));
+        }
+    }
+    Ok(reference)
+}
+
 impl RobotSkeleton {
     /// Measures `model` at `q_reference` (one value per variable, radians) with the map
     /// `points` (human joint → robot point) and the sole frames `soles` (`[left, right]`).
@@ -133,29 +167,8 @@ impl RobotSkeleton {
     ) -> Result<Self, ScaleError> {
         let mut data = model.new_data();
         model.forward_kinematics(&mut data, q_reference)?;
-        let origin = |name: &str| -> Result<Vector3<f64>, ModelError> {
-            Ok(data
-                .frame_placement(model.frame_id(name)?)
-                .translation
-                .vector)
-        };
-        let mut reference = [None; COUNT];
-        for (joint, point) in points {
-            let joint = *joint;
-            if reference[joint.index()].is_some() {
-                return Err(ScaleError::DuplicateJoint(joint.name()));
-            }
-            reference[joint.index()] = Some(match point {
-                RobotPoint::Frame(a) => origin(a)?,
-                RobotPoint::Midpoint(a, b) => (origin(a)? + origin(b)?) * 0.5,
-            });
-        }
+        let reference = reference_points(model, &data, points)?;
         use HumanJoint::*;
-        for joint in [MidHip, LHip, RHip, LKnee, RKnee, LAnkle, RAnkle] {
-            if reference[joint.index()].is_none() {
-                return Err(ScaleError::MissingJoint(joint.name()));
-            }
-        }
         let point = |j: HumanJoint| reference[j.index()].unwrap_or_else(Vector3::zeros);
 
         let mut antecedent = [None; COUNT];
@@ -474,6 +487,8 @@ impl Scaler {
 
     /// Scales one human frame for the human's `support` phase (`Airborne`: keep the last stance;
     /// double support before any). Error: the frame time is not finite.
+    // Kept as one pass (~95 lines): eq. 1 places the stance leg backwards from the support
+    // ankle, then every other joint forwards from MidHip; the order of placement is the method.
     pub fn scale(
         &mut self,
         frame: &HumanFrame,

@@ -437,6 +437,8 @@ fn human_ankle(foot: Side) -> HumanJoint {
 impl TaskTable {
     /// The paper's table for `phase` (Table I with the corrections in the module docs), with λ
     /// and ρ from `config`.
+    // One function on purpose (~100 lines): each `match` arm below is one row of Table I, and the
+    // table reads top to bottom like the paper's; split up, the rows would no longer line up.
     pub fn paper(phase: SupportPhase, config: &PhaseConfig, profile: &BipedProfile) -> Self {
         let root = phase.model_root();
         let free = root.other();
@@ -641,6 +643,7 @@ impl TaskTable {
     ///   the leg cannot reach leaves the foot short of it, never dragging on the floor.
     ///
     /// The gradients are the paper's.
+    // One function on purpose (~95 lines), for the same reason as `paper`: one arm per table row.
     pub fn executable(phase: SupportPhase, config: &PhaseConfig, profile: &BipedProfile) -> Self {
         let root = phase.model_root();
         let free = root.other();

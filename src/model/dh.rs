@@ -173,6 +173,103 @@ struct Loader<'a> {
     origin: &'a str,
 }
 
+/// The `[units]` table: metres, radians, kilograms.
+fn check_units(units: &Row<'_>) -> Result<(), DhError> {
+    units.allow(&["length", "angle", "mass"])?;
+    for (field, expected) in [("length", "m"), ("angle", "rad"), ("mass", "kg")] {
+        let got = units.string(field)?;
+        if got != expected {
+            let problem = DhProblem::WrongUnit {
+                expected,
+                got: got.to_owned(),
+            };
+            return Err(units.err(field, problem));
+        }
+    }
+    Ok(())
+}
+
+/// A `[[variables]]` row.
+fn variable(row: &Row<'_>) -> Result<Variable, DhError> {
+    row.allow(&["name", "lower", "upper", "velocity"])?;
+    let (lower, upper) = (row.number("lower")?, row.number("upper")?);
+    if lower > upper {
+        return Err(row.err("upper", DhProblem::LowerAboveUpper { lower, upper }));
+    }
+    Ok(Variable {
+        name: row.string("name")?.to_owned(),
+        lower,
+        upper,
+        velocity: row.mass("velocity")?,
+    })
+}
+
+/// A `[[frames]]` row.
+fn frame(row: &Row<'_>) -> Result<FrameSpec, DhError> {
+    row.allow(&["name", "link", "position", "rpy"])?;
+    let rpy = row.opt_vec3("rpy")?.unwrap_or_else(Vector3::zeros);
+    Ok(FrameSpec {
+        name: row.string("name")?.to_owned(),
+        link: row.string("link")?.to_owned(),
+        placement: IsometryMatrix3::from_parts(
+            Translation3::from(row.vec3("position")?),
+            Rotation3::from_euler_angles(rpy.x, rpy.y, rpy.z),
+        ),
+    })
+}
+
+/// The error naming the row and field of a tree-building issue of `spec`, whose variables,
+/// joints and frames came from `rows`.
+fn tree_issue_error(
+    spec: &TreeSpec,
+    [variables, joints, frames]: &[Vec<Row<'_>>; 3],
+    issue: TreeIssue,
+) -> DhError {
+    let (row, field, problem) = match issue {
+        TreeIssue::DuplicateVariable(i) => (
+            &variables[i],
+            "name",
+            DhProblem::Duplicate(spec.variables[i].name.clone()),
+        ),
+        TreeIssue::UnusedVariable(i) => (
+            &variables[i],
+            "name",
+            DhProblem::UnusedVariable(spec.variables[i].name.clone()),
+        ),
+        TreeIssue::DuplicateJoint(i) => (
+            &joints[i],
+            "name",
+            DhProblem::Duplicate(spec.joints[i].name.clone()),
+        ),
+        TreeIssue::DuplicateLink(i) => (
+            &joints[i],
+            "link",
+            DhProblem::Duplicate(spec.joints[i].link.name.clone()),
+        ),
+        TreeIssue::UnknownAntecedent(i) => (
+            &joints[i],
+            "antecedent",
+            DhProblem::UnknownAntecedent(spec.joints[i].antecedent.clone()),
+        ),
+        TreeIssue::Cycle(i) => (
+            &joints[i],
+            "antecedent",
+            DhProblem::Cycle(spec.joints[i].antecedent.clone()),
+        ),
+        TreeIssue::DuplicateFrame(i) => (
+            &frames[i],
+            "name",
+            DhProblem::Duplicate(spec.frames[i].name.clone()),
+        ),
+        TreeIssue::UnknownFrameLink(i) => (
+            &frames[i],
+            "link",
+            DhProblem::UnknownLink(spec.frames[i].link.clone()),
+        ),
+    };
+    row.err(field, problem)
+}
+
 /// One TOML table being read, with its place for error messages.
 struct Row<'a> {
     origin: &'a str,
@@ -201,20 +298,7 @@ impl Loader<'_> {
             return Err(top.err("format", DhProblem::WrongFormat(format.to_owned())));
         }
         let name = top.opt_string("name")?.unwrap_or("").to_owned();
-        let units = top.sub_table("units")?;
-        units.allow(&["length", "angle", "mass"])?;
-        for (field, expected) in [("length", "m"), ("angle", "rad"), ("mass", "kg")] {
-            let got = units.string(field)?;
-            if got != expected {
-                return Err(units.err(
-                    field,
-                    DhProblem::WrongUnit {
-                        expected,
-                        got: got.to_owned(),
-                    },
-                ));
-            }
-        }
+        check_units(&top.sub_table("units")?)?;
         let base_row = top.sub_table("base")?;
         base_row.allow(&["link", "mass", "com"])?;
         let base = Link {
@@ -223,44 +307,20 @@ impl Loader<'_> {
             com: base_row.vec3("com")?,
             inertia: None,
         };
-
-        let variable_rows = top.rows("variables")?;
-        let mut variables = Vec::with_capacity(variable_rows.len());
-        for row in &variable_rows {
-            row.allow(&["name", "lower", "upper", "velocity"])?;
-            let (lower, upper) = (row.number("lower")?, row.number("upper")?);
-            if lower > upper {
-                return Err(row.err("upper", DhProblem::LowerAboveUpper { lower, upper }));
-            }
-            variables.push(Variable {
-                name: row.string("name")?.to_owned(),
-                lower,
-                upper,
-                velocity: row.mass("velocity")?,
-            });
-        }
-
-        let joint_rows = top.rows("joints")?;
-        let mut joints = Vec::with_capacity(joint_rows.len());
-        for row in &joint_rows {
-            joints.push(self.joint(row, &variables)?);
-        }
-
-        let frame_rows = top.rows("frames")?;
-        let mut frames = Vec::with_capacity(frame_rows.len());
-        for row in &frame_rows {
-            row.allow(&["name", "link", "position", "rpy"])?;
-            let rpy = row.opt_vec3("rpy")?.unwrap_or_else(Vector3::zeros);
-            frames.push(FrameSpec {
-                name: row.string("name")?.to_owned(),
-                link: row.string("link")?.to_owned(),
-                placement: IsometryMatrix3::from_parts(
-                    Translation3::from(row.vec3("position")?),
-                    Rotation3::from_euler_angles(rpy.x, rpy.y, rpy.z),
-                ),
-            });
-        }
-
+        let rows = [
+            top.rows("variables")?,
+            top.rows("joints")?,
+            top.rows("frames")?,
+        ];
+        let variables = rows[0]
+            .iter()
+            .map(variable)
+            .collect::<Result<Vec<_>, _>>()?;
+        let joints = rows[1]
+            .iter()
+            .map(|row| self.joint(row, &variables))
+            .collect::<Result<_, _>>()?;
+        let frames = rows[2].iter().map(frame).collect::<Result<_, _>>()?;
         let spec = TreeSpec {
             name,
             base,
@@ -268,51 +328,9 @@ impl Loader<'_> {
             joints,
             frames,
         };
-        spec.clone().build().map_err(|issue| {
-            let (row, field, problem) = match issue {
-                TreeIssue::DuplicateVariable(i) => (
-                    &variable_rows[i],
-                    "name",
-                    DhProblem::Duplicate(spec.variables[i].name.clone()),
-                ),
-                TreeIssue::UnusedVariable(i) => (
-                    &variable_rows[i],
-                    "name",
-                    DhProblem::UnusedVariable(spec.variables[i].name.clone()),
-                ),
-                TreeIssue::DuplicateJoint(i) => (
-                    &joint_rows[i],
-                    "name",
-                    DhProblem::Duplicate(spec.joints[i].name.clone()),
-                ),
-                TreeIssue::DuplicateLink(i) => (
-                    &joint_rows[i],
-                    "link",
-                    DhProblem::Duplicate(spec.joints[i].link.name.clone()),
-                ),
-                TreeIssue::UnknownAntecedent(i) => (
-                    &joint_rows[i],
-                    "antecedent",
-                    DhProblem::UnknownAntecedent(spec.joints[i].antecedent.clone()),
-                ),
-                TreeIssue::Cycle(i) => (
-                    &joint_rows[i],
-                    "antecedent",
-                    DhProblem::Cycle(spec.joints[i].antecedent.clone()),
-                ),
-                TreeIssue::DuplicateFrame(i) => (
-                    &frame_rows[i],
-                    "name",
-                    DhProblem::Duplicate(spec.frames[i].name.clone()),
-                ),
-                TreeIssue::UnknownFrameLink(i) => (
-                    &frame_rows[i],
-                    "link",
-                    DhProblem::UnknownLink(spec.frames[i].link.clone()),
-                ),
-            };
-            row.err(field, problem)
-        })
+        spec.clone()
+            .build()
+            .map_err(|issue| tree_issue_error(&spec, &rows, issue))
     }
 
     fn joint(&self, row: &Row<'_>, variables: &[Variable]) -> Result<JointSpec, DhError> {

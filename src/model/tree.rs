@@ -69,43 +69,7 @@ impl TreeSpec {
             .map_or(Ok(()), |i| Err(TreeIssue::DuplicateVariable(i)))?;
         first_duplicate(joints.iter().map(|j| j.name.as_str()))
             .map_or(Ok(()), |i| Err(TreeIssue::DuplicateJoint(i)))?;
-        // Link name → the row that defines it (None: the base).
-        let mut link_row: HashMap<&str, Option<usize>> = HashMap::new();
-        link_row.insert(base.name.as_str(), None);
-        for (row, j) in joints.iter().enumerate() {
-            if link_row.insert(j.link.name.as_str(), Some(row)).is_some() {
-                return Err(TreeIssue::DuplicateLink(row));
-            }
-        }
-        // Children of the base (key None) and of each row's link, in row order.
-        let mut children: HashMap<Option<usize>, Vec<usize>> = HashMap::new();
-        let mut parent_row = Vec::with_capacity(joints.len());
-        for (row, j) in joints.iter().enumerate() {
-            let parent = *link_row
-                .get(j.antecedent.as_str())
-                .ok_or(TreeIssue::UnknownAntecedent(row))?;
-            children.entry(parent).or_default().push(row);
-            parent_row.push(parent);
-        }
-        drop(link_row);
-        // Depth-first preorder from the base: parents before children, subtrees contiguous.
-        let mut order: Vec<usize> = Vec::with_capacity(joints.len());
-        let mut stack: Vec<usize> = children.get(&None).cloned().unwrap_or_default();
-        stack.reverse();
-        while let Some(row) = stack.pop() {
-            order.push(row);
-            if let Some(kids) = children.get(&Some(row)) {
-                stack.extend(kids.iter().rev());
-            }
-        }
-        if order.len() < joints.len() {
-            let mut seen = vec![false; joints.len()];
-            for &r in &order {
-                seen[r] = true;
-            }
-            let row = seen.iter().position(|s| !s).unwrap_or(0);
-            return Err(TreeIssue::Cycle(row));
-        }
+        let (order, parent_row) = preorder(&base, &joints)?;
         let mut used = vec![false; variables.len()];
         for j in &joints {
             if let Some(v) = j.variable {
@@ -142,20 +106,7 @@ impl TreeSpec {
                 offset: spec.offset,
             });
         }
-        first_duplicate(frames.iter().map(|f| f.name.as_str()))
-            .map_or(Ok(()), |i| Err(TreeIssue::DuplicateFrame(i)))?;
-        let mut model_frames = Vec::with_capacity(frames.len());
-        for (row, f) in frames.into_iter().enumerate() {
-            let link = links
-                .iter()
-                .position(|l| l.name == f.link)
-                .ok_or(TreeIssue::UnknownFrameLink(row))?;
-            model_frames.push(Frame {
-                name: f.name,
-                link,
-                placement: f.placement,
-            });
-        }
+        let model_frames = attach_frames(frames, &links)?;
         Ok(Model::assemble(
             name,
             links,
@@ -164,6 +115,72 @@ impl TreeSpec {
             model_frames,
         ))
     }
+}
+
+/// The joint rows in depth-first preorder from the base (parents before children, subtrees
+/// contiguous), and the row defining each row's parent link (`None`: the base).
+fn preorder(
+    base: &Link,
+    joints: &[JointSpec],
+) -> Result<(Vec<usize>, Vec<Option<usize>>), TreeIssue> {
+    // Link name → the row that defines it (None: the base).
+    let mut link_row: HashMap<&str, Option<usize>> = HashMap::new();
+    link_row.insert(base.name.as_str(), None);
+    for (row, j) in joints.iter().enumerate() {
+        if link_row.insert(j.link.name.as_str(), Some(row)).is_some() {
+            return Err(TreeIssue::DuplicateLink(row));
+        }
+    }
+    // Children of the base (key None) and of each row's link, in row order.
+    let mut children: HashMap<Option<usize>, Vec<usize>> = HashMap::new();
+    let mut parent_row = Vec::with_capacity(joints.len());
+    for (row, j) in joints.iter().enumerate() {
+        let parent = *link_row
+            .get(j.antecedent.as_str())
+            .ok_or(TreeIssue::UnknownAntecedent(row))?;
+        children.entry(parent).or_default().push(row);
+        parent_row.push(parent);
+    }
+    let mut order: Vec<usize> = Vec::with_capacity(joints.len());
+    let mut stack: Vec<usize> = children.get(&None).cloned().unwrap_or_default();
+    stack.reverse();
+    while let Some(row) = stack.pop() {
+        order.push(row);
+        if let Some(kids) = children.get(&Some(row)) {
+            stack.extend(kids.iter().rev());
+        }
+    }
+    if order.len() < joints.len() {
+        // The rows never reached hang off a cycle.
+        let mut seen = vec![false; joints.len()];
+        for &r in &order {
+            seen[r] = true;
+        }
+        let row = seen.iter().position(|s| !s).unwrap_or(0);
+        return Err(TreeIssue::Cycle(row));
+    }
+    Ok((order, parent_row))
+}
+
+/// The frames, each on the link it names.
+fn attach_frames(frames: Vec<FrameSpec>, links: &[Link]) -> Result<Vec<Frame>, TreeIssue> {
+    first_duplicate(frames.iter().map(|f| f.name.as_str()))
+        .map_or(Ok(()), |i| Err(TreeIssue::DuplicateFrame(i)))?;
+    frames
+        .into_iter()
+        .enumerate()
+        .map(|(row, f)| {
+            let link = links
+                .iter()
+                .position(|l| l.name == f.link)
+                .ok_or(TreeIssue::UnknownFrameLink(row))?;
+            Ok(Frame {
+                name: f.name,
+                link,
+                placement: f.placement,
+            })
+        })
+        .collect()
 }
 
 fn first_duplicate<'a>(names: impl Iterator<Item = &'a str>) -> Option<usize> {

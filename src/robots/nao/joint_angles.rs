@@ -182,6 +182,9 @@ impl JointAngles {
 }
 
 impl HumanJointAngles for JointAngles {
+    // One function on purpose (~95 lines): one block per NAO chain (head, each arm, each leg),
+    // each the closed-form angles of that chain from the human's segment directions, in the
+    // order of the variables; the blocks share the torso frame and the keep-last rule.
     fn compute(
         &mut self,
         directions: &SegmentDirections,
