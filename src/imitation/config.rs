@@ -43,8 +43,9 @@ pub struct ImitatorConfig {
     pub iterations_per_frame: usize,
     /// Largest speed a task asks for (m/s): each frame a task's error is clipped to
     /// `max_task_speed · dt`, so the velocity limits are rarely hit and the clamping loop does not
-    /// have to take the tasks apart. Default 0.15 m/s, about what 10 % of the NAO's rated joint
-    /// velocities give at its hands (0.8 rad/s × 0.2 m).
+    /// have to take the tasks apart. Default 0.15 m/s, about what 10 % of the rated joint
+    /// velocities give at the hands of a robot with 0.2 m arms and 8 rad/s joints (0.8 rad/s ×
+    /// 0.2 m); scale it with the robot's size.
     pub max_task_speed: f64,
     /// Largest speed the tasks that follow the human ask for (m/s): the points whose target is
     /// the scaled human ([`PointTarget::Scaled`](super::tables::PointTarget::Scaled), the hands in the default tables), in place of
@@ -52,7 +53,7 @@ pub struct ImitatorConfig {
     /// torso and the feet keep their slow, shaped references (the joint velocity bounds still
     /// limit the arms). Default 0.15 m/s, the same as `max_task_speed`: at 0.5 m/s the hands'
     /// mean errors on the bundled clips drop by a third to a half, but the arms' reaction on
-    /// the body then topples the weak-servo NAO of the physics judge on one walk.
+    /// the body then topples the weak-servo model of the physics judge on one walk.
     pub max_tracking_speed: f64,
     /// When and where the robot steps: the human's footprints, scaled, clipped to the step
     /// envelope, taken one step at a time (see [`super::footsteps`]).

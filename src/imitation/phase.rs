@@ -224,8 +224,8 @@ impl fmt::Display for SupportPhase {
 pub struct PhaseConfig {
     /// A CoM step ends when the CoM ground projection is within this distance of its goal.
     /// Default 5 mm: a third of λ, so at the end of "CoM to RFoot" the CoM is at least 10 mm in
-    /// front of the support ankle, inside a NAO sole (about 160 × 90 mm around a point 20 mm
-    /// ahead of the ankle) by more than 25 mm in every direction; and well above the millimetre
+    /// front of the support ankle, inside a 160 × 90 mm sole centred 20 mm ahead of the ankle
+    /// by more than 25 mm in every direction; and well above the millimetre
     /// residual a converged solve leaves, so the step does end.
     pub com_tolerance: f64,
     /// Offset λ of the CoM goal from the support ankle toward the foot centre (x of the sole)
@@ -244,13 +244,13 @@ pub struct PhaseConfig {
     /// Distance (m) between the CoM goal of a single support and the inner edge of the support
     /// foot's contact area, where the contact area is narrower than twice this, its middle. The
     /// least lateral shift that keeps this margin: the stance hip's roll torque grows with how
-    /// far the CoM goes past the hip, and at the sole's centre a NAO's hip roll servo works at
-    /// 88 % of its rated torque (Poubel's [0, 0] under the ankle is worse). Default 15 mm.
+    /// far the CoM goes past the hip, and with the CoM at the sole's centre the hip-roll servo of
+    /// a 5 kg robot with 0.1 m hip spacing works at 88 % of its rated torque (Poubel's [0, 0] under the ankle is worse). Default 15 mm.
     pub support_margin: f64,
     /// A CoM step also waits until the torso is within this angle (rad) of its target
     /// orientation: a foot lifts only once the torso leans over the stance foot, because until
-    /// then the stance hip's roll servo holds the upper body out to the side (on a NAO beyond
-    /// its torque limit when the servos are weak). Default 0.03 rad.
+    /// then the stance hip's roll servo holds the upper body out to the side (on a small robot
+    /// beyond its torque limit when the servos are weak). Default 0.03 rad.
     pub posture_tolerance: f64,
 }
 

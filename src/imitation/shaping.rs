@@ -9,8 +9,8 @@
 //! (`d = |g − r|`, the speed from which the point can still stop at the goal), and the velocity
 //! moves toward it by at most `a_max·dt`. The point starts, cruises and brakes smoothly and
 //! stops at the goal with zero speed. In the cart-table model the ZMP is `r − (z_c/g)·r̈`, so a
-//! bound on `r̈` bounds how far the ZMP strays from the CoM: 0.3 m/s² at the NAO's CoM height
-//! (≈ 0.26 m) is 8 mm. An unbounded CoM step (the paper's) moves the CoM as fast as the joint
+//! bound on `r̈` bounds how far the ZMP strays from the CoM: 0.3 m/s² at a CoM height
+//! of 0.26 m is 8 mm. An unbounded CoM step (the paper's) moves the CoM as fast as the joint
 //! velocity limits allow and starts and stops it in one frame.
 //!
 //! # Swing height

@@ -381,14 +381,14 @@ fn foot_frames(profile: &BipedProfile, foot: Side) -> [&str; 3] {
 
 /// How far below its standing height the executable tables keep the torso (m). Shifting the
 /// hips over one foot with the torso upright lengthens the far leg; at the standing height both
-/// knees of a NAO end up straight (a singular posture the swing leg cannot lift from quickly).
+/// knees of a small biped with 0.1 m shanks end up straight (a singular posture the swing leg cannot lift from quickly).
 pub const TORSO_LOWERING: f64 = 0.02;
 
 /// Sideways lean of the torso over the foot the robot stands or is about to stand on in the
 /// executable tables (rad). With an upright pelvis the stance hip ends up outside the CoM and
-/// its roll servo holds the whole upper body (88 % of a NAO's rated hip-roll torque, beyond the
-/// limit of a weak servo); leaning 0.25 rad brings the upper body over the hip (static hip-roll
-/// torque 2.55 → 1.7 N·m on the NAO; 0.15 rad was not enough for the judge's weak model). A
+/// its roll servo holds the whole upper body (88 % of the rated hip-roll torque of a 5 kg biped
+/// with 0.1 m hip spacing, beyond the limit of a weak servo); leaning 0.25 rad brings the upper
+/// body over the hip (static hip-roll torque 2.55 → 1.7 N·m there; 0.15 rad was not enough for the judge's weak model). A
 /// foot lifts only once the lean is reached ([`PhaseConfig::posture_tolerance`]). Large leans (Table I's free torso leant 16°) put
 /// the swing foot on the floor early when a servo sags.
 pub const TORSO_LEAN: f64 = 0.25;
