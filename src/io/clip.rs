@@ -26,6 +26,7 @@ pub enum ClipError {
     Kinect(#[from] KinectError),
 }
 
+#[derive(Debug)]
 enum Source {
     // Boxed: the BVH reader is several times larger than the Kinect one.
     Bvh(Box<BvhReader<BufReader<File>>>),
@@ -33,6 +34,7 @@ enum Source {
 }
 
 /// A clip being read, one frame at a time.
+#[derive(Debug)]
 pub struct Clip {
     source: Source,
     capture: CaptureSystem,

@@ -319,6 +319,7 @@ impl TaskStack {
 }
 
 /// Mutable view of one level: its Jacobian and desired task velocity.
+#[derive(Debug)]
 pub struct LevelMut<'a> {
     index: usize,
     name: &'a str,
