@@ -14,6 +14,10 @@
 //! `iterations_per_frame`. `--walk` lets the robot's feet follow the human's footprints
 //! (`FootstepConfig::follow`): it walks where the human walks. `--robot` picks the robot: the
 //! built-in NAO (default) or Unitree G1, or a biped profile file (`BipedProfile::from_toml_file`).
+//! `--skeleton MAP.toml` reads a BVH clip whose joints do not carry the CMU names through a
+//! skeleton map (`taskstack::io::skeleton_map`). `--tracking-speed` (m/s) and
+//! `--upper-body-fraction` set `ImitatorConfig::max_tracking_speed` and
+//! `upper_body_velocity_fraction`.
 
 mod plots;
 
@@ -28,6 +32,7 @@ use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
 use taskstack::imitation::metrics::{CONTACT_HEIGHT, EFFECTORS, ImitationMetrics, MetricsRecorder};
 use taskstack::imitation::support::SupportConfig;
 use taskstack::io::clip::Clip;
+use taskstack::io::skeleton_map::SkeletonMap;
 use taskstack::robots::{BipedProfile, g1, nao};
 
 const DEFAULT_CLIP: &str = concat!(
@@ -42,6 +47,7 @@ fn main() -> ExitCode {
     let mut hold = 5.0;
     let mut config = ImitatorConfig::default();
     let mut robot = "nao".to_owned();
+    let mut skeleton: Option<PathBuf> = None;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
@@ -58,6 +64,10 @@ fn main() -> ExitCode {
                 None => return usage(),
             },
             "--walk" => config.footsteps.follow = true,
+            "--skeleton" => match args.next() {
+                Some(m) => skeleton = Some(PathBuf::from(m)),
+                None => return usage(),
+            },
             "--robot" => match args.next() {
                 Some(r) => robot = r,
                 None => return usage(),
@@ -68,6 +78,14 @@ fn main() -> ExitCode {
             },
             "--task-speed" => match args.next().and_then(|v| v.parse().ok()) {
                 Some(v) => config.max_task_speed = v,
+                None => return usage(),
+            },
+            "--tracking-speed" => match args.next().and_then(|v| v.parse().ok()) {
+                Some(v) => config.max_tracking_speed = v,
+                None => return usage(),
+            },
+            "--upper-body-fraction" => match args.next().and_then(|v| v.parse().ok()) {
+                Some(v) => config.upper_body_velocity_fraction = Some(v),
                 None => return usage(),
             },
             "--iterations" => match args.next().and_then(|v| v.parse().ok()) {
@@ -90,7 +108,20 @@ fn main() -> ExitCode {
             }
         },
     };
-    match run(&clip, &out, profile, config, hold) {
+    let source = match &skeleton {
+        None => Clip::open(&clip).map_err(|e| e.to_string()),
+        Some(map) => SkeletonMap::from_toml_file(map)
+            .map_err(|e| format!("--skeleton {e}"))
+            .and_then(|map| Clip::open_mapped(&clip, &map).map_err(|e| e.to_string())),
+    };
+    let source = match source {
+        Ok(source) => source,
+        Err(e) => {
+            eprintln!("imitate: {}: {e}", clip.display());
+            return ExitCode::FAILURE;
+        }
+    };
+    match run(source, &clip, &out, profile, config, hold) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("imitate: {}: {e}", clip.display());
@@ -101,19 +132,19 @@ fn main() -> ExitCode {
 
 fn usage() -> ExitCode {
     eprintln!(
-        "usage: imitate [CLIP.bvh|CLIP.csv] [--out DIR] [--velocity-fraction F] [--hold S] [--task-speed V] [--iterations N] [--walk] [--robot nao|g1|PROFILE.toml]"
+        "usage: imitate [CLIP.bvh|CLIP.csv] [--out DIR] [--velocity-fraction F] [--hold S] [--task-speed V] [--iterations N] [--walk] [--robot nao|g1|PROFILE.toml] [--skeleton MAP.toml] [--tracking-speed V] [--upper-body-fraction F]"
     );
     ExitCode::from(2)
 }
 
 fn run(
+    mut clip: Clip,
     path: &Path,
     out: &Path,
     profile: BipedProfile,
     config: ImitatorConfig,
     hold: f64,
 ) -> Result<(), Box<dyn std::error::Error>> {
-    let mut clip = Clip::open(path)?;
     let config = ImitatorConfig {
         support: SupportConfig::for_capture(clip.capture()),
         ..config

@@ -13,6 +13,7 @@ use thiserror::Error;
 
 use super::bvh::{BvhConfig, BvhError, BvhReader, CMU_MB_NAMES};
 use super::kinect::{KinectConfig, KinectError, KinectReader};
+use super::skeleton_map::SkeletonMap;
 use crate::human::{CaptureSystem, HumanFrame};
 
 /// Error of either reader.
@@ -61,6 +62,22 @@ impl Clip {
         if motion_builder {
             let mut t_pose = HumanFrame::new(0.0);
             reader.read_frame(&mut t_pose)?;
+        }
+        Ok(Self {
+            source: Source::Bvh(Box::new(reader)),
+            capture: CaptureSystem::Optical,
+        })
+    }
+
+    /// Opens the BVH file `path` (any extension) whose skeleton `map` describes: its unit, up
+    /// axis and joint names (see [`super::skeleton_map`]); the map's leading frames are skipped.
+    pub fn open_mapped(path: impl AsRef<Path>, map: &SkeletonMap) -> Result<Self, ClipError> {
+        let mut reader = BvhReader::open(path, map.config.clone())?;
+        let mut skipped = HumanFrame::new(0.0);
+        for _ in 0..map.skip_frames {
+            if !reader.read_frame(&mut skipped)? {
+                break;
+            }
         }
         Ok(Self {
             source: Source::Bvh(Box::new(reader)),

@@ -7,6 +7,7 @@
 pub mod bvh;
 pub mod clip;
 pub mod kinect;
+pub mod skeleton_map;
 
 use std::io::{self, BufRead, Read};
 
