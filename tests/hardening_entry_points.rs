@@ -344,8 +344,8 @@ fn imitator_config_out_of_range_is_refused_by_name() {
     let fields: [(&str, Set); 10] = [
         ("velocity_fraction", |c, v| c.velocity_fraction = v),
         ("nominal_dt", |c, v| c.nominal_dt = v),
-        ("max_task_speed", |c, v| c.max_task_speed = v),
-        ("max_tracking_speed", |c, v| c.max_tracking_speed = v),
+        ("max_task_speed", |c, v| c.max_task_speed = Some(v)),
+        ("max_tracking_speed", |c, v| c.max_tracking_speed = Some(v)),
         ("upper_body_velocity_fraction", |c, v| {
             c.upper_body_velocity_fraction = Some(v)
         }),

@@ -204,8 +204,8 @@ fn other_clips_keep_the_invariants() {
 fn a_walk_at_full_speed_keeps_the_invariants() {
     let config = ImitatorConfig {
         velocity_fraction: 1.0,
-        upper_body_velocity_fraction: None,
-        max_task_speed: 1.0,
+        upper_body_velocity_fraction: Some(1.0),
+        max_task_speed: Some(1.0),
         iterations_per_frame: 2,
         motion: MotionLimits {
             com_speed: 0.1,

@@ -36,7 +36,7 @@ use taskstack::human::Side;
 use taskstack::imitation::imitator::{Imitator, ImitatorConfig, RobotFrame};
 use taskstack::imitation::metrics::{CONTACT_HEIGHT, MetricsRecorder, convex_margin};
 use taskstack::io::clip::Clip;
-use taskstack::robots::nao;
+use taskstack::robots::{g1, nao};
 
 struct Counting;
 
@@ -305,4 +305,37 @@ fn short_soak_three_clips_three_passes() {
 #[ignore = "full soak, about 1.7 × 10^5 frames: cargo test --release --test soak -- --ignored"]
 fn full_soak_all_clips_ten_passes() {
     check_soak(&load(&ALL), 10);
+}
+
+/// The G1's `Imitator::step` allocates nothing either once warmed up by a first clip (allocations
+/// counted on this thread over the next two clips). The G1's per-frame invariants are checked
+/// clip by clip in `tests/imitation_profiles.rs`: back to back, where the human jumps between
+/// clips, its held foot drifts (see issue 11's closing note).
+#[test]
+fn g1_step_does_not_allocate_after_warm_up() {
+    let clips = load(&SHORT);
+    let mut imitator = Imitator::new(g1::profile(), ImitatorConfig::default()).unwrap();
+    let mut next_start = 0.0;
+    let mut after_warm_up = 0;
+    let mut frames = 0;
+    for (c, clip) in clips.iter().enumerate() {
+        let offset = next_start - clip[0].time;
+        for human in clip {
+            let mut human = *human;
+            human.time += offset;
+            let before = allocations();
+            let r = imitator.step(&human).unwrap();
+            let n = allocations() - before;
+            next_start = r.time + 1.0 / 120.0;
+            if c > 0 {
+                after_warm_up += n;
+                frames += 1;
+            }
+        }
+    }
+    assert!(frames > 500, "{frames} frames counted");
+    assert_eq!(
+        after_warm_up, 0,
+        "{after_warm_up} allocations in {frames} steps"
+    );
 }

@@ -9,7 +9,7 @@
 //! (Fig. 8) and `phases.svg`; prints a summary. `--velocity-fraction` is the share of the rated
 //! joint velocities the robot may use (default 0.1, as in the paper). After the clip the human's
 //! last pose is held for `--hold` seconds (default 5) so the robot can finish the step it is
-//! taking; those frames are in the outputs too. `--task-speed` (m/s, default 0.15) and
+//! taking; those frames are in the outputs too. `--task-speed` (m/s, default the profile's: 0.15 for both robots) and
 //! `--iterations` (per frame, default 1) set `ImitatorConfig::max_task_speed` and
 //! `iterations_per_frame`. `--walk` lets the robot's feet follow the human's footprints
 //! (`FootstepConfig::follow`): it walks where the human walks. `--robot` picks the robot: the
@@ -77,11 +77,11 @@ fn main() -> ExitCode {
                 None => return usage(),
             },
             "--task-speed" => match args.next().and_then(|v| v.parse().ok()) {
-                Some(v) => config.max_task_speed = v,
+                Some(v) => config.max_task_speed = Some(v),
                 None => return usage(),
             },
             "--tracking-speed" => match args.next().and_then(|v| v.parse().ok()) {
-                Some(v) => config.max_tracking_speed = v,
+                Some(v) => config.max_tracking_speed = Some(v),
                 None => return usage(),
             },
             "--upper-body-fraction" => match args.next().and_then(|v| v.parse().ok()) {

@@ -26,14 +26,15 @@ pub struct ImitatorConfig {
     /// with the feet held fully while they stand, the CoM at the middle of the contact area and
     /// an upright torso.
     pub tables: Option<TaskTables>,
-    /// Fraction of each joint's rated velocity the robot may use (paper: 0.1). With
-    /// `upper_body_velocity_fraction` set, this applies to the legs only: the joints on the
-    /// chain between the two soles, which carry the robot and close a loop in double support.
+    /// Fraction of each leg joint's rated velocity the robot may use (paper: 0.1): the joints
+    /// on the chain between the two soles, which carry the robot and close a loop in double
+    /// support.
     pub velocity_fraction: f64,
-    /// Fraction of the rated velocity of every joint off the sole-to-sole chain (arms, head),
-    /// or `None` for `velocity_fraction`. Default 0.5: the arms follow the human closely, while
-    /// the legs keep the paper's 10 %; the balance level sees the arms' effect on the CoM and
-    /// the solver slows the arms down when the legs cannot compensate.
+    /// Fraction of the rated velocity of every joint off the sole-to-sole chain (arms, head);
+    /// `None` (default): the profile's [`MotionTuning::upper_body_velocity_fraction`](crate::robots::MotionTuning::upper_body_velocity_fraction) (0.5 for
+    /// the NAO: the arms follow the human closely while the legs keep the paper's 10 %; the
+    /// balance level sees the arms' effect on the CoM and the solver slows the arms down when
+    /// the legs cannot compensate). Set it to `velocity_fraction` for one fraction everywhere.
     pub upper_body_velocity_fraction: Option<f64>,
     /// Speed and acceleration bounds of the CoM reference and of the swing foot (see
     /// [`super::shaping`]).
@@ -43,18 +44,19 @@ pub struct ImitatorConfig {
     pub iterations_per_frame: usize,
     /// Largest speed a task asks for (m/s): each frame a task's error is clipped to
     /// `max_task_speed · dt`, so the velocity limits are rarely hit and the clamping loop does not
-    /// have to take the tasks apart. Default 0.15 m/s, about what 10 % of the rated joint
-    /// velocities give at the hands of a robot with 0.2 m arms and 8 rad/s joints (0.8 rad/s ×
-    /// 0.2 m); scale it with the robot's size.
-    pub max_task_speed: f64,
+    /// have to take the tasks apart. `None` (default): the profile's
+    /// [`MotionTuning::task_speed`](crate::robots::MotionTuning::task_speed) (0.15 m/s for the NAO, about what 10 % of its rated joint
+    /// velocities give at its hands).
+    pub max_task_speed: Option<f64>,
     /// Largest speed the tasks that follow the human ask for (m/s): the points whose target is
-    /// the scaled human ([`PointTarget::Scaled`](super::tables::PointTarget::Scaled), the hands in the default tables), in place of
-    /// `max_task_speed`, so that the arms can follow the human more closely while the CoM, the
-    /// torso and the feet keep their slow, shaped references (the joint velocity bounds still
-    /// limit the arms). Default 0.15 m/s, the same as `max_task_speed`: at 0.5 m/s the hands'
-    /// mean errors on the bundled clips drop by a third to a half, but the arms' reaction on
-    /// the body then topples the weak-servo model of the physics judge on one walk.
-    pub max_tracking_speed: f64,
+    /// the scaled human ([`PointTarget::Scaled`](super::tables::PointTarget::Scaled), the hands
+    /// in the default tables), in place of `max_task_speed`, so that the arms can follow the
+    /// human more closely while the CoM, the torso and the feet keep their slow, shaped
+    /// references (the joint velocity bounds still limit the arms). `None` (default): the
+    /// profile's [`MotionTuning::tracking_speed`](crate::robots::MotionTuning::tracking_speed) (0.15 m/s for the NAO: at 0.5 m/s its hands'
+    /// mean errors on the bundled clips drop by a third to a half, but the arms' reaction on the
+    /// body then topples the weak-servo model of the physics judge on one walk).
+    pub max_tracking_speed: Option<f64>,
     /// When and where the robot steps: the human's footprints, scaled, clipped to the step
     /// envelope, taken one step at a time (see [`super::footsteps`]).
     pub footsteps: FootstepConfig,
@@ -79,11 +81,11 @@ impl Default for ImitatorConfig {
             tables: None,
             phase: PhaseConfig::default(),
             velocity_fraction: 0.1,
-            upper_body_velocity_fraction: Some(0.5),
+            upper_body_velocity_fraction: None,
             motion: MotionLimits::default(),
             iterations_per_frame: 1,
-            max_task_speed: 0.15,
-            max_tracking_speed: 0.15,
+            max_task_speed: None,
+            max_tracking_speed: None,
             footsteps: FootstepConfig::default(),
             nominal_dt: 1.0 / 120.0,
             solver: Settings::default(),
@@ -117,12 +119,12 @@ impl ImitatorConfig {
             ),
             (
                 "max_task_speed",
-                Some(self.max_task_speed),
+                self.max_task_speed,
                 "must be finite and > 0 m/s",
             ),
             (
                 "max_tracking_speed",
-                Some(self.max_tracking_speed),
+                self.max_tracking_speed,
                 "must be finite and > 0 m/s",
             ),
             (

@@ -132,20 +132,21 @@ fn position_bounds(model: &Model) -> Result<JointBounds, SolverError> {
 }
 
 /// `position` with the velocity limits of `config`: the model's rated velocities times the
-/// velocity fraction on the legs (`legs[k]`), times the upper-body fraction elsewhere.
+/// velocity fraction on the legs (`legs[k]`), times the `upper_body` fraction elsewhere.
 fn velocity_bounds(
     model: &Model,
     position: &JointBounds,
     legs: &[bool],
     config: &ImitatorConfig,
+    upper_body: f64,
 ) -> Result<JointBounds, SolverError> {
     let velocity: Vec<f64> = model
         .variables()
         .iter()
         .zip(legs)
-        .map(|(v, &leg)| match config.upper_body_velocity_fraction {
-            Some(upper) if !leg => v.velocity * upper,
-            _ => v.velocity * config.velocity_fraction,
+        .map(|(v, &leg)| match leg {
+            true => v.velocity * config.velocity_fraction,
+            false => v.velocity * upper_body,
         })
         .collect();
     JointBounds::with_velocity(position.lower(), position.upper(), &velocity)
@@ -211,7 +212,10 @@ impl Imitator {
         let position_bounds = position_bounds(model)?;
         let q = initial_posture(&profile, &config, &position_bounds)?;
         let legs = sole_chain_variables(&profile, &q)?;
-        let bounds = velocity_bounds(model, &position_bounds, &legs, &config)?;
+        let tuning = profile.tuning;
+        let upper_body =
+            (config.upper_body_velocity_fraction).unwrap_or(tuning.upper_body_velocity_fraction);
+        let bounds = velocity_bounds(model, &position_bounds, &legs, &config, upper_body)?;
         // The legs are pulled toward the standing posture, not the human's leg angles: those
         // would only drive the closed chain of double support against itself, and with no pull
         // at all the free height of the pelvis drifts until the knees are straight (singular).
@@ -246,8 +250,8 @@ impl Imitator {
             bounds,
             velocity_fraction: config.velocity_fraction,
             iterations: config.iterations_per_frame,
-            max_task_speed: config.max_task_speed,
-            max_tracking_speed: config.max_tracking_speed,
+            max_task_speed: config.max_task_speed.unwrap_or(tuning.task_speed),
+            max_tracking_speed: config.max_tracking_speed.unwrap_or(tuning.tracking_speed),
             nominal_dt: config.nominal_dt,
             phases,
             data,

@@ -8,6 +8,6 @@ pub mod profile;
 pub mod profile_toml;
 
 pub use profile::{
-    BipedProfile, FootArea, FootFrames, HumanJointAngles, JointAnglesFactory, ProfileError,
-    RobotPoint, SolePlacement,
+    BipedProfile, FootArea, FootFrames, HumanJointAngles, JointAnglesFactory, MotionTuning,
+    ProfileError, RobotPoint, SolePlacement,
 };

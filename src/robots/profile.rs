@@ -205,6 +205,50 @@ pub trait HumanJointAngles: Send + Sync + fmt::Debug {
 /// Builds a robot's [`HumanJointAngles`] for one of its models.
 pub type JointAnglesFactory = fn(&Model) -> Result<Box<dyn HumanJointAngles>, ProfileError>;
 
+/// How fast the imitation may move a robot: the defaults of the imitator's speed settings that
+/// depend on the robot's size and actuators (`ImitatorConfig::max_task_speed`,
+/// `max_tracking_speed` and `upper_body_velocity_fraction` override them).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MotionTuning {
+    /// Largest speed a task asks for (m/s): each frame a task's error is clipped to this times
+    /// the time step, so the velocity limits are rarely hit.
+    pub task_speed: f64,
+    /// Largest speed the tasks that follow the human (the hands) ask for (m/s).
+    pub tracking_speed: f64,
+    /// Fraction of the rated velocity of every joint off the sole-to-sole chain (arms, head);
+    /// the legs keep the imitator's `velocity_fraction`.
+    pub upper_body_velocity_fraction: f64,
+}
+
+impl Default for MotionTuning {
+    /// Tuned on the NAO (0.57 m tall, 0.2 m arms, rated joint speeds 4–8 rad/s): tasks at up to
+    /// 0.15 m/s (about what 10 % of the rated speeds give at the hands) and the arms at half
+    /// their rated speeds.
+    fn default() -> Self {
+        MotionTuning {
+            task_speed: 0.15,
+            tracking_speed: 0.15,
+            upper_body_velocity_fraction: 0.5,
+        }
+    }
+}
+
+impl MotionTuning {
+    /// The first field that is not finite and > 0, with its value.
+    pub fn invalid_field(&self) -> Option<(&'static str, f64)> {
+        [
+            ("task_speed", self.task_speed),
+            ("tracking_speed", self.tracking_speed),
+            (
+                "upper_body_velocity_fraction",
+                self.upper_body_velocity_fraction,
+            ),
+        ]
+        .into_iter()
+        .find(|(_, v)| !(v.is_finite() && *v > 0.0))
+    }
+}
+
 /// Everything the imitation needs to know about a biped (see the module docs).
 #[derive(Clone, Debug)]
 pub struct BipedProfile {
@@ -230,6 +274,9 @@ pub struct BipedProfile {
     /// The human-to-robot joint-angle map, or `None`: the joint-tracking gradient then pulls
     /// toward [`BipedProfile::stand`].
     pub joint_angles: Option<JointAnglesFactory>,
+    /// How fast the imitation may move this robot (the size-dependent defaults of the
+    /// imitator's settings).
+    pub tuning: MotionTuning,
 }
 
 impl BipedProfile {
@@ -297,6 +344,12 @@ impl BipedProfile {
                     format!("{} = {q} rad is outside [{}, {}]", v.name, v.lower, v.upper),
                 ));
             }
+        }
+        if let Some((field, value)) = self.tuning.invalid_field() {
+            return Err(invalid(
+                &format!("tuning.{field}"),
+                format!("{value} is not finite and > 0"),
+            ));
         }
         if let Some((field, value)) = self.step_envelope.invalid_field() {
             return Err(invalid(

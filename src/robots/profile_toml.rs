@@ -38,6 +38,11 @@
 //!
 //! [frames]                           # optional extra frames: a link and an offset
 //! l_hand = { link = "l_forearm", xyz = [0.1, 0.0, 0.0] }
+//!
+//! [tuning]                           # optional, each field too (defaults: MotionTuning's)
+//! task_speed = 0.15                  # m/s
+//! tracking_speed = 0.15              # m/s, the hands
+//! upper_body_velocity_fraction = 0.5
 //! ```
 //!
 //! The soles become links named `left_sole` and `right_sole` (added to the URDF text before it
@@ -50,7 +55,7 @@ use std::path::Path;
 use nalgebra::{IsometryMatrix3, Translation3};
 use serde::Deserialize;
 
-use super::profile::{BipedProfile, FootArea, FootFrames, ProfileError, RobotPoint};
+use super::profile::{BipedProfile, FootArea, FootFrames, MotionTuning, ProfileError, RobotPoint};
 use crate::human::{HumanJoint, Side};
 use crate::model::{Model, UrdfError, UrdfFrame, UrdfOptions};
 
@@ -71,6 +76,15 @@ struct File {
     points: BTreeMap<String, Point>,
     #[serde(default)]
     frames: BTreeMap<String, ExtraFrame>,
+    tuning: Option<Tuning>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Tuning {
+    task_speed: Option<f64>,
+    tracking_speed: Option<f64>,
+    upper_body_velocity_fraction: Option<f64>,
 }
 
 #[derive(Deserialize)]
@@ -251,9 +265,22 @@ fn build(file: File, urdf: &str) -> Result<BipedProfile, ProfileError> {
             yaw_max: e.yaw_max,
         },
         joint_angles: None,
+        tuning: tuning(file.tuning),
     };
     profile.validate()?;
     Ok(profile)
+}
+
+/// The `[tuning]` table over the defaults.
+fn tuning(file: Option<Tuning>) -> MotionTuning {
+    let default = MotionTuning::default();
+    let Some(t) = file else { return default };
+    MotionTuning {
+        task_speed: t.task_speed.unwrap_or(default.task_speed),
+        tracking_speed: t.tracking_speed.unwrap_or(default.tracking_speed),
+        upper_body_velocity_fraction: (t.upper_body_velocity_fraction)
+            .unwrap_or(default.upper_body_velocity_fraction),
+    }
 }
 
 /// The standing posture: the named joints at their values, the others at 0.

@@ -41,7 +41,7 @@ pub use joint_angles::JointAngles;
 
 use crate::human::{HumanJoint, Side};
 use crate::model::{Model, ModelData, ModelError, UrdfError, UrdfFrame, UrdfOptions};
-use crate::robots::{BipedProfile, FootArea, FootFrames, RobotPoint};
+use crate::robots::{BipedProfile, FootArea, FootFrames, MotionTuning, RobotPoint};
 
 /// The 23 IK variables (NAOqi joint names) in the order of `q` of every NAO model.
 pub const VARIABLES: [&str; 23] = [
@@ -210,6 +210,8 @@ pub fn profile_with(models: [Model; 2]) -> BipedProfile {
         points: points(),
         stand: STAND.to_vec(),
         step_envelope: STEP_ENVELOPE,
+        // The defaults were tuned on the NAO.
+        tuning: MotionTuning::default(),
         joint_angles: Some(JointAngles::boxed),
     }
 }
