@@ -26,7 +26,7 @@ use serde_json::{Value, json};
 use thiserror::Error;
 
 use crate::human::HumanFrame;
-use crate::imitation::imitator::{ImitationError, Imitator, ImitatorConfig};
+use crate::imitation::imitator::{ImitationError, Imitator, ImitatorConfig, RobotFrame};
 use crate::imitation::metrics::{
     EffectorError, ImitationMetrics, MeanMax, MetricsRecorder, Spread,
 };
@@ -94,6 +94,10 @@ pub struct BatchOptions {
     /// Imitator settings shared by every clip, except `support`, which each clip replaces by the
     /// defaults of its kind of source ([`SupportConfig::for_capture`] of [`Clip::capture`]: optical mocap or Kinect).
     pub imitator: ImitatorConfig,
+    /// After each clip, the human's last pose is held this long (s, frames 1/120 s apart) so
+    /// that the robot can finish the step it is taking; those frames are in the outputs too.
+    /// Default 0.
+    pub hold: f64,
 }
 
 impl Default for BatchOptions {
@@ -102,6 +106,7 @@ impl Default for BatchOptions {
             robot: nao::profile(),
             threads: 0,
             imitator: ImitatorConfig::default(),
+            hold: 0.0,
         }
     }
 }
@@ -228,7 +233,7 @@ pub fn retarget_all(
     let job = |(clip, output): (&PathBuf, &PathBuf)| ClipOutcome {
         clip: clip.clone(),
         output: output.clone(),
-        result: retarget_clip(options.robot.clone(), &options.imitator, clip, output),
+        result: retarget_clip(options, clip, output),
     };
     let (clips, threads) = run_jobs(clips, &outputs, options.threads, job)?;
     Ok(BatchSummary {
@@ -281,59 +286,105 @@ where
     Ok((clips.iter().zip(outputs).map(job).collect(), 1))
 }
 
-/// Retargets one clip to `robot` and writes `joints.csv` and `metrics.json` into `output`
-/// (created if needed). `config.support` is replaced by the clip's defaults.
+/// Time step of the held frames after a clip (s).
+const HOLD_STEP: f64 = 1.0 / 120.0;
+
+/// Imitates every frame of `source` (read from `path`, named in errors) with `imitator`, then
+/// holds the human's last pose for `hold` seconds (frames [`HOLD_STEP`] apart) so that the robot
+/// can finish the step it is taking. Calls `each` with every robot frame, in order; returns the
+/// metrics of the run, the clip's end marked before the hold
+/// ([`MetricsRecorder::mark_clip_end`]). The one clip loop of batch retargeting and of the
+/// `imitate` example.
+///
+/// # Errors
+/// [`BatchError::Clip`] for a read error, [`BatchError::Imitation`] naming the frame.
+pub fn imitate_clip(
+    path: &Path,
+    mut source: Clip,
+    imitator: &mut Imitator,
+    hold: f64,
+    mut each: impl FnMut(&RobotFrame),
+) -> Result<ImitationMetrics, BatchError> {
+    let mut recorder = MetricsRecorder::new(imitator);
+    let mut frame = HumanFrame::new(0.0);
+    let mut last: Option<HumanFrame> = None;
+    let mut end = f64::INFINITY;
+    for index in 0.. {
+        let read = source.read_frame(&mut frame);
+        let more = read.map_err(|source| BatchError::Clip {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        if more {
+            last = Some(frame);
+        } else {
+            // The clip is over: the human holds the last pose while the robot finishes.
+            let Some(held) = last.as_mut() else { break };
+            if end.is_infinite() {
+                recorder.mark_clip_end();
+                end = held.time + hold;
+            }
+            held.time += HOLD_STEP;
+            if held.time > end {
+                break;
+            }
+            frame = *held;
+        }
+        let robot = imitator
+            .step(&frame)
+            .map_err(|source| BatchError::Imitation {
+                path: path.to_path_buf(),
+                frame: index,
+                source,
+            })?;
+        recorder.record(robot);
+        each(robot);
+    }
+    Ok(recorder.finish())
+}
+
+/// The `joints.csv` header: `time` and the imitator's variable names.
+pub fn joints_header(imitator: &Imitator) -> String {
+    let names: Vec<&str> = imitator.variable_names().collect();
+    format!("time,{}\n", names.join(","))
+}
+
+/// Appends `frame`'s `joints.csv` line to `out`: the time (s) and the joint angles (rad), six
+/// decimals.
+pub fn push_joints_line(out: &mut String, frame: &RobotFrame) {
+    let _ = write!(out, "{:.6}", frame.time);
+    for q in &frame.q {
+        let _ = write!(out, ",{q:.6}");
+    }
+    out.push('\n');
+}
+
+/// Retargets one clip to `options.robot` and writes `joints.csv` and `metrics.json` into
+/// `output` (created if needed). `options.imitator.support` is replaced by the clip's defaults.
 pub fn retarget_clip(
-    robot: BipedProfile,
-    config: &ImitatorConfig,
+    options: &BatchOptions,
     clip: &Path,
     output: &Path,
 ) -> Result<ClipSummary, BatchError> {
     let start = Instant::now();
     let path = || clip.to_path_buf();
-    let mut source = Clip::open(clip).map_err(|source| BatchError::Clip {
+    let source = Clip::open(clip).map_err(|source| BatchError::Clip {
         path: path(),
         source,
     })?;
     let config = ImitatorConfig {
         support: SupportConfig::for_capture(source.capture()),
-        ..config.clone()
+        ..options.imitator.clone()
     };
+    let robot = options.robot.clone();
     let mut imitator = Imitator::new(robot, config).map_err(|source| BatchError::Imitation {
         path: path(),
         frame: 0,
         source,
     })?;
-    let mut recorder = MetricsRecorder::new(&imitator);
-    let names: Vec<&str> = imitator.variable_names().collect();
-    let mut joints = format!("time,{}\n", names.join(","));
-    let mut frame = HumanFrame::new(0.0);
-    let mut index = 0;
-    loop {
-        let more = source
-            .read_frame(&mut frame)
-            .map_err(|source| BatchError::Clip {
-                path: path(),
-                source,
-            })?;
-        if !more {
-            break;
-        }
-        let imitation = |source| BatchError::Imitation {
-            path: path(),
-            frame: index,
-            source,
-        };
-        let robot = imitator.step(&frame).map_err(imitation)?;
-        let _ = write!(joints, "{:.6}", robot.time);
-        for q in &robot.q {
-            let _ = write!(joints, ",{q:.6}");
-        }
-        joints.push('\n');
-        recorder.record(robot);
-        index += 1;
-    }
-    let metrics = recorder.finish();
+    let mut joints = joints_header(&imitator);
+    let each = |frame: &RobotFrame| push_joints_line(&mut joints, frame);
+    let metrics = imitate_clip(clip, source, &mut imitator, options.hold, each)?;
     let io = |file: &Path| {
         let file = file.to_path_buf();
         move |source| BatchError::Io { path: file, source }

@@ -120,3 +120,37 @@ fn clips_with_the_same_stem_are_refused_before_any_work() {
     assert!(matches!(err, BatchError::DuplicateOutput { .. }), "{err}");
     assert!(!out.exists());
 }
+
+/// The clip loop holds the human's last pose for `hold` seconds at 120 Hz after the clip: the
+/// extra frames are imitated, passed on and counted, 1/120 s apart after the clip's last frame.
+#[test]
+fn imitate_clip_holds_the_last_pose() {
+    use taskstack::batch::imitate_clip;
+    use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
+    use taskstack::io::clip::Clip;
+    use taskstack::robots::nao;
+
+    let path = mocap(SHORT[2]);
+    let count = |hold: f64| {
+        let mut imitator = Imitator::new(nao::profile(), ImitatorConfig::default()).unwrap();
+        let mut times = Vec::new();
+        let source = Clip::open(&path).unwrap();
+        let metrics =
+            imitate_clip(&path, source, &mut imitator, hold, |r| times.push(r.time)).unwrap();
+        assert_eq!(metrics.frames, times.len());
+        times
+    };
+    let clip = count(0.0);
+    let held = count(0.5);
+    // 0.5 s at 120 Hz: 60 frames, or 59 when the accumulated time step rounds past the end.
+    let extra = held.len() - clip.len();
+    assert!((59..=60).contains(&extra), "{extra} held frames");
+    assert_eq!(held[..clip.len()], clip[..]);
+    let last = *clip.last().unwrap();
+    let step = held[clip.len()] - last;
+    assert!(
+        (step - 1.0 / 120.0).abs() < 1e-12,
+        "first held step {step} s"
+    );
+    assert!(*held.last().unwrap() <= last + 0.5 + 1e-9);
+}

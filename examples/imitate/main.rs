@@ -21,15 +21,14 @@
 
 mod plots;
 
-use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use taskstack::batch::metrics_json;
-use taskstack::human::HumanFrame;
+use taskstack::batch::{imitate_clip, joints_header, metrics_json, push_joints_line};
 use taskstack::human::Side;
-use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
-use taskstack::imitation::metrics::{CONTACT_HEIGHT, EFFECTORS, ImitationMetrics, MetricsRecorder};
+use taskstack::imitation::imitator::{Imitator, ImitatorConfig, RobotFrame};
+use taskstack::imitation::metrics::{CONTACT_HEIGHT, EFFECTORS, ImitationMetrics};
+use taskstack::imitation::support::HumanSupport;
 use taskstack::imitation::support::SupportConfig;
 use taskstack::io::clip::Clip;
 use taskstack::io::skeleton_map::SkeletonMap;
@@ -138,7 +137,7 @@ fn usage() -> ExitCode {
 }
 
 fn run(
-    mut clip: Clip,
+    clip: Clip,
     path: &Path,
     out: &Path,
     profile: BipedProfile,
@@ -150,82 +149,15 @@ fn run(
         ..config
     };
     let mut imitator = Imitator::new(profile, config)?;
-    let mut recorder = MetricsRecorder::new(&imitator);
-    let names: Vec<String> = imitator.variable_names().map(str::to_owned).collect();
-    let mut joints = format!("time,{}\n", names.join(","));
+    let mut joints = joints_header(&imitator);
     let mut samples = Vec::new();
     let profile = imitator.profile().clone();
     // The plotted effectors: the first three of EFFECTORS (hands, left ankle).
     let plotted: Vec<&str> = EFFECTORS[..3].iter().map(|(name, _)| *name).collect();
-    let mut frame = HumanFrame::new(0.0);
-    let mut last: Option<HumanFrame> = None;
-    let mut end = f64::INFINITY;
-    loop {
-        if clip.read_frame(&mut frame)? {
-            last = Some(frame);
-        } else {
-            // The clip is over: the human holds the last pose while the robot finishes.
-            let Some(held) = last.as_mut() else { break };
-            if end.is_infinite() {
-                recorder.mark_clip_end();
-            }
-            end = end.min(held.time + hold);
-            held.time += 1.0 / 120.0;
-            if held.time > end {
-                break;
-            }
-            frame = *held;
-        }
-        let r = imitator.step(&frame)?;
-        recorder.record(r);
-        let _ = write!(joints, "{:.6}", r.time);
-        for q in &r.q {
-            let _ = write!(joints, ",{q:.6}");
-        }
-        joints.push('\n');
-
-        // World positions for the plots.
-        let world = |p: &nalgebra::Vector3<f64>| {
-            let w = r.world_t_root.transform_point(&(*p).into());
-            [w.x, w.y, w.z]
-        };
-        let effectors = EFFECTORS[..plotted.len()]
-            .iter()
-            .zip(&r.effectors)
-            .map(|((_, joint), robot)| {
-                (world(robot), r.reference[joint.index()].as_ref().map(world))
-            })
-            .collect();
-        let footprints = [(Side::Right, r.right_sole), (Side::Left, r.left_sole)]
-            .into_iter()
-            .filter_map(|(foot, sole)| {
-                let outline: Vec<_> = profile
-                    .foot(foot)
-                    .outline
-                    .iter()
-                    .map(|&[x, y]| sole.transform_point(&nalgebra::Point3::new(x, y, 0.0)))
-                    .collect();
-                outline
-                    .iter()
-                    .all(|p| p.z.abs() <= CONTACT_HEIGHT)
-                    .then(|| (foot, outline.iter().map(|p| [p.x, p.y]).collect()))
-            })
-            .collect();
-        samples.push(plots::Sample {
-            time: r.time,
-            effectors,
-            com: [r.com.x, r.com.y],
-            footprints,
-            human: match r.human_support {
-                taskstack::imitation::support::HumanSupport::Double => "Double",
-                taskstack::imitation::support::HumanSupport::Right => "Right",
-                taskstack::imitation::support::HumanSupport::Left => "Left",
-                taskstack::imitation::support::HumanSupport::Airborne => "Airborne",
-            },
-            robot: r.phase.to_string(),
-        });
-    }
-    let metrics = recorder.finish();
+    let metrics = imitate_clip(path, clip, &mut imitator, hold, |r| {
+        push_joints_line(&mut joints, r);
+        samples.push(sample(r, &profile, plotted.len()));
+    })?;
     std::fs::create_dir_all(out)?;
     std::fs::write(out.join("joints.csv"), joints)?;
     std::fs::write(out.join("metrics.json"), metrics_json(&metrics, path))?;
@@ -307,4 +239,43 @@ fn print_summary(m: &ImitationMetrics, clip: &Path, out: &Path) {
         "wrote {}/{{joints.csv, metrics.json, effectors.svg, com.svg, phases.svg}}",
         out.display()
     );
+}
+
+/// The plotted quantities of robot frame `r` (world frame, m): the first `plotted` effectors of
+/// `EFFECTORS` and their references, the CoM, the soles on the ground, the phases.
+fn sample(r: &RobotFrame, profile: &BipedProfile, plotted: usize) -> plots::Sample {
+    let world = |p: &nalgebra::Vector3<f64>| {
+        let w = r.world_t_root.transform_point(&(*p).into());
+        [w.x, w.y, w.z]
+    };
+    let effectors = EFFECTORS[..plotted]
+        .iter()
+        .zip(&r.effectors)
+        .map(|((_, joint), robot)| (world(robot), r.reference[joint.index()].as_ref().map(world)))
+        .collect();
+    let footprints = [(Side::Right, r.right_sole), (Side::Left, r.left_sole)]
+        .into_iter()
+        .filter_map(|(foot, sole)| {
+            let outline: Vec<_> = (profile.foot(foot).outline.iter())
+                .map(|&[x, y]| sole.transform_point(&nalgebra::Point3::new(x, y, 0.0)))
+                .collect();
+            outline
+                .iter()
+                .all(|p| p.z.abs() <= CONTACT_HEIGHT)
+                .then(|| (foot, outline.iter().map(|p| [p.x, p.y]).collect()))
+        })
+        .collect();
+    plots::Sample {
+        time: r.time,
+        effectors,
+        com: [r.com.x, r.com.y],
+        footprints,
+        human: match r.human_support {
+            HumanSupport::Double => "Double",
+            HumanSupport::Right => "Right",
+            HumanSupport::Left => "Left",
+            HumanSupport::Airborne => "Airborne",
+        },
+        robot: r.phase.to_string(),
+    }
 }
