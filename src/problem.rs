@@ -158,27 +158,21 @@ fn axes(v: &Value, field: &str) -> Result<Vec<Axis>, ProblemError> {
         .collect()
 }
 
-/// The joint-order side of a problem: file order ↔ model variables.
-struct JointOrder<'a> {
-    names: &'a [String],
-}
-
-impl JointOrder<'_> {
-    /// `values` (file order, from `field`) as one entry per model variable.
-    fn to_model(&self, values: &[f64], field: &str) -> Result<Vec<f64>, ProblemError> {
-        if values.len() != self.names.len() {
-            let reason = format!("{} values for {} joints", values.len(), self.names.len());
-            return Err(invalid(field, reason));
-        }
-        nao::VARIABLES
-            .iter()
-            .map(|v| {
-                let i = self.names.iter().position(|j| j == v);
-                i.map(|i| values[i])
-                    .ok_or_else(|| invalid("joint_order", format!("lacks {v}")))
-            })
-            .collect()
+/// `values` (in the file's joint order `names`, read from `field`) as one entry per model
+/// variable.
+fn to_model(names: &[String], values: &[f64], field: &str) -> Result<Vec<f64>, ProblemError> {
+    if values.len() != names.len() {
+        let reason = format!("{} values for {} joints", values.len(), names.len());
+        return Err(invalid(field, reason));
     }
+    nao::VARIABLES
+        .iter()
+        .map(|v| {
+            let i = names.iter().position(|j| j == v);
+            i.map(|i| values[i])
+                .ok_or_else(|| invalid("joint_order", format!("lacks {v}")))
+        })
+        .collect()
 }
 
 impl Problem {
@@ -206,16 +200,13 @@ impl Problem {
                 name => model.variable_index(name),
             })
             .collect::<Result<_, _>>()?;
-        let order = JointOrder {
-            names: &joint_order,
-        };
-        let limits = |side: &str| {
-            let field = format!("joint_limits.{side}");
-            order.to_model(&floats(&doc["joint_limits"][side], &field)?, &field)
-        };
-        let bounds = JointBounds::new(&limits("lower")?, &limits("upper")?)?;
-        let q_init = order.to_model(&floats(&doc["q_init"], "q_init")?, "q_init")?;
-        let q_ref = order.to_model(&floats(&doc["q_ref"], "q_ref")?, "q_ref")?;
+        let read =
+            |field: &str, value: &Value| to_model(&joint_order, &floats(value, field)?, field);
+        let lower = read("joint_limits.lower", &doc["joint_limits"]["lower"])?;
+        let upper = read("joint_limits.upper", &doc["joint_limits"]["upper"])?;
+        let bounds = JointBounds::new(&lower, &upper)?;
+        let q_init = read("q_init", &doc["q_init"])?;
+        let q_ref = read("q_ref", &doc["q_ref"])?;
         let frames = doc["frames"]["count"]
             .as_u64()
             .ok_or_else(|| invalid("frames.count", "expected a count"))?;

@@ -43,6 +43,7 @@ use crate::solver::{JointBounds, JointLimitAvoidance, JointTracking, Settings, S
 
 pub use super::config::ImitatorConfig;
 pub use super::error::ImitationError;
+use super::output::effector_frames;
 pub use super::output::{EFFECTORS, RobotFrame};
 
 /// The online imitator.
@@ -123,14 +124,6 @@ fn initial_posture(
     Ok(q)
 }
 
-/// The model's joint position limits (rad or m), without velocity limits.
-fn position_bounds(model: &Model) -> Result<JointBounds, SolverError> {
-    let variables = model.variables();
-    let lower: Vec<f64> = variables.iter().map(|v| v.lower).collect();
-    let upper: Vec<f64> = variables.iter().map(|v| v.upper).collect();
-    JointBounds::new(&lower, &upper)
-}
-
 /// `position` with the velocity limits of `config`: the model's rated velocities times the
 /// velocity fraction on the legs (`legs[k]`), times the `upper_body` fraction elsewhere.
 fn velocity_bounds(
@@ -163,15 +156,8 @@ fn sole_frames(profile: &BipedProfile) -> Result<[[FrameId; 2]; 2], ModelError> 
 }
 
 /// The frames of [`EFFECTORS`] (hands, ankles) in the model rooted at each sole: `[root]`.
-fn effector_frames(profile: &BipedProfile) -> Result<[[FrameId; 4]; 2], ModelError> {
-    let [left_hand, right_hand] = &profile.hands;
-    let [left_ankle, right_ankle] = profile.feet.each_ref().map(|f| f.ankle.as_str());
-    let names = [
-        left_hand.as_str(),
-        right_hand.as_str(),
-        left_ankle,
-        right_ankle,
-    ];
+fn effector_ids(profile: &BipedProfile) -> Result<[[FrameId; 4]; 2], ModelError> {
+    let names = effector_frames(profile);
     let ids = |root: Side| -> Result<[FrameId; 4], ModelError> {
         let model = profile.model(root);
         let [a, b, c, d] = names.map(|name| model.frame_id(name));
@@ -205,11 +191,12 @@ impl Imitator {
     ///
     /// # Errors
     /// [`ImitationError`] naming the faulty setting, profile field or table.
-    pub fn new(profile: BipedProfile, config: ImitatorConfig) -> Result<Self, ImitationError> {
+    pub fn new(profile: BipedProfile, mut config: ImitatorConfig) -> Result<Self, ImitationError> {
         config.validate()?;
         profile.validate()?;
         let model = profile.model(Side::Right);
-        let position_bounds = position_bounds(model)?;
+        // Position limits only matter to the limit-avoidance gradient and the start clamp.
+        let position_bounds = crate::tasks::joint_bounds(model)?;
         let q = initial_posture(&profile, &config, &position_bounds)?;
         let legs = sole_chain_variables(&profile, &q)?;
         let tuning = profile.tuning;
@@ -220,15 +207,15 @@ impl Imitator {
         // would only drive the closed chain of double support against itself, and with no pull
         // at all the free height of the pelvis drifts until the knees are straight (singular).
         let stance = legs.iter().zip(&q).map(|(&l, &v)| l.then_some(v)).collect();
-        let tables = match &config.tables {
-            Some(tables) => tables.clone(),
+        let tables = match config.tables.take() {
+            Some(tables) => tables,
             None => TaskTables::executable(&config.phase, &profile),
         };
         let phases = phase_solvers(&tables, &profile, &q, config.solver)?;
         let angles = profile.joint_angles.map(|build| build(model)).transpose()?;
         let mut data = profile.models.each_ref().map(Model::new_data);
         let soles = sole_frames(&profile)?;
-        let effectors = effector_frames(&profile)?;
+        let effectors = effector_ids(&profile)?;
         let right = Side::Right.index();
         model.forward_kinematics(&mut data[right], &q)?;
         let left_sole = *data[right].frame_placement(soles[right][Side::Left.index()]);

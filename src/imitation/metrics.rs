@@ -22,6 +22,7 @@
 use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 
 use super::imitator::{Imitator, RobotFrame};
+use super::output::effector_frames;
 use super::phase::SupportPhase;
 use super::support::HumanSupport;
 use super::tables::{PointTarget, Task};
@@ -313,9 +314,7 @@ impl MetricsRecorder {
     /// joint bounds and feet are read once here.
     pub fn new(imitator: &Imitator) -> Self {
         let profile = imitator.profile();
-        let [lh, rh] = &profile.hands;
-        let [la, ra] = profile.feet.each_ref().map(|f| &f.ankle);
-        let frames = [lh, rh, la, ra];
+        let frames = effector_frames(profile);
         let tracked = SupportPhase::ALL.map(|phase| {
             let tasks: Vec<&Task> = imitator
                 .table(phase)

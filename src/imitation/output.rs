@@ -5,6 +5,7 @@ use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 use super::phase::SupportPhase;
 use super::support::HumanSupport;
 use crate::human::{HumanJoint, Side};
+use crate::robots::BipedProfile;
 use crate::solver::driver::StopReason;
 use crate::solver::{LevelReport, SolveReport};
 
@@ -17,6 +18,13 @@ pub const EFFECTORS: [(&str, HumanJoint); 4] = [
     ("l_ankle", HumanJoint::LAnkle),
     ("r_ankle", HumanJoint::RAnkle),
 ];
+
+/// The robot frames of [`EFFECTORS`] in `profile`: its hands, then its feet's ankles.
+pub(super) fn effector_frames(profile: &BipedProfile) -> [&str; 4] {
+    let [left_hand, right_hand] = &profile.hands;
+    let [left_ankle, right_ankle] = &profile.feet;
+    [left_hand, right_hand, &left_ankle.ankle, &right_ankle.ankle].map(String::as_str)
+}
 
 /// One robot output frame.
 #[derive(Debug, Clone)]

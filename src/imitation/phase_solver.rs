@@ -115,13 +115,13 @@ impl PhaseSolver {
                     } => (Some((frame, Vector3::from(*offset))), *axes),
                     Task::Orientation { frame, .. } => (Some((frame, Vector3::zeros())), Axes::XY),
                 };
-                let point = match point {
-                    Some((frame, offset)) => Some(FramePoint {
-                        frame: model.frame_id(frame)?,
-                        offset,
-                    }),
-                    None => None,
-                };
+                let point = point
+                    .map(|(frame, offset)| {
+                        model
+                            .frame_id(frame)
+                            .map(|frame| FramePoint { frame, offset })
+                    })
+                    .transpose()?;
                 let (rest_height, standing) = match &point {
                     Some(p) => (
                         model.point_position(&rest, p.frame, &p.offset)?.z,
