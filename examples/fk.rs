@@ -1,4 +1,4 @@
-//! Forward kinematics of the NAO as JSON lines (DESIGN §5 contract).
+//! Forward kinematics of the NAO as JSON lines.
 //!
 //! ```sh
 //! cargo run --release --example fk -- --root r_sole|l_sole|torso|urdf:<path>

@@ -46,6 +46,12 @@ pub enum BatchError {
         /// The reader's error.
         source: ClipError,
     },
+    /// The clip holds no frame of motion.
+    #[error("{}: the clip has no frame of motion", path.display())]
+    EmptyClip {
+        /// The clip file.
+        path: PathBuf,
+    },
     /// The imitator could not be built or refused a frame.
     #[error("{}: frame {frame}: {source}", path.display())]
     Imitation {
@@ -290,14 +296,15 @@ where
 const HOLD_STEP: f64 = 1.0 / 120.0;
 
 /// Imitates every frame of `source` (read from `path`, named in errors) with `imitator`, then
-/// holds the human's last pose for `hold` seconds (frames [`HOLD_STEP`] apart) so that the robot
+/// holds the human's last pose for `hold` seconds (frames 1/120 s apart) so that the robot
 /// can finish the step it is taking. Calls `each` with every robot frame, in order; returns the
 /// metrics of the run, the clip's end marked before the hold
 /// ([`MetricsRecorder::mark_clip_end`]). The one clip loop of batch retargeting and of the
 /// `imitate` example.
 ///
 /// # Errors
-/// [`BatchError::Clip`] for a read error, [`BatchError::Imitation`] naming the frame.
+/// [`BatchError::Clip`] for a read error, [`BatchError::EmptyClip`] when the clip has no frame,
+/// [`BatchError::Imitation`] naming the frame.
 pub fn imitate_clip(
     path: &Path,
     mut source: Clip,
@@ -308,7 +315,10 @@ pub fn imitate_clip(
     let mut recorder = MetricsRecorder::new(imitator);
     let mut frame = HumanFrame::new(0.0);
     let mut last: Option<HumanFrame> = None;
-    let mut end = f64::INFINITY;
+    // The hold's frames: counted, not accumulated in floating point, so 0.5 s is 60 frames.
+    let hold_frames = (hold / HOLD_STEP + 1e-6).floor() as u64;
+    let mut held_frames = 0;
+    let mut clip_end = None;
     for index in 0.. {
         let read = source.read_frame(&mut frame);
         let more = read.map_err(|source| BatchError::Clip {
@@ -319,15 +329,20 @@ pub fn imitate_clip(
             last = Some(frame);
         } else {
             // The clip is over: the human holds the last pose while the robot finishes.
-            let Some(held) = last.as_mut() else { break };
-            if end.is_infinite() {
+            let Some(held) = last.as_mut() else {
+                return Err(BatchError::EmptyClip {
+                    path: path.to_path_buf(),
+                });
+            };
+            let end = *clip_end.get_or_insert_with(|| {
                 recorder.mark_clip_end();
-                end = held.time + hold;
-            }
-            held.time += HOLD_STEP;
-            if held.time > end {
+                held.time
+            });
+            held_frames += 1;
+            if held_frames > hold_frames {
                 break;
             }
+            held.time = end + held_frames as f64 * HOLD_STEP;
             frame = *held;
         }
         let robot = imitator
@@ -343,24 +358,56 @@ pub fn imitate_clip(
     Ok(recorder.finish())
 }
 
-/// The `joints.csv` header: `time` and the imitator's variable names.
-pub fn joints_header(imitator: &Imitator) -> String {
-    let names: Vec<&str> = imitator.variable_names().collect();
-    format!("time,{}\n", names.join(","))
+/// Writes `joints.csv` as the frames come: a header `time,<the imitator's variable names>`,
+/// then per frame the time (s) and the joint angles (rad), six decimals.
+#[derive(Debug)]
+pub struct JointsWriter<W: std::io::Write> {
+    out: W,
+    line: String,
 }
 
-/// Appends `frame`'s `joints.csv` line to `out`: the time (s) and the joint angles (rad), six
-/// decimals.
-pub fn push_joints_line(out: &mut String, frame: &RobotFrame) {
-    let _ = write!(out, "{:.6}", frame.time);
-    for q in &frame.q {
-        let _ = write!(out, ",{q:.6}");
+impl<W: std::io::Write> JointsWriter<W> {
+    /// A writer into `out` (buffer it: one write per frame follows).
+    pub fn new(out: W) -> Self {
+        Self {
+            out,
+            line: String::new(),
+        }
     }
-    out.push('\n');
+
+    /// Writes the header line.
+    pub fn header(&mut self, imitator: &Imitator) -> std::io::Result<()> {
+        self.line.clear();
+        self.line.push_str("time");
+        for name in imitator.variable_names() {
+            self.line.push(',');
+            self.line.push_str(name);
+        }
+        self.line.push('\n');
+        self.out.write_all(self.line.as_bytes())
+    }
+
+    /// Writes `frame`'s line.
+    pub fn frame(&mut self, frame: &RobotFrame) -> std::io::Result<()> {
+        self.line.clear();
+        let _ = write!(self.line, "{:.6}", frame.time);
+        for q in &frame.q {
+            let _ = write!(self.line, ",{q:.6}");
+        }
+        self.line.push('\n');
+        self.out.write_all(self.line.as_bytes())
+    }
+
+    /// Flushes the output.
+    pub fn finish(&mut self) -> std::io::Result<()> {
+        self.out.flush()
+    }
 }
 
 /// Retargets one clip to `options.robot` and writes `joints.csv` and `metrics.json` into
-/// `output` (created if needed). `options.imitator.support` is replaced by the clip's defaults.
+/// `output` (created once the clip is open, before any frame is imitated). `joints.csv` is written as the frames
+/// come, so memory stays flat however long the clip. `options.imitator.support` is replaced by
+/// the clip's defaults.
 pub fn retarget_clip(
     options: &BatchOptions,
     clip: &Path,
@@ -368,10 +415,18 @@ pub fn retarget_clip(
 ) -> Result<ClipSummary, BatchError> {
     let start = Instant::now();
     let path = || clip.to_path_buf();
+    let io = |file: &Path| {
+        let file = file.to_path_buf();
+        move |source| BatchError::Io { path: file, source }
+    };
     let source = Clip::open(clip).map_err(|source| BatchError::Clip {
         path: path(),
         source,
     })?;
+    std::fs::create_dir_all(output).map_err(io(output))?;
+    let joints_path = output.join("joints.csv");
+    let file = std::fs::File::create(&joints_path).map_err(io(&joints_path))?;
+    let mut joints = JointsWriter::new(std::io::BufWriter::new(file));
     let config = ImitatorConfig {
         support: SupportConfig::for_capture(source.capture()),
         ..options.imitator.clone()
@@ -382,16 +437,17 @@ pub fn retarget_clip(
         frame: 0,
         source,
     })?;
-    let mut joints = joints_header(&imitator);
-    let each = |frame: &RobotFrame| push_joints_line(&mut joints, frame);
-    let metrics = imitate_clip(clip, source, &mut imitator, options.hold, each)?;
-    let io = |file: &Path| {
-        let file = file.to_path_buf();
-        move |source| BatchError::Io { path: file, source }
+    joints.header(&imitator).map_err(io(&joints_path))?;
+    let mut written = Ok(());
+    let each = |frame: &RobotFrame| {
+        if written.is_ok() {
+            written = joints.frame(frame);
+        }
     };
-    std::fs::create_dir_all(output).map_err(io(output))?;
-    let joints_path = output.join("joints.csv");
-    std::fs::write(&joints_path, joints).map_err(io(&joints_path))?;
+    let metrics = imitate_clip(clip, source, &mut imitator, options.hold, each)?;
+    written
+        .and_then(|()| joints.finish())
+        .map_err(io(&joints_path))?;
     let metrics_path = output.join("metrics.json");
     std::fs::write(&metrics_path, metrics_json(&metrics, clip)).map_err(io(&metrics_path))?;
     let hand = |name: &str| {
@@ -438,6 +494,8 @@ pub fn metrics_json(m: &ImitationMetrics, clip: &Path) -> String {
         "clip": clip.file_name().map(|f| f.to_string_lossy().into_owned()),
         "frames": m.frames,
         "duration_s": m.duration,
+        "clip_frames": m.clip_frames,
+        "clip_duration_s": m.clip_duration,
         "human_support_changes": m.human_support_changes,
         "robot_support_changes": m.robot_support_changes,
         "robot_support_sequence": m.robot_support_sequence,

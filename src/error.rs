@@ -1,4 +1,4 @@
-//! [`Error`]: every error of the crate in one type, for applications that handle them alike
+//! [`Error`](enum@Error): every error of the crate in one type, for applications that handle them alike
 //! (`?` converts each module's error into it). Library code returns the module errors, which
 //! say more precisely what can fail.
 

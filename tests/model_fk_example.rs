@@ -1,4 +1,4 @@
-//! The `fk` example's JSON-lines contract (DESIGN §5), run as a process. `cargo test` builds the
+//! The `fk` example's JSON-lines contract, run as a process. `cargo test` builds the
 //! examples next to the test binaries (`target/<profile>/examples/`).
 
 use std::io::Write;

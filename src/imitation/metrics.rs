@@ -4,7 +4,7 @@
 //!   reference, in the model root's frame (m), split by single and double support.
 //! * **Static stability**: the signed distance of the CoM ground projection to the edge of the
 //!   support polygon (positive inside, m): the convex hull of the sole outlines
-//!   ([`Foot::sole_outline`]) of the feet on the ground, a foot being on the ground when all its
+//!   ([`FootFrames::outline`](crate::robots::FootFrames::outline)) of the feet on the ground, a foot being on the ground when all its
 //!   outline points are within [`CONTACT_HEIGHT`] of the floor.
 //! * **Executability**: joint-limit violations, and velocity-limit violations
 //!   (`|Δq|/Δt > fraction · v_max`), counted per joint and frame.
@@ -118,10 +118,15 @@ pub struct EffectorError {
 /// The metrics of a run.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ImitationMetrics {
-    /// Frames imitated.
+    /// Frames imitated, the hold after the clip included.
     pub frames: usize,
-    /// Time from the first to the last frame (s).
+    /// Time from the first to the last frame, the hold included (s).
     pub duration: f64,
+    /// Frames of the clip itself: `frames` less the hold's
+    /// ([`MetricsRecorder::mark_clip_end`]; all frames when it was not called).
+    pub clip_frames: usize,
+    /// Time from the first to the last frame of the clip itself (s).
+    pub clip_duration: f64,
     /// Changes of the human's support (airborne frames ignored).
     pub human_support_changes: usize,
     /// Changes of the robot's continuous phase (DS, RS, LS).
@@ -216,6 +221,8 @@ pub struct MetricsRecorder {
     human_steps: StepCounter,
     robot_steps: StepCounter,
     pending: usize,
+    /// Frames and last time when the clip ended ([`MetricsRecorder::mark_clip_end`]).
+    clip_end: Option<(usize, f64)>,
 }
 
 fn continuous_name(phase: SupportPhase) -> Option<&'static str> {
@@ -364,12 +371,14 @@ impl MetricsRecorder {
             human_steps: StepCounter::default(),
             robot_steps: StepCounter::default(),
             pending: 0,
+            clip_end: None,
         }
     }
 
     /// The clip's last frame has been recorded; the frames that follow are a hold (the human's
     /// last pose repeated) and count for the catch-up time, not for the clip's tracking errors.
     pub fn mark_clip_end(&mut self) {
+        self.clip_end.get_or_insert((self.frames, self.last_time));
         self.travel.mark_clip_end(self.last_time);
     }
 
@@ -546,9 +555,13 @@ impl MetricsRecorder {
         let mut transitions = self.transitions.clone();
         // The lag search is quadratic in the clip's frames: once.
         let (lag_errors, hand_lag_s) = self.hands.lag_removed();
+        let first_time = self.first_time.unwrap_or(self.last_time);
+        let (clip_frames, clip_end) = self.clip_end.unwrap_or((self.frames, self.last_time));
         ImitationMetrics {
             frames: self.frames,
-            duration: self.last_time - self.first_time.unwrap_or(self.last_time),
+            duration: self.last_time - first_time,
+            clip_frames,
+            clip_duration: clip_end - first_time,
             human_support_changes: self.human_changes,
             robot_support_changes: self.sequence.len().saturating_sub(1),
             robot_support_sequence: self.sequence.clone(),

@@ -1,4 +1,4 @@
-//! Human-to-robot imitation (DESIGN §4): the human skeleton frame every motion source is converted
+//! Human-to-robot imitation: the human skeleton frame every motion source is converted
 //! to, and the detection of which of the human's feet support the body.
 //!
 //! A motion source (a BVH file, a Kinect stream; see [`crate::io`]) yields one

@@ -31,7 +31,7 @@ pub(super) fn effector_frames(profile: &BipedProfile) -> [&str; 4] {
 pub struct RobotFrame {
     /// Time of the human frame (s).
     pub time: f64,
-    /// Joint angles in the model's variable order (rad); names in [`Imitator::variable_names`].
+    /// Joint angles in the model's variable order (rad); names in [`Imitator::variable_names`](super::imitator::Imitator::variable_names).
     pub q: Vec<f64>,
     /// The human's support at this frame.
     pub human_support: HumanSupport,

@@ -626,9 +626,9 @@ impl TaskTable {
     ///   fixes only two heights, so the foot's heading was free and a loaded foot twisted on the
     ///   floor; in DS it slid to the scaled human ankle. A foot that must move takes a step.
     /// * **The CoM goes inside the contact area by a margin**, not to the ankle: in single
-    ///   support and while a foot moves, to [`Foot::stance_point`] (the support sole's contact
+    ///   support and while a foot moves, to [`BipedProfile::stance_point`](crate::robots::BipedProfile::stance_point) (the support sole's contact
     ///   rectangle, [`PhaseConfig::support_margin`] from its inner edge); in DS midway between
-    ///   the two rectangles' centres ([`Foot::sole_centre`]).
+    ///   the two rectangles' centres ([`BipedProfile::sole_centre`](crate::robots::BipedProfile::sole_centre)).
     /// * **An upright torso at its standing height** ("posture": its z axis vertical, 2 rows, and
     ///   its height, 1 row) below the balance level: in single support the hips shift over the
     ///   stance foot instead of the whole robot leaning 16° sideways, which put the swing foot

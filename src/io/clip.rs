@@ -91,6 +91,16 @@ impl Clip {
         self.capture
     }
 
+    /// How many frames are left to read according to the file's header (a BVH `Frames` count
+    /// less the frames already read or skipped), for progress reports only: the file may hold
+    /// fewer. `None` for a Kinect CSV, which has no header count.
+    pub fn declared_frames(&self) -> Option<u64> {
+        match &self.source {
+            Source::Bvh(r) => Some(r.declared_frames().saturating_sub(r.frames_read())),
+            Source::Kinect(_) => None,
+        }
+    }
+
     /// Reads the next frame into `out`; `Ok(false)` at the end of the clip.
     pub fn read_frame(&mut self, out: &mut HumanFrame) -> Result<bool, ClipError> {
         Ok(match &mut self.source {

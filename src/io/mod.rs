@@ -1,4 +1,4 @@
-//! Readers of human motion (DESIGN §1, layer `io`): BVH motion capture ([`bvh`]) and Microsoft
+//! Readers of human motion (the `io` layer, above `human`): BVH motion capture ([`bvh`]) and Microsoft
 //! Kinect v2 skeleton CSV ([`kinect`]). Both stream: a reader parses its header once and then
 //! yields one [`crate::human::HumanFrame`] at a time, so a live source and a file feed
 //! the same pipeline. Both cap what a file may ask for (line length, joint count) so that hostile

@@ -1,0 +1,211 @@
+//! `taskstack batch`: many clips, one output folder each, in parallel.
+
+use std::collections::HashMap;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use clap::Args;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use serde_json::json;
+use taskstack::batch::clips_in;
+use taskstack::imitation::metrics::ImitationMetrics;
+
+use crate::Report;
+use crate::options::ImitationOptions;
+use crate::run::{Settings, imitate_into};
+
+/// Imitate many clips, each into its own folder OUT/<clip name>/, in parallel.
+///
+/// Every clip gets the outputs of `taskstack imitate` (joints.csv, metrics.json, view.html and
+/// the SVG plots). A clip that fails does not stop the others; the summary table says which
+/// failed and why, and the exit status is 1 if any did.
+#[derive(Debug, Args)]
+pub(crate) struct BatchArgs {
+    /// Clip files (.bvh, .csv) and folders; a folder stands for its .bvh and .csv files.
+    #[arg(value_name = "DIR|FILE", required = true)]
+    inputs: Vec<PathBuf>,
+    /// Output folder: each clip writes into OUT/<clip file name without extension>/.
+    #[arg(long, short, value_name = "OUT")]
+    out: PathBuf,
+    /// Clips imitated at once. Default: one per core.
+    #[arg(long, short, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1024))]
+    jobs: Option<u32>,
+    #[command(flatten)]
+    options: ImitationOptions,
+}
+
+struct Done {
+    clip: PathBuf,
+    out: PathBuf,
+    result: Result<ImitationMetrics>,
+    seconds: f64,
+}
+
+pub(crate) fn run(args: BatchArgs, report: Report) -> Result<ExitCode> {
+    let clips = collect_clips(&args.inputs)?;
+    let mut folders: HashMap<PathBuf, &PathBuf> = HashMap::new();
+    for clip in &clips {
+        let out = args.out.join(clip.file_stem().unwrap_or(clip.as_os_str()));
+        if let Some(first) = folders.insert(out.clone(), clip) {
+            bail!(
+                "clips {} and {} would both write into {}",
+                first.display(),
+                clip.display(),
+                out.display()
+            );
+        }
+    }
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("output folder {}: cannot create it", args.out.display()))?;
+    let settings = Settings {
+        profile: args.options.profile()?,
+        config: args.options.imitator_config(),
+        hold: args.options.hold,
+        map: args.options.skeleton_map()?,
+    };
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let jobs = args
+        .jobs
+        .map_or(cores, |j| j as usize)
+        .min(clips.len())
+        .max(1);
+    let bar = ProgressBar::with_draw_target(Some(clips.len() as u64), ProgressDrawTarget::hidden());
+    if report.human() {
+        bar.set_draw_target(ProgressDrawTarget::stderr());
+        bar.set_style(
+            ProgressStyle::with_template("{bar:30} {pos}/{len} clips, {elapsed} {msg}")
+                .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        );
+    }
+    let start = Instant::now();
+    let next = AtomicUsize::new(0);
+    let done = Mutex::new(Vec::with_capacity(clips.len()));
+    std::thread::scope(|scope| {
+        for _ in 0..jobs {
+            scope.spawn(|| {
+                while let Some(clip) = clips.get(next.fetch_add(1, Ordering::Relaxed)) {
+                    let out = args.out.join(clip.file_stem().unwrap_or(clip.as_os_str()));
+                    let began = Instant::now();
+                    let result = imitate_into(clip, &out, &settings, &mut |_| {});
+                    bar.set_message(format!("{}", clip.display()));
+                    bar.inc(1);
+                    let seconds = began.elapsed().as_secs_f64();
+                    let mut done = done.lock().unwrap_or_else(|e| e.into_inner());
+                    done.push(Done {
+                        clip: clip.clone(),
+                        out,
+                        result,
+                        seconds,
+                    });
+                }
+            });
+        }
+    });
+    bar.finish_and_clear();
+    let mut done = done.into_inner().unwrap_or_else(|e| e.into_inner());
+    done.sort_by(|a, b| a.clip.cmp(&b.clip));
+    let failed = done.iter().filter(|d| d.result.is_err()).count();
+    if report.json {
+        println!("{}", batch_json(&done, jobs, start.elapsed().as_secs_f64()));
+    } else {
+        print_table(&done, report, jobs, start.elapsed().as_secs_f64());
+    }
+    Ok(if failed == 0 {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    })
+}
+
+/// The clips of the inputs: files as given, folders' .bvh and .csv files sorted.
+fn collect_clips(inputs: &[PathBuf]) -> Result<Vec<PathBuf>> {
+    let mut clips = Vec::new();
+    for input in inputs {
+        if input.is_dir() {
+            let found =
+                clips_in(input).with_context(|| format!("input folder {}", input.display()))?;
+            if found.is_empty() {
+                bail!(
+                    "input folder {}: no .bvh or .csv clip in it",
+                    input.display()
+                );
+            }
+            clips.extend(found);
+        } else if input.is_file() {
+            clips.push(input.clone());
+        } else {
+            bail!("clip {}: no such file or folder", input.display());
+        }
+    }
+    Ok(clips)
+}
+
+fn hand_mean(m: &ImitationMetrics, name: &str) -> Option<f64> {
+    let e = m.effectors_clip.iter().find(|e| e.name == name)?;
+    let (s, d) = (&e.single_support, &e.double_support);
+    let n = s.count + d.count;
+    (n > 0).then(|| (s.mean * s.count as f64 + d.mean * d.count as f64) / n as f64)
+}
+
+fn print_table(done: &[Done], report: Report, jobs: usize, seconds: f64) {
+    for d in done {
+        if let Err(e) = &d.result {
+            eprintln!("taskstack: error: {e:#}");
+        }
+    }
+    if report.quiet {
+        return;
+    }
+    println!(
+        "{:<48} {:>7} {:>7} {:>9} {:>13} {:>8} {:>6} {:>7}",
+        "clip", "frames", "clip s", "supports", "hands cm L/R", "CoM out", "limits", "wall s"
+    );
+    let cm = |v: Option<f64>| v.map_or("-".to_owned(), |v| format!("{:.1}", v * 100.0));
+    for d in done {
+        let name = d
+            .clip
+            .file_name()
+            .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+        match &d.result {
+            Ok(m) => println!(
+                "{:<48} {:>7} {:>7.1} {:>9} {:>13} {:>8} {:>6} {:>7.1}",
+                name,
+                m.clip_frames,
+                m.clip_duration,
+                format!("{}→{}", m.human_support_changes, m.robot_support_changes),
+                format!(
+                    "{}/{}",
+                    cm(hand_mean(m, "l_hand")),
+                    cm(hand_mean(m, "r_hand"))
+                ),
+                m.frames_com_outside,
+                m.joint_limit_violations + m.velocity_limit_violations,
+                d.seconds
+            ),
+            Err(_) => println!("{name:<48} FAILED (see above)"),
+        }
+    }
+    let ok = done.iter().filter(|d| d.result.is_ok()).count();
+    println!(
+        "{ok} of {} clips imitated in {seconds:.1} s on {jobs} threads; supports = human → robot support changes, CoM out = frames with the CoM outside the support polygon, limits = joint × frame violations",
+        done.len()
+    );
+}
+
+fn batch_json(done: &[Done], jobs: usize, seconds: f64) -> serde_json::Value {
+    let clips: Vec<_> = done
+        .iter()
+        .map(|d| match &d.result {
+            Ok(m) => json!({
+                "clip": d.clip, "out": d.out, "ok": true, "wall_time_s": d.seconds,
+                "metrics": serde_json::from_str::<serde_json::Value>(&taskstack::batch::metrics_json(m, &d.clip)).unwrap_or_default(),
+            }),
+            Err(e) => json!({ "clip": d.clip, "out": d.out, "ok": false, "error": format!("{e:#}") }),
+        })
+        .collect();
+    json!({ "clips": clips, "threads": jobs, "wall_time_s": seconds })
+}

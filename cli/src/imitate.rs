@@ -1,0 +1,167 @@
+//! `taskstack imitate`: one clip, one robot, one output folder.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Duration;
+
+use anyhow::{Result, bail};
+use clap::Args;
+use indicatif::{ProgressBar, ProgressStyle};
+use serde_json::json;
+use taskstack::imitation::metrics::ImitationMetrics;
+
+use crate::Report;
+use crate::options::ImitationOptions;
+use crate::run::{OUTPUT_FILES, Progress, Settings, default_out, imitate_into};
+
+/// The clip imitated when none is given: CMU 05_02 (standing, arm gestures, small steps, a
+/// stance on the right leg), bundled with the crate.
+const BUNDLED_CLIP: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../tests/data/mocap/cmu_05_02_stand_arm_gestures_turn_single_leg.bvh"
+);
+
+/// Imitate a motion clip with a humanoid robot, online, frame by frame.
+///
+/// Reads a BVH clip (CMU skeletons, or any skeleton through --skeleton) or a Kinect v2 CSV,
+/// imitates it with the robot (Poubel et al.'s support phases: the robot stands on one leg when
+/// the human does, and with --walk steps where the human steps), then holds the last pose for
+/// --hold seconds. Writes into the output folder, as the frames come:
+///
+///   joints.csv     time (s) and the robot's joint angles (rad), one line per frame
+///   metrics.json   tracking errors (m), balance margins (m), limits, slip, travel, step times (µs)
+///   view.html      a 3D viewer of the robot and the scaled human (opens in any browser, offline)
+///   effectors.svg  each hand's and ankle's distance to the scaled human over time, phases shaded
+///   com.svg        the CoM ground path inside the footprints, seen from above
+///   phases.svg     the human's support and the robot's phase over time
+///   joints.svg     the right arm's joint angles against their limits
+#[derive(Debug, Args)]
+#[command(verbatim_doc_comment)]
+pub(crate) struct ImitateArgs {
+    /// The clip: a .bvh file or a Kinect v2 .csv. Default: the bundled CMU 05_02 clip.
+    #[arg(value_name = "CLIP")]
+    clip: Option<PathBuf>,
+    /// Output folder (created if needed). Default: taskstack-out/<clip name> in the current
+    /// folder.
+    #[arg(long, short, value_name = "DIR")]
+    out: Option<PathBuf>,
+    #[command(flatten)]
+    options: ImitationOptions,
+}
+
+pub(crate) fn run(args: ImitateArgs, report: Report) -> Result<ExitCode> {
+    let clip = args
+        .clip
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(BUNDLED_CLIP));
+    if args.clip.is_none() && !clip.is_file() {
+        bail!("the bundled clip is not at {}: give a CLIP", clip.display());
+    }
+    let out = args.out.clone().unwrap_or_else(|| default_out(&clip));
+    let settings = Settings {
+        profile: args.options.profile()?,
+        config: args.options.imitator_config(),
+        hold: args.options.hold,
+        map: args.options.skeleton_map()?,
+    };
+    let bar = ProgressBar::hidden();
+    let mut progress = |event: Progress| match event {
+        Progress::Start(total) if report.human() => {
+            bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
+            match total {
+                Some(n) => bar.set_length(n),
+                None => bar.set_style(
+                    ProgressStyle::with_template("{spinner} {pos} frames")
+                        .unwrap_or_else(|_| ProgressStyle::default_spinner()),
+                ),
+            }
+            bar.enable_steady_tick(Duration::from_millis(200));
+        }
+        Progress::Start(_) => {}
+        Progress::Frames(n) => bar.set_position(n),
+    };
+    let metrics = imitate_into(&clip, &out, &settings, &mut progress);
+    bar.finish_and_clear();
+    let metrics = metrics?;
+    if report.json {
+        let value = json!({
+            "clip": clip,
+            "out": out,
+            "files": OUTPUT_FILES,
+            "metrics": serde_json::from_str::<serde_json::Value>(&taskstack::batch::metrics_json(&metrics, &clip))?,
+        });
+        println!("{value}");
+    } else if !report.quiet {
+        print_summary(&metrics, &clip, &out, &settings);
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn print_summary(m: &ImitationMetrics, clip: &Path, out: &Path, settings: &Settings) {
+    let hold_frames = m.frames - m.clip_frames;
+    println!(
+        "{} on {}: {} frames ({:.2} s) of the clip, then {} frames ({:.2} s) holding its last pose",
+        clip.display(),
+        settings.profile.name,
+        m.clip_frames,
+        m.clip_duration,
+        hold_frames,
+        m.duration - m.clip_duration
+    );
+    println!(
+        "support changes: human {}, robot {} ({})",
+        m.human_support_changes,
+        m.robot_support_changes,
+        m.robot_support_sequence.join(" → ")
+    );
+    println!(
+        "distance of each effector to the scaled human over the clip, while its phase tracks it (cm):"
+    );
+    println!(
+        "  {:8} {:>22} {:>22}",
+        "", "single support", "double support"
+    );
+    println!(
+        "  {:8} {:>22} {:>22}",
+        "", "mean / max (frames)", "mean / max (frames)"
+    );
+    for e in &m.effectors_clip {
+        let cell = |s: &taskstack::imitation::metrics::MeanMax| match s.count {
+            0 => "not tracked".to_owned(),
+            n => format!("{:.1} / {:.1} ({n})", s.mean * 100.0, s.max * 100.0),
+        };
+        println!(
+            "  {:8} {:>22} {:>22}",
+            e.name,
+            cell(&e.single_support),
+            cell(&e.double_support)
+        );
+    }
+    println!(
+        "balance: CoM ground projection at least {:.1} mm inside the support polygon ({} frames outside)",
+        m.min_com_margin * 1000.0,
+        m.frames_com_outside
+    );
+    println!(
+        "limits: {} joint-position and {} joint-velocity violations (joint × frame)",
+        m.joint_limit_violations, m.velocity_limit_violations
+    );
+    println!(
+        "standing feet: slip {:.2} mm / turn {:.3}° (support foot), {:.2} mm / {:.3}° (other foot)",
+        m.max_support_slip * 1000.0,
+        m.max_support_turn.to_degrees(),
+        m.max_held_foot_slip * 1000.0,
+        m.max_held_foot_turn.to_degrees()
+    );
+    let t = &m.travel;
+    println!(
+        "travel: scaled human {:.3} m, robot {:.3} m; steps: human {}, robot {}",
+        t.scaled_human_m, t.robot_m, m.human_steps, m.robot_steps
+    );
+    let s = &m.solve_time_us;
+    println!(
+        "time per frame: median {:.0} µs, 99th percentile {:.0} µs",
+        s.median, s.p99
+    );
+    println!("wrote {}/{{{}}}", out.display(), OUTPUT_FILES.join(", "));
+}

@@ -1,0 +1,89 @@
+//! `taskstack`: the command-line tool of the taskstack crate. Imitates motion clips with a
+//! humanoid (one clip or a batch), solves benchmark problems, computes forward kinematics, and
+//! writes a 3D viewer of every run. `taskstack --help` and `taskstack help COMMAND` explain
+//! every option.
+
+mod batch;
+mod fk;
+mod imitate;
+mod options;
+mod plots;
+mod run;
+mod solve;
+mod svg;
+mod view;
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+/// Prioritized task-stack inverse kinematics and online human-to-humanoid motion imitation.
+///
+/// Units everywhere: metres, radians, seconds. World axes: x forward, y left, z up.
+#[derive(Debug, Parser)]
+#[command(name = "taskstack", version, propagate_version = true)]
+struct Cli {
+    /// Print nothing but errors: no progress bar, no summary.
+    #[arg(long, short, global = true)]
+    quiet: bool,
+    /// Print the result on stdout as one JSON document (for scripts) instead of the summary.
+    #[arg(long, global = true)]
+    json: bool,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    Imitate(imitate::ImitateArgs),
+    Batch(batch::BatchArgs),
+    Fk(fk::FkArgs),
+    Solve(solve::SolveArgs),
+    View(view::ViewArgs),
+}
+
+/// How the command reports: progress and summary for people, JSON for scripts, or nothing.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Report {
+    pub(crate) quiet: bool,
+    pub(crate) json: bool,
+}
+
+impl Report {
+    /// Whether to show progress bars and human summaries.
+    pub(crate) fn human(self) -> bool {
+        !self.quiet && !self.json
+    }
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let report = Report {
+        quiet: cli.quiet,
+        json: cli.json,
+    };
+    let result = match cli.command {
+        Command::Imitate(args) => imitate::run(args, report),
+        Command::Batch(args) => batch::run(args, report),
+        Command::Fk(args) => fk::run(args),
+        Command::Solve(args) => solve::run(args, report),
+        Command::View(args) => view::run(args, report),
+    };
+    match result {
+        Ok(code) => code,
+        Err(error) if is_broken_pipe(&error) => ExitCode::SUCCESS,
+        Err(error) => {
+            eprintln!("taskstack: error: {error:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// A reader of our stdout went away (`taskstack … | head`): not an error of ours.
+fn is_broken_pipe(error: &anyhow::Error) -> bool {
+    error.chain().any(|cause| {
+        cause
+            .downcast_ref::<std::io::Error>()
+            .is_some_and(|e| e.kind() == std::io::ErrorKind::BrokenPipe)
+    })
+}

@@ -1,0 +1,158 @@
+//! Options shared by `imitate` and `batch`: the robot, the imitator's settings, the hold.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use clap::Args;
+use taskstack::ImitatorConfig;
+use taskstack::io::clip::Clip;
+use taskstack::io::skeleton_map::SkeletonMap;
+use taskstack::robots::{BipedProfile, g1, nao};
+
+/// The longest hold after a clip (s): an hour of the last pose is more than any step needs.
+pub(crate) const MAX_HOLD: f64 = 3600.0;
+
+#[derive(Debug, Clone, Args)]
+pub(crate) struct ImitationOptions {
+    /// The robot: `nao` (NAO H25 V5), `g1` (Unitree G1, 29 DoF) or a biped profile file
+    /// (TOML next to a URDF; see `taskstack::robots::BipedProfile::from_toml_file`).
+    #[arg(long, value_name = "nao|g1|PROFILE.toml", default_value = "nao")]
+    pub(crate) robot: String,
+    /// Let the robot's feet follow the human's footprints: it walks where the human walks, one
+    /// step at a time. Without it the robot stands on one leg when the human does, and puts the
+    /// foot back where it was.
+    #[arg(long)]
+    pub(crate) walk: bool,
+    /// After the clip, hold the human's last pose this long (s, frames 1/120 s apart) so the
+    /// robot can finish the step it is taking; those frames are in every output. At most 3600.
+    #[arg(long, value_name = "SECONDS", default_value_t = 5.0, value_parser = hold,
+          allow_negative_numbers = true)]
+    pub(crate) hold: f64,
+    /// Share of each joint's rated velocity the legs may use (0 < F ≤ 1; Poubel et al. use 0.1).
+    #[arg(long, value_name = "F", default_value_t = 0.1, value_parser = fraction,
+          allow_negative_numbers = true)]
+    pub(crate) velocity_fraction: f64,
+    /// Share of the rated velocity the arms, head and torso may use (0 < F ≤ 1). Default: the
+    /// robot profile's (NAO 0.5, G1 0.1).
+    #[arg(long, value_name = "F", value_parser = fraction, allow_negative_numbers = true)]
+    pub(crate) upper_body_fraction: Option<f64>,
+    /// Fastest speed of the CoM and foot targets (m/s, > 0). Default: the profile's (0.15).
+    #[arg(long, value_name = "M_PER_S", value_parser = positive, allow_negative_numbers = true)]
+    pub(crate) task_speed: Option<f64>,
+    /// Fastest speed of the hand targets toward the scaled human (m/s, > 0). Default: the
+    /// profile's (NAO 0.15, G1 0.3).
+    #[arg(long, value_name = "M_PER_S", value_parser = positive, allow_negative_numbers = true)]
+    pub(crate) tracking_speed: Option<f64>,
+    /// Solver iterations per human frame (1–100).
+    #[arg(long, value_name = "N", default_value_t = 1,
+          value_parser = clap::value_parser!(u32).range(1..=100))]
+    pub(crate) iterations: u32,
+    /// Read BVH clips whose joints do not carry the CMU names through this skeleton map (TOML:
+    /// unit scale, up axis, frames to skip, human joint = BVH joint name).
+    #[arg(long, value_name = "MAP.toml")]
+    pub(crate) skeleton: Option<PathBuf>,
+}
+
+impl ImitationOptions {
+    /// The robot named by `--robot`.
+    pub(crate) fn profile(&self) -> Result<BipedProfile> {
+        Ok(match self.robot.as_str() {
+            "nao" => nao::profile(),
+            "g1" => g1::profile(),
+            path => BipedProfile::from_toml_file(path)
+                .with_context(|| format!("--robot {path}: not nao, g1 or a readable profile"))?,
+        })
+    }
+
+    /// The skeleton map of `--skeleton`, read once for every clip.
+    pub(crate) fn skeleton_map(&self) -> Result<Option<SkeletonMap>> {
+        self.skeleton
+            .as_ref()
+            .map(|path| {
+                SkeletonMap::from_toml_file(path)
+                    .with_context(|| format!("--skeleton {}", path.display()))
+            })
+            .transpose()
+    }
+
+    /// The imitator settings of these options (support detection is set per clip).
+    pub(crate) fn imitator_config(&self) -> ImitatorConfig {
+        let mut config = ImitatorConfig {
+            velocity_fraction: self.velocity_fraction,
+            upper_body_velocity_fraction: self.upper_body_fraction,
+            max_task_speed: self.task_speed,
+            max_tracking_speed: self.tracking_speed,
+            iterations_per_frame: self.iterations as usize,
+            ..ImitatorConfig::default()
+        };
+        config.footsteps.follow = self.walk;
+        config
+    }
+}
+
+/// Opens a clip, by the map if one is given; the error names the file.
+pub(crate) fn open_clip(path: &Path, map: Option<&SkeletonMap>) -> Result<Clip> {
+    if path.is_dir() {
+        anyhow::bail!("clip {}: is a folder, not a clip file", path.display());
+    }
+    let clip = match map {
+        None => Clip::open(path),
+        Some(map) => Clip::open_mapped(path, map),
+    };
+    clip.with_context(|| format!("clip {}", path.display()))
+}
+
+fn number(text: &str) -> Result<f64, String> {
+    let value: f64 = text
+        .parse()
+        .map_err(|_| format!("`{text}` is not a number"))?;
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(format!("`{text}` is not finite"))
+    }
+}
+
+fn positive(text: &str) -> Result<f64, String> {
+    let value = number(text)?;
+    if value > 0.0 {
+        Ok(value)
+    } else {
+        Err(format!("{value} is not > 0"))
+    }
+}
+
+fn fraction(text: &str) -> Result<f64, String> {
+    let value = positive(text)?;
+    if value <= 1.0 {
+        Ok(value)
+    } else {
+        Err(format!("{value} is not ≤ 1"))
+    }
+}
+
+fn hold(text: &str) -> Result<f64, String> {
+    let value = number(text)?;
+    if (0.0..=MAX_HOLD).contains(&value) {
+        Ok(value)
+    } else {
+        Err(format!("{value} s is not within 0–{MAX_HOLD} s"))
+    }
+}
+
+impl ImitationOptions {
+    /// The default options with `--robot robot` (for commands that only need the robot).
+    pub(crate) fn for_robot(robot: &str) -> Self {
+        Self {
+            robot: robot.to_owned(),
+            walk: false,
+            hold: 0.0,
+            velocity_fraction: 0.1,
+            upper_body_fraction: None,
+            task_speed: None,
+            tracking_speed: None,
+            iterations: 1,
+            skeleton: None,
+        }
+    }
+}

@@ -1,0 +1,301 @@
+//! `view.html`: a self-contained 3D viewer of an imitation run (the robot drawn from its model's
+//! links, the scaled human, the floor, the support polygon, the CoM ground projection, the
+//! phases), written while the clip is imitated; and the `view` command that opens it.
+//!
+//! The file is the page template (`viewer.html`) with the run's data spliced in as compact JSON:
+//! positions in integer millimetres, at most [`VIEW_RATE`] frames per second, so a 60 s clip
+//! stays around 2 MB. Frames are written as they come, so memory stays flat.
+
+use std::io::Write;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::{Context, Result, bail};
+use clap::Args;
+use serde_json::json;
+use taskstack::human::{HumanJoint, Side};
+use taskstack::imitation::metrics::CONTACT_HEIGHT;
+use taskstack::imitation::phase::SupportPhase;
+use taskstack::imitation::support::HumanSupport;
+use taskstack::model::{FrameId, Model, ModelData};
+use taskstack::{Imitator, IsometryMatrix3, RobotFrame, Vector3};
+
+use crate::Report;
+
+/// The page: a script that draws the data it finds in `const RUN` and `const FRAMES`.
+const TEMPLATE: &str = include_str!("viewer.html");
+/// Where the data goes in [`TEMPLATE`].
+const DATA_MARK: &str = "/*RUN DATA*/";
+
+/// Frames per second of the viewer's data (the run's frames are thinned to at most this rate).
+pub(crate) const VIEW_RATE: f64 = 30.0;
+
+/// Segments shorter than this are not drawn (m): joints whose frames share an origin.
+const MIN_SEGMENT: f64 = 0.005;
+
+/// Streams `view.html` for one run.
+pub(crate) struct ViewWriter<W: Write> {
+    out: W,
+    /// The model rooted at the right sole: every frame is drawn with it, whatever the root, so
+    /// the point list stays the same (the sole's world placement puts it in place).
+    model: Model,
+    data: ModelData,
+    right_sole: FrameId,
+    /// Links whose origins are drawn, in the order of each frame's point list.
+    links: Vec<usize>,
+    /// Named frames drawn as points beyond their link (hands, head…).
+    frames: Vec<FrameId>,
+    outlines: [Vec<[f64; 2]>; 2],
+    next_time: f64,
+    written: usize,
+    line: String,
+}
+
+impl<W: Write> ViewWriter<W> {
+    /// Writes the page and the run's constant data (robot segments, sole outlines, human
+    /// skeleton) for `imitator`'s robot; `title` names the run.
+    pub(crate) fn new(mut out: W, imitator: &Imitator, title: &str) -> Result<Self> {
+        let profile = imitator.profile();
+        let model = profile.model(Side::Right).clone();
+        let mut data = model.new_data();
+        let right_sole = model.frame_id(&profile.foot(Side::Right).sole)?;
+        let stand = &profile.stand;
+        model.forward_kinematics(&mut data, stand)?;
+        let origin = |link: usize| data.link_placement(link).translation.vector;
+        // A segment per joint from its parent's origin to its child's, when they are apart.
+        let mut links: Vec<usize> = Vec::new();
+        let point =
+            |link: usize, links: &mut Vec<usize>| match links.iter().position(|&l| l == link) {
+                Some(i) => i,
+                None => {
+                    links.push(link);
+                    links.len() - 1
+                }
+            };
+        let mut segments = Vec::new();
+        for (j, joint) in model.joints().iter().enumerate() {
+            let (parent, child) = (joint.antecedent, j + 1);
+            if (origin(child) - origin(parent)).norm() >= MIN_SEGMENT {
+                let a = point(parent, &mut links);
+                let b = point(child, &mut links);
+                segments.push([a, b]);
+            }
+        }
+        let drawn = [&profile.hands[0], &profile.hands[1], &profile.torso];
+        let mut frames = Vec::new();
+        for name in drawn {
+            let id = model.frame_id(name)?;
+            let link = model.frames()[id.index()].link;
+            let to = data.frame_placement(id).translation.vector;
+            if (to - origin(link)).norm() >= MIN_SEGMENT {
+                let a = point(link, &mut links);
+                frames.push(id);
+                segments.push([a, usize::MAX - frames.len() + 1]);
+            }
+        }
+        // Frame points follow the link points in each frame's list.
+        let n = links.len();
+        for s in &mut segments {
+            if s[1] > usize::MAX / 2 {
+                s[1] = n + (usize::MAX - s[1]);
+            }
+        }
+        let height = (0..model.links().len())
+            .map(|l| origin(l).z)
+            .fold(0.0, f64::max);
+        let human: Vec<[usize; 2]> = HumanJoint::ALL
+            .iter()
+            .filter_map(|j| j.antecedent().map(|a| [a.index(), j.index()]))
+            .collect();
+        let outlines = [Side::Left, Side::Right].map(|s| profile.foot(s).outline.clone());
+        let run = json!({
+            "title": title,
+            "robot": profile.name,
+            "height_m": height,
+            "segments": segments,
+            "human_segments": human,
+            "human_joints": HumanJoint::ALL.iter().map(|j| j.name()).collect::<Vec<_>>(),
+            "rate_hz": VIEW_RATE,
+            "phases": SupportPhase::ALL.iter().map(ToString::to_string).collect::<Vec<_>>(),
+        });
+        let (head, _) = split_template()?;
+        write!(out, "{head}const RUN = {run};\nconst FRAMES = [\n")?;
+        Ok(Self {
+            out,
+            model,
+            data,
+            right_sole,
+            links,
+            frames,
+            outlines,
+            next_time: f64::NEG_INFINITY,
+            written: 0,
+            line: String::new(),
+        })
+    }
+
+    /// Adds robot frame `r` if it is due at [`VIEW_RATE`]. Each frame is
+    /// `[time ms, phase, human support, robot points, human points, left sole, right sole,
+    /// CoM xy, grounded bits]`, lengths in mm in the world frame.
+    pub(crate) fn frame(&mut self, r: &RobotFrame) -> Result<()> {
+        if r.time < self.next_time {
+            return Ok(());
+        }
+        // 1 % early, so that frames 1/120 s apart are kept every fourth, not fifth.
+        self.next_time = r.time + 0.99 / VIEW_RATE;
+        self.model.forward_kinematics(&mut self.data, &r.q)?;
+        let world_t_base = r.right_sole * self.data.frame_placement(self.right_sole).inverse();
+        let phase = r.phase.index();
+        let line = &mut self.line;
+        line.clear();
+        line.push_str(&format!(
+            "[{},{},{},[",
+            (r.time * 1000.0).round(),
+            phase,
+            human_support_index(r.human_support)
+        ));
+        let mut first = true;
+        let links = self.links.iter().map(|&l| self.data.link_placement(l));
+        let frames = self.frames.iter().map(|&f| self.data.frame_placement(f));
+        for placement in links.chain(frames) {
+            let p = world_t_base.transform_point(&placement.translation.vector.into());
+            push_point(line, &mut first, &p.coords);
+        }
+        line.push_str("],[");
+        let mut first = true;
+        for reference in &r.reference {
+            if !first {
+                line.push(',');
+            }
+            first = false;
+            match reference {
+                Some(p) => {
+                    let w = r.world_t_root.transform_point(&(*p).into()).coords;
+                    push_xyz(line, &w);
+                }
+                None => line.push_str("null,null,null"),
+            }
+        }
+        line.push(']');
+        let mut grounded = 0;
+        for (i, sole) in [&r.left_sole, &r.right_sole].into_iter().enumerate() {
+            line.push_str(",[");
+            let mut first = true;
+            let mut on_ground = true;
+            for &[x, y] in &self.outlines[i] {
+                let corner = sole_point(sole, x, y);
+                on_ground &= corner.z.abs() <= CONTACT_HEIGHT;
+                push_point(line, &mut first, &corner);
+            }
+            line.push(']');
+            grounded |= u8::from(on_ground) << i;
+        }
+        line.push_str(&format!(
+            ",[{},{}],{grounded}],\n",
+            mm(r.com.x),
+            mm(r.com.y)
+        ));
+        self.out.write_all(line.as_bytes())?;
+        self.written += 1;
+        Ok(())
+    }
+
+    /// Closes the data (the clip's last time `clip_end`, s, after which the human holds its
+    /// pose; the run's `summary`) and writes the rest of the page.
+    pub(crate) fn finish(mut self, clip_end: f64, summary: serde_json::Value) -> Result<()> {
+        let tail = json!({ "clip_end_ms": (clip_end * 1000.0).round(),
+                           "summary": summary, "frames": self.written });
+        let (_, rest) = split_template()?;
+        write!(self.out, "];\nconst TAIL = {tail};\n{rest}")?;
+        self.out.flush()?;
+        Ok(())
+    }
+}
+
+fn split_template() -> Result<(&'static str, &'static str)> {
+    TEMPLATE
+        .split_once(DATA_MARK)
+        .context("the viewer template has no data mark")
+}
+
+fn mm(v: f64) -> i64 {
+    (v * 1000.0).round() as i64
+}
+
+fn push_xyz(line: &mut String, p: &Vector3<f64>) {
+    line.push_str(&format!("{},{},{}", mm(p.x), mm(p.y), mm(p.z)));
+}
+
+fn push_point(line: &mut String, first: &mut bool, p: &Vector3<f64>) {
+    if !*first {
+        line.push(',');
+    }
+    *first = false;
+    push_xyz(line, p);
+}
+
+fn sole_point(sole: &IsometryMatrix3<f64>, x: f64, y: f64) -> Vector3<f64> {
+    sole.transform_point(&Vector3::new(x, y, 0.0).into()).coords
+}
+
+fn human_support_index(support: HumanSupport) -> u8 {
+    match support {
+        HumanSupport::Double => 0,
+        HumanSupport::Right => 1,
+        HumanSupport::Left => 2,
+        HumanSupport::Airborne => 3,
+    }
+}
+
+/// Open the 3D viewer of an output folder of `taskstack imitate` or `taskstack batch`.
+///
+/// Prints the path of OUT_DIR/view.html and opens it in the system's browser (xdg-open, open or
+/// start). The page needs no network: everything is in the one file.
+#[derive(Debug, Args)]
+pub(crate) struct ViewArgs {
+    /// An output folder of `imitate` (it holds view.html).
+    #[arg(value_name = "OUT_DIR")]
+    out: PathBuf,
+    /// Only print the page's path; do not start a browser.
+    #[arg(long)]
+    no_open: bool,
+}
+
+pub(crate) fn run(args: ViewArgs, report: Report) -> Result<ExitCode> {
+    if !args.out.is_dir() {
+        bail!("output folder {}: not a folder", args.out.display());
+    }
+    let page = args.out.join("view.html");
+    if !page.is_file() {
+        bail!(
+            "output folder {}: no view.html (write one with `taskstack imitate CLIP --out {}`)",
+            args.out.display(),
+            args.out.display()
+        );
+    }
+    let page = page.canonicalize().context("view.html")?;
+    if report.json {
+        println!("{}", json!({ "view": page }));
+    } else if !report.quiet {
+        println!("{}", page.display());
+    }
+    if !args.no_open {
+        open_in_browser(&page)?;
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn open_in_browser(page: &std::path::Path) -> Result<()> {
+    let opener = if cfg!(target_os = "macos") {
+        "open"
+    } else if cfg!(windows) {
+        "explorer"
+    } else {
+        "xdg-open"
+    };
+    std::process::Command::new(opener)
+        .arg(page)
+        .spawn()
+        .with_context(|| format!("cannot start `{opener}`; open {} yourself", page.display()))?;
+    Ok(())
+}

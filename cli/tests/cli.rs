@@ -1,0 +1,421 @@
+//! The `taskstack` command as a user meets it: help texts, the happy paths, and every kind of
+//! bad input with its exit status and a message naming the culprit.
+
+mod common;
+
+use common::{KINECT, WALK, clip, s, taskstack, taskstack_with_input, temp_dir};
+use serde_json::Value;
+
+#[test]
+fn every_subcommand_explains_its_options_and_outputs() {
+    let top = taskstack(&["--help"]);
+    assert_eq!(top.code, Some(0), "{}", top.stderr);
+    for command in ["imitate", "batch", "fk", "solve", "view"] {
+        assert!(
+            top.stdout.contains(command),
+            "top-level help lists {command}"
+        );
+    }
+    let imitate = taskstack(&["imitate", "--help"]);
+    assert_eq!(imitate.code, Some(0));
+    for needle in [
+        "joints.csv",
+        "metrics.json",
+        "view.html",
+        "effectors.svg",
+        "com.svg",
+        "phases.svg",
+        "joints.svg",
+        "--hold",
+        "[default: 5]",
+        "--velocity-fraction",
+        "m/s",
+        "--robot",
+        "--walk",
+        "--out",
+        "--skeleton",
+        "--quiet",
+        "--json",
+    ] {
+        assert!(
+            imitate.stdout.contains(needle),
+            "imitate --help mentions {needle}:\n{}",
+            imitate.stdout
+        );
+    }
+    for (command, needles) in [
+        (
+            "batch",
+            &["--jobs", "--out", "metrics.json", "exit status"][..],
+        ),
+        ("fk", &["metres", "radians", "--root", "--urdf"][..]),
+        (
+            "solve",
+            &["PROBLEM.json", "--frames", "--repeats", "µs"][..],
+        ),
+        ("view", &["OUT_DIR", "--no-open"][..]),
+    ] {
+        let help = taskstack(&[command, "--help"]);
+        assert_eq!(help.code, Some(0), "{command} --help");
+        for needle in needles {
+            assert!(
+                help.stdout.contains(needle),
+                "{command} --help mentions {needle}:\n{}",
+                help.stdout
+            );
+        }
+    }
+    // -h is help, not a clip path.
+    assert_eq!(taskstack(&["imitate", "-h"]).code, Some(0));
+}
+
+#[test]
+fn imitate_writes_every_output_and_reports_clip_and_hold_apart() {
+    let out = temp_dir("imitate").join("run");
+    let clip = clip(KINECT);
+    let run = taskstack(&["imitate", s(&clip), "--out", s(&out), "--hold", "0.5"]);
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    for file in [
+        "joints.csv",
+        "metrics.json",
+        "view.html",
+        "effectors.svg",
+        "com.svg",
+        "phases.svg",
+        "joints.svg",
+    ] {
+        let len = std::fs::metadata(out.join(file))
+            .map(|m| m.len())
+            .unwrap_or(0);
+        assert!(len > 100, "{file} written ({len} bytes)");
+    }
+    let metrics: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("metrics.json")).unwrap()).unwrap();
+    let frames = metrics["frames"].as_u64().unwrap();
+    let clip_frames = metrics["clip_frames"].as_u64().unwrap();
+    // The hold: 0.5 s of frames 1/120 s apart after the clip.
+    assert_eq!(frames - clip_frames, 60);
+    let lines = std::fs::read_to_string(out.join("joints.csv"))
+        .unwrap()
+        .lines()
+        .count() as u64;
+    assert_eq!(lines, frames + 1, "a header and one line per frame");
+    assert!(
+        run.stdout.contains(&format!("{clip_frames} frames")),
+        "{}",
+        run.stdout
+    );
+    assert!(
+        run.stdout
+            .contains("60 frames (0.50 s) holding its last pose"),
+        "{}",
+        run.stdout
+    );
+}
+
+#[test]
+fn imitate_json_is_one_document_for_scripts_and_quiet_prints_nothing() {
+    let dir = temp_dir("json");
+    let clip = clip(KINECT);
+    let json = taskstack(&[
+        "--json",
+        "imitate",
+        s(&clip),
+        "--out",
+        s(&dir.join("a")),
+        "--hold",
+        "0",
+    ]);
+    assert_eq!(json.code, Some(0), "{}", json.stderr);
+    let value: Value = serde_json::from_str(&json.stdout).expect("stdout is one JSON document");
+    assert!(value["metrics"]["hand_lag_s"].is_number());
+    assert_eq!(value["files"].as_array().map(Vec::len), Some(7));
+    let quiet = taskstack(&[
+        "-q",
+        "imitate",
+        s(&clip),
+        "--out",
+        s(&dir.join("b")),
+        "--hold",
+        "0",
+    ]);
+    assert_eq!(quiet.code, Some(0), "{}", quiet.stderr);
+    assert_eq!(quiet.stdout, "");
+    assert_eq!(quiet.stderr, "");
+}
+
+/// Expects exit status `code` and every one of `needles` in stderr.
+fn fails(args: &[&str], code: i32, needles: &[&str]) {
+    let run = taskstack(args);
+    assert_eq!(run.code, Some(code), "{args:?}: {}", run.stderr);
+    for needle in needles {
+        assert!(
+            run.stderr.contains(needle),
+            "{args:?}: stderr names {needle}:\n{}",
+            run.stderr
+        );
+    }
+}
+
+#[test]
+fn bad_clips_are_errors_naming_the_clip() {
+    let dir = temp_dir("bad-clips");
+    let out = dir.join("out");
+    let missing = dir.join("missing.bvh");
+    fails(
+        &["imitate", s(&missing), "--out", s(&out)],
+        1,
+        &["missing.bvh"],
+    );
+    let empty = dir.join("empty.bvh");
+    std::fs::write(&empty, "").unwrap();
+    fails(&["imitate", s(&empty), "--out", s(&out)], 1, &["empty.bvh"]);
+    // A BVH cut in the middle of its motion: the first frames are fine, the last line is short.
+    let text = std::fs::read_to_string(clip(WALK)).unwrap();
+    let truncated = dir.join("truncated.bvh");
+    std::fs::write(&truncated, &text[..text.len() * 2 / 3]).unwrap();
+    fails(
+        &["imitate", s(&truncated), "--out", s(&out), "--hold", "0"],
+        1,
+        &["truncated.bvh"],
+    );
+    // A header and no frame of motion.
+    let header = text.split("Frame Time:").next().unwrap().replace(
+        text.lines().find(|l| l.starts_with("Frames:")).unwrap(),
+        "Frames: 0",
+    );
+    let frameless = dir.join("frameless.bvh");
+    std::fs::write(&frameless, header + "Frame Time: 0.008333\n").unwrap();
+    fails(
+        &["imitate", s(&frameless), "--out", s(&out)],
+        1,
+        &["frameless.bvh", "no frame"],
+    );
+    let garbage = dir.join("notes.bvh");
+    std::fs::write(&garbage, "these are my notes, not a clip\n").unwrap();
+    fails(
+        &["imitate", s(&garbage), "--out", s(&out)],
+        1,
+        &["notes.bvh"],
+    );
+    let kinect = dir.join("table.csv");
+    std::fs::write(&kinect, "a,b,c\n1,2,3\n").unwrap();
+    fails(
+        &["imitate", s(&kinect), "--out", s(&out)],
+        1,
+        &["table.csv"],
+    );
+    fails(&["imitate", s(&dir), "--out", s(&out)], 1, &["is a folder"]);
+}
+
+#[test]
+fn an_unwritable_output_folder_fails_before_any_work_naming_the_folder() {
+    let dir = temp_dir("unwritable");
+    let file = dir.join("a-file");
+    std::fs::write(&file, "").unwrap();
+    let out = file.join("out");
+    let run = taskstack(&["imitate", s(&clip(WALK)), "--out", s(&out)]);
+    assert_eq!(run.code, Some(1));
+    assert!(
+        run.stderr.contains("output folder") && run.stderr.contains("a-file/out"),
+        "{}",
+        run.stderr
+    );
+    assert!(
+        !run.stderr.contains("slow_walk.bvh:"),
+        "the clip is not blamed: {}",
+        run.stderr
+    );
+}
+
+#[test]
+fn bad_options_are_usage_errors_naming_the_option() {
+    let clip = clip(KINECT);
+    let c = s(&clip);
+    fails(&["imitate", c, "--frobnicate"], 2, &["--frobnicate"]);
+    fails(&["imitate", c, "--hold", "abc"], 2, &["--hold", "abc"]);
+    fails(&["imitate", c, "--hold", "1e12"], 2, &["--hold"]);
+    fails(&["imitate", c, "--hold", "-1"], 2, &["--hold"]);
+    fails(
+        &["imitate", c, "--velocity-fraction", "2"],
+        2,
+        &["--velocity-fraction"],
+    );
+    fails(&["imitate", c, "--task-speed", "0"], 2, &["--task-speed"]);
+    fails(
+        &["imitate", c, "--tracking-speed", "NaN"],
+        2,
+        &["--tracking-speed"],
+    );
+    fails(&["imitate", c, "--iterations", "0"], 2, &["--iterations"]);
+    fails(
+        &["imitate", c, "--robot", "no-such-robot.toml"],
+        1,
+        &["--robot", "no-such-robot.toml"],
+    );
+    fails(
+        &["imitate", c, "--skeleton", "no-such-map.toml"],
+        1,
+        &["--skeleton", "no-such-map.toml"],
+    );
+    fails(&["batch", c], 2, &["--out"]);
+    fails(&["frobnicate"], 2, &["frobnicate"]);
+}
+
+#[test]
+fn batch_runs_every_clip_and_keeps_going_past_a_bad_one() {
+    let dir = temp_dir("batch");
+    let clips = dir.join("clips");
+    std::fs::create_dir_all(&clips).unwrap();
+    std::fs::copy(clip(KINECT), clips.join("wave.csv")).unwrap();
+    std::fs::copy(
+        clip("kinect2_labanotation_ges02_balancinghands.csv"),
+        clips.join("balance.csv"),
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let run = taskstack(&[
+        "batch",
+        s(&clips),
+        "--out",
+        s(&out),
+        "--jobs",
+        "2",
+        "--hold",
+        "0",
+    ]);
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    for name in ["wave", "balance"] {
+        assert!(
+            out.join(name).join("view.html").is_file(),
+            "{name} has its outputs"
+        );
+        assert!(
+            run.stdout.contains(&format!("{name}.csv")),
+            "the table lists {name}: {}",
+            run.stdout
+        );
+    }
+    assert!(run.stdout.contains("2 of 2 clips"), "{}", run.stdout);
+
+    std::fs::write(clips.join("broken.csv"), "not,a,kinect,file\n").unwrap();
+    let run = taskstack(&[
+        "--json",
+        "batch",
+        s(&clips),
+        "--out",
+        s(&out),
+        "--hold",
+        "0",
+    ]);
+    assert_eq!(run.code, Some(1), "a failed clip fails the batch");
+    let value: Value = serde_json::from_str(&run.stdout).expect("one JSON document");
+    let clips = value["clips"].as_array().unwrap();
+    assert_eq!(clips.len(), 3);
+    let broken = clips
+        .iter()
+        .find(|c| c["clip"].as_str().unwrap().ends_with("broken.csv"))
+        .unwrap();
+    assert_eq!(broken["ok"], false);
+    assert!(broken["error"].as_str().unwrap().contains("broken.csv"));
+    assert_eq!(clips.iter().filter(|c| c["ok"] == true).count(), 2);
+    fails(
+        &["batch", s(&dir.join("nowhere")), "--out", s(&out)],
+        1,
+        &["nowhere"],
+    );
+}
+
+#[test]
+fn fk_answers_json_lines_and_names_the_bad_line() {
+    let run = taskstack_with_input(
+        &["fk"],
+        "{\"q\": {\"LShoulderPitch\": 0.5}}\n\n{\"q\": {}}\n",
+    );
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    let lines: Vec<Value> = run
+        .stdout
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(lines.len(), 2, "one line per non-blank input line");
+    // At the standing zero posture of the NAO rooted at the right sole, the left sole is 100 mm
+    // to the left (hip offsets ±50 mm) on the floor: the URDF's HipOffsetY.
+    let l_sole = &lines[1]["frames"]["l_sole"];
+    assert!((l_sole[1].as_f64().unwrap() - 0.1).abs() < 1e-9, "{l_sole}");
+    assert!(l_sole[2].as_f64().unwrap().abs() < 1e-9);
+    // The coupled hip: RHipYawPitch drives the same motor as LHipYawPitch.
+    let run = taskstack_with_input(
+        &["fk"],
+        "{\"q\": {\"LHipYawPitch\": 0.1, \"RHipYawPitch\": 0.2}}\n",
+    );
+    assert_eq!(run.code, Some(1));
+    assert!(
+        run.stderr.contains("input line 1") && run.stderr.contains("one motor"),
+        "{}",
+        run.stderr
+    );
+    let run = taskstack_with_input(&["fk"], "{\"q\": {}}\n{\"q\": {\"Elbow\": 1}}\n");
+    assert_eq!(run.code, Some(1));
+    assert!(
+        run.stderr.contains("input line 2") && run.stderr.contains("Elbow"),
+        "{}",
+        run.stderr
+    );
+    assert_eq!(
+        run.stdout.lines().count(),
+        1,
+        "the good line before it was answered"
+    );
+}
+
+#[test]
+fn solve_runs_a_benchmark_problem() {
+    let problem = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../tests/data/bench/problem_rs.json");
+    let run = taskstack(&["--json", "solve", s(&problem), "--frames", "3"]);
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    let value: Value = serde_json::from_str(&run.stdout).unwrap();
+    assert_eq!(value["frames"].as_array().map(Vec::len), Some(3));
+    assert_eq!(value["summary"]["limit_violations"], 0);
+    let run = taskstack(&["solve", s(&problem), "--frames", "2"]);
+    assert!(
+        run.stdout.contains("worst error per task"),
+        "{}",
+        run.stdout
+    );
+    let dir = temp_dir("solve");
+    let bad = dir.join("bad.json");
+    std::fs::write(&bad, "{\"schema\": 1}").unwrap();
+    fails(&["solve", s(&bad)], 1, &["bad.json"]);
+    fails(&["solve", s(&problem), "--frames", "0"], 2, &["--frames"]);
+}
+
+#[test]
+fn view_prints_the_page_of_an_output_folder() {
+    let dir = temp_dir("view");
+    let out = dir.join("run");
+    let run = taskstack(&[
+        "-q",
+        "imitate",
+        s(&clip(KINECT)),
+        "--out",
+        s(&out),
+        "--hold",
+        "0",
+    ]);
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    let view = taskstack(&["view", s(&out), "--no-open"]);
+    assert_eq!(view.code, Some(0), "{}", view.stderr);
+    assert!(
+        view.stdout.trim_end().ends_with("view.html"),
+        "{}",
+        view.stdout
+    );
+    fails(&["view", s(&dir), "--no-open"], 1, &["no view.html"]);
+    fails(
+        &["view", s(&dir.join("none")), "--no-open"],
+        1,
+        &["not a folder"],
+    );
+}

@@ -1,0 +1,106 @@
+//! `view.html` in a real browser: a headless Chromium (or Chrome) loads the page of an imitation
+//! run with `#selftest`, which steps the playback and reports, per drawn frame, how many canvas
+//! pixels differ from the background, and every script error. Without a browser the test says
+//! so and passes, unless `TASKSTACK_REQUIRE_BROWSER` is set (CI sets it and installs Chromium).
+
+mod common;
+
+use std::path::PathBuf;
+use std::process::Command;
+
+use common::{KINECT, clip, s, taskstack, temp_dir};
+use serde_json::Value;
+
+/// The first browser found: `TASKSTACK_BROWSER`, else chromium, chromium-browser, google-chrome.
+fn browser() -> Option<PathBuf> {
+    let candidates = std::env::var_os("TASKSTACK_BROWSER")
+        .map(PathBuf::from)
+        .into_iter()
+        .chain(
+            [
+                "chromium",
+                "chromium-browser",
+                "google-chrome",
+                "google-chrome-stable",
+            ]
+            .map(PathBuf::from),
+        );
+    candidates.into_iter().find(|b| {
+        Command::new(b)
+            .arg("--version")
+            .output()
+            .is_ok_and(|o| o.status.success())
+    })
+}
+
+#[test]
+fn the_viewer_draws_and_plays_in_a_headless_browser() {
+    let Some(browser) = browser() else {
+        assert!(
+            std::env::var_os("TASKSTACK_REQUIRE_BROWSER").is_none(),
+            "TASKSTACK_REQUIRE_BROWSER is set but no Chromium or Chrome was found"
+        );
+        eprintln!("viewer test skipped: no chromium, chromium-browser or google-chrome on PATH");
+        return;
+    };
+    let out = temp_dir("viewer").join("run");
+    let run = taskstack(&[
+        "-q",
+        "imitate",
+        s(&clip(KINECT)),
+        "--out",
+        s(&out),
+        "--hold",
+        "1",
+    ]);
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    let page = out.join("view.html").canonicalize().unwrap();
+    let size = std::fs::metadata(&page).unwrap().len();
+    let profile = temp_dir("viewer-profile");
+    let output = Command::new(&browser)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--no-first-run",
+            "--window-size=900,600",
+            "--virtual-time-budget=5000",
+            "--enable-logging=stderr",
+            "--v=0",
+        ])
+        .arg(format!("--user-data-dir={}", s(&profile)))
+        .arg("--dump-dom")
+        .arg(format!("file://{}#selftest", s(&page)))
+        .output()
+        .expect("the browser runs");
+    let dom = String::from_utf8_lossy(&output.stdout);
+    let log = String::from_utf8_lossy(&output.stderr);
+    let report = dom
+        .split("<pre id=\"selftest\">")
+        .nth(1)
+        .and_then(|rest| rest.split("</pre>").next())
+        .unwrap_or_else(|| panic!("no self-test report in the page; browser log:\n{log}"));
+    let report: Value =
+        serde_json::from_str(&report.replace("&quot;", "\"")).expect("the report is JSON");
+    assert_eq!(
+        report["errors"],
+        Value::Array(vec![]),
+        "script errors: {report}"
+    );
+    let frames = report["frames"].as_u64().unwrap();
+    // Up to 30 frames per second of the 3.4 s clip (30 Hz, with dropped frames) and the 1 s hold.
+    assert!((100..=135).contains(&frames), "{report}");
+    let pixels = report["pixels"].as_f64().unwrap();
+    for drawn in report["drawn"].as_array().unwrap() {
+        // The floor grid, the robot, the human and the feet cover a few percent of the canvas.
+        let share = drawn.as_f64().unwrap() / pixels;
+        assert!(share > 0.01 && share < 0.9, "drawn share {share}: {report}");
+    }
+    let played = report["played_to"].as_u64().unwrap();
+    assert!(
+        (15..=31).contains(&played),
+        "one second of playback moves up to 30 frames: {report}"
+    );
+    assert!(!log.contains("Uncaught"), "console errors:\n{log}");
+    assert!(size < 2_000_000, "view.html is {size} bytes");
+}
