@@ -339,3 +339,37 @@ fn g1_step_does_not_allocate_after_warm_up() {
         "{after_warm_up} allocations in {frames} steps"
     );
 }
+
+/// The clip loop with its metrics keeps a flat heap however long the clip or the hold: live
+/// bytes at the clip's 1500th frame (past the hand-lag window) and at the end of a 20 s hold
+/// (2400 more frames) are the same. A per-frame buffer of 8 bytes would add 30 kB.
+#[test]
+fn the_clip_loop_and_its_metrics_keep_memory_flat() {
+    let name = "cmu_02_10_wash_self_standing_arm_gestures.bvh";
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/mocap")
+        .join(name);
+    let clip = Clip::open(&path).unwrap();
+    let mut imitator = Imitator::new(nao::profile(), ImitatorConfig::default()).unwrap();
+    let (mut frames, mut at_1500, mut last) = (0usize, 0isize, 0isize);
+    let metrics = taskstack::batch::imitate_clip(&path, clip, &mut imitator, 20.0, |_| {
+        frames += 1;
+        if frames == 1500 {
+            at_1500 = live_bytes();
+        }
+        last = live_bytes();
+    })
+    .unwrap();
+    assert!(
+        metrics.clip_frames > 2000,
+        "{} clip frames",
+        metrics.clip_frames
+    );
+    assert_eq!(metrics.frames - metrics.clip_frames, 2400);
+    assert!(
+        last - at_1500 <= 1024,
+        "the heap grew by {} bytes over {} frames",
+        last - at_1500,
+        frames - 1500
+    );
+}

@@ -153,69 +153,98 @@ impl StepCounter {
     }
 }
 
-/// One frame of the hand trace: the robot's hands (left, right), their references, and the
-/// support kind (1 single, 2 double, 0 a transition).
-pub(crate) type HandSample = ([Vector3<f64>; 2], [Option<Vector3<f64>>; 2], u8);
+/// Most lags (frames) the hand-lag search tries: [`MAX_LAG`] at up to 500 frames per second.
+const LAG_CAPACITY: usize = 1024;
 
-/// Per-frame hand positions and their references (world frame, m), for the lag search.
+/// Per lag, per hand, per support kind (single, double): error sum, maximum, count.
+type LagCells = [[(f64, f64, usize); 2]; 2];
+
+/// The hand-lag search, run as the frames come in memory bounded by [`LAG_CAPACITY`]: for every
+/// lag `k` it accumulates the errors between the robot's hands at frame `i + k` and the
+/// references of frame `i` (world frame, m), so no trace of the clip is kept.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct HandTrace {
-    pub(crate) times: Vec<f64>,
-    pub(crate) samples: Vec<HandSample>,
+    /// Times of the first frames: a lag `k` is searched if `first_times[k]` is within
+    /// [`MAX_LAG`] of the first.
+    first_times: Vec<f64>,
+    /// The references and support kinds (1 single, 2 double, 0 a transition) of the last
+    /// [`LAG_CAPACITY`] frames, frame `i` at `i % LAG_CAPACITY`.
+    recent: Vec<([Option<Vector3<f64>>; 2], u8)>,
+    frames: usize,
+    /// Per lag: error sum and count over both hands.
+    totals: Vec<(f64, usize)>,
+    /// Per lag: the errors by hand and support kind.
+    cells: Vec<LagCells>,
 }
 
 /// Mean hand errors (m) once the best lag is removed: `[hand][single, double]` as (mean, max,
 /// count), and the lag (s).
-pub(crate) type LagRemoved = ([[(f64, f64, usize); 2]; 2], f64);
+pub(crate) type LagRemoved = (LagCells, f64);
 
 impl HandTrace {
-    /// The lag (s) that minimises the mean hand error, and the errors with it removed.
-    pub(crate) fn lag_removed(&self) -> LagRemoved {
-        let n = self.samples.len();
-        let mut best = (f64::INFINITY, 0);
-        for k in 0..n {
-            if self.times[k] - self.times[0] > MAX_LAG {
+    /// Adds a frame at `time` (s): the robot's hands (left, right), their references, and the
+    /// support kind (1 single, 2 double, 0 a transition).
+    pub(crate) fn record(
+        &mut self,
+        time: f64,
+        robot: [Vector3<f64>; 2],
+        reference: [Option<Vector3<f64>>; 2],
+        kind: u8,
+    ) {
+        let j = self.frames;
+        if j < LAG_CAPACITY {
+            self.first_times.push(time);
+            self.recent.push((reference, kind));
+            self.totals.push((0.0, 0));
+            self.cells.push(Default::default());
+        } else {
+            self.recent[j % LAG_CAPACITY] = (reference, kind);
+        }
+        // Frame j pairs its hands with the references of frames j − k, lag k ascending.
+        for k in 0..=j.min(LAG_CAPACITY - 1) {
+            if self.first_times[k] - self.first_times[0] > MAX_LAG {
                 break;
             }
-            let (mut sum, mut count) = (0.0, 0);
-            for i in 0..n - k {
-                for h in 0..2 {
-                    if let Some(reference) = self.samples[i].1[h] {
-                        sum += (self.samples[i + k].0[h] - reference).norm();
-                        count += 1;
-                    }
-                }
-            }
-            if count > 0 && sum / (count as f64) < best.0 {
-                best = (sum / count as f64, k);
-            }
-        }
-        let k = best.1;
-        let mut out = [[(0.0, 0.0_f64, 0_usize); 2]; 2];
-        for i in 0..n.saturating_sub(k) {
-            let kind = self.samples[i].2;
-            if kind == 0 {
-                continue;
-            }
+            let (references, kind) = self.recent[(j - k) % LAG_CAPACITY];
             for h in 0..2 {
-                if let Some(reference) = self.samples[i].1[h] {
-                    let e = (self.samples[i + k].0[h] - reference).norm();
-                    let cell = &mut out[h][usize::from(kind == 2)];
+                let Some(reference) = references[h] else {
+                    continue;
+                };
+                let e = (robot[h] - reference).norm();
+                self.totals[k].0 += e;
+                self.totals[k].1 += 1;
+                if kind != 0 {
+                    let cell = &mut self.cells[k][h][usize::from(kind == 2)];
                     cell.0 += e;
                     cell.1 = cell.1.max(e);
                     cell.2 += 1;
                 }
             }
         }
+        self.frames += 1;
+    }
+
+    /// The lag (s) that minimises the mean hand error, and the errors with it removed.
+    pub(crate) fn lag_removed(&self) -> LagRemoved {
+        let mut best = (f64::INFINITY, 0);
+        for (k, &(sum, count)) in self.totals.iter().enumerate() {
+            if self.first_times[k] - self.first_times[0] > MAX_LAG {
+                break;
+            }
+            if count > 0 && sum / (count as f64) < best.0 {
+                best = (sum / count as f64, k);
+            }
+        }
+        let k = best.1;
+        let mut out = self.cells.get(k).copied().unwrap_or_default();
         for cell in out.iter_mut().flatten() {
             if cell.2 > 0 {
                 cell.0 /= cell.2 as f64;
             }
         }
-        let lag = if n > k {
-            self.times[k] - self.times[0]
-        } else {
-            0.0
+        let lag = match self.first_times.get(k) {
+            Some(t) => t - self.first_times[0],
+            None => 0.0,
         };
         (out, lag)
     }
@@ -305,9 +334,7 @@ mod tests {
         let path = |t: f64| Vector3::new(t.sin(), 0.0, 0.0);
         for i in 0..100 {
             let t = i as f64 * 0.1;
-            trace.times.push(t);
-            let robot = path(t - 0.5);
-            trace.samples.push(([robot; 2], [Some(path(t)); 2], 2));
+            trace.record(t, [path(t - 0.5); 2], [Some(path(t)); 2], 2);
         }
         let (errors, lag) = trace.lag_removed();
         assert!((lag - 0.5).abs() < 1e-9, "{lag}");
