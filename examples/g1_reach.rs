@@ -10,6 +10,8 @@
 //! between the feet, 3 cm ahead of the ankles), the right hand's position; a pull toward the zero
 //! posture fills the remaining freedom.
 
+use std::fmt::Write as _;
+
 use nalgebra::Vector3;
 use taskstack::robots::g1;
 use taskstack::solver::Solver;
@@ -17,6 +19,7 @@ use taskstack::solver::driver::{DriverSettings, PositionDriver};
 use taskstack::tasks::{ComTask, PoseTask, PositionTask, TaskSet, joint_bounds};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let mut text = String::new();
     let model = g1::right_sole();
     let mut q = vec![0.0; model.nv()];
     let mut data = model.new_data();
@@ -54,7 +57,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut driver = PositionDriver::new(&solver, settings)?;
     let bounds = joint_bounds(&model)?;
 
-    println!("target (m)              iterations  contact (m)  CoM (m)    hand (m)");
+    let _ = writeln!(
+        text,
+        "target (m)              iterations  contact (m)  CoM (m)    hand (m)"
+    );
     for target in [
         [0.35, -0.2, 0.9],
         [0.4, -0.1, 1.1],
@@ -64,7 +70,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         set.task_mut::<PositionTask>("right_rubber_hand")?.target = Vector3::from(target);
         let report = driver.run(&mut solver, &mut set, &mut q, &bounds)?;
         let e = report.task_errors();
-        println!(
+        let _ = writeln!(
+            text,
             "{:<23} {:>10}  {:>11.1e}  {:>9.1e}  {:>8.4}",
             format!("{target:?}"),
             report.iterations,
@@ -76,8 +83,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // Out of reach, the hand stops as close as the levels above allow. Each of its steps still
     // moves the feet and CoM a little to second order (the iteration is linearised), so those
     // levels sit within a millimetre rather than 1e-6 m while the hand keeps pulling.
-    println!(
+    let _ = writeln!(
+        text,
         "(the last target is out of reach: the hand stops short; contact and CoM within 1 mm)"
     );
-    Ok(())
+    // A reader that closed the pipe (`| head`) is not an error of ours.
+    match std::io::Write::write_all(&mut std::io::stdout(), text.as_bytes()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e.into()),
+        _ => Ok(()),
+    }
 }

@@ -8,6 +8,8 @@
 //! Prints, for each target, what each priority level achieved, the iterations and the clamped
 //! joints. Run: `cargo run --release --example planar_arm`.
 
+use std::fmt::Write as _;
+
 use taskstack::solver::driver::{DriverSettings, PositionDriver, TaskModel};
 use taskstack::solver::{
     JointBounds, JointLimitAvoidance, Solver, SolverError, StackShape, TaskStack,
@@ -79,7 +81,8 @@ impl TaskModel for PlanarArm {
     }
 }
 
-fn main() -> Result<(), SolverError> {
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let mut text = String::new();
     let n = LINKS.len();
     let shape = StackShape::new(n)
         .with_level("reach", &[("tip", 2)])
@@ -102,8 +105,12 @@ fn main() -> Result<(), SolverError> {
     };
     let mut q = vec![0.3, 0.4, 0.3, 0.2, 0.1];
 
-    println!("5-link planar arm, link lengths {LINKS:?} m; levels: 1 tip (x, y), 2 elbow height");
-    println!(
+    let _ = writeln!(
+        text,
+        "5-link planar arm, link lengths {LINKS:?} m; levels: 1 tip (x, y), 2 elbow height"
+    );
+    let _ = writeln!(
+        text,
         "joint limits (rad): lower {:?}, upper {:?}\n",
         bounds.lower(),
         bounds.upper()
@@ -121,29 +128,37 @@ fn main() -> Result<(), SolverError> {
         let report = driver.run(&mut solver, &mut arm, &mut q, &bounds)?;
         let tip_at = PlanarArm::point(&q, LINKS.len() - 1);
         let elbow_at = PlanarArm::point(&q, ELBOW)[1];
-        println!(
+        let _ = writeln!(
+            text,
             "tip target ({:.3}, {:.3}) m, elbow height {:.3} m: {:?} after {} iterations",
             tip[0], tip[1], elbow, report.stop, report.iterations
         );
-        println!(
+        let _ = writeln!(
+            text,
             "  level 1 tip         at ({:.4}, {:.4}) m, error {:.2e} m",
             tip_at[0],
             tip_at[1],
             report.task_errors()[0]
         );
-        println!(
+        let _ = writeln!(
+            text,
             "  level 2 elbow height {:.4} m,          error {:.2e} m",
             elbow_at,
             report.task_errors()[1]
         );
         let last = solver.report();
         let clamped = last.clamped_joints();
-        println!(
+        let _ = writeln!(
+            text,
             "  last step: level ranks {:?}, clamped joints {:?}, q = {:.3?} rad\n",
             last.levels().iter().map(|l| l.rank).collect::<Vec<_>>(),
             clamped,
             q
         );
     }
-    Ok(())
+    // A reader that closed the pipe (`| head`) is not an error of ours.
+    match std::io::Write::write_all(&mut std::io::stdout(), text.as_bytes()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e.into()),
+        _ => Ok(()),
+    }
 }

@@ -4,6 +4,11 @@
 use taskstack::imitation::tables::TaskTables;
 use taskstack::robots::nao;
 
-fn main() {
-    print!("{}", TaskTables::paper(&nao::profile()));
+fn main() -> std::io::Result<()> {
+    let text = TaskTables::paper(&nao::profile()).to_string();
+    // A reader that closed the pipe (`| head`) is not an error of ours.
+    match std::io::Write::write_all(&mut std::io::stdout(), text.as_bytes()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e),
+        _ => Ok(()),
+    }
 }

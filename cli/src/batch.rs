@@ -1,6 +1,7 @@
 //! `taskstack batch`: many clips, one output folder each, in parallel.
 
 use std::collections::HashMap;
+use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::Mutex;
@@ -109,11 +110,23 @@ pub(crate) fn run(args: BatchArgs, report: Report) -> Result<ExitCode> {
     let mut done = done.into_inner().unwrap_or_else(|e| e.into_inner());
     done.sort_by(|a, b| a.clip.cmp(&b.clip));
     let failed = done.iter().filter(|d| d.result.is_err()).count();
+    let mut text = String::new();
     if report.json {
-        println!("{}", batch_json(&done, jobs, start.elapsed().as_secs_f64()));
+        let _ = writeln!(
+            text,
+            "{}",
+            batch_json(&done, jobs, start.elapsed().as_secs_f64())
+        );
     } else {
-        print_table(&done, report, jobs, start.elapsed().as_secs_f64());
+        print_table(
+            &mut text,
+            &done,
+            report,
+            jobs,
+            start.elapsed().as_secs_f64(),
+        );
     }
+    crate::output(&text)?;
     Ok(if failed == 0 {
         ExitCode::SUCCESS
     } else {
@@ -151,7 +164,7 @@ fn hand_mean(m: &ImitationMetrics, name: &str) -> Option<f64> {
     (n > 0).then(|| (s.mean * s.count as f64 + d.mean * d.count as f64) / n as f64)
 }
 
-fn print_table(done: &[Done], report: Report, jobs: usize, seconds: f64) {
+fn print_table(text: &mut String, done: &[Done], report: Report, jobs: usize, seconds: f64) {
     for d in done {
         if let Err(e) = &d.result {
             eprintln!("taskstack: error: {e:#}");
@@ -160,7 +173,8 @@ fn print_table(done: &[Done], report: Report, jobs: usize, seconds: f64) {
     if report.quiet {
         return;
     }
-    println!(
+    let _ = writeln!(
+        text,
         "{:<48} {:>7} {:>7} {:>9} {:>13} {:>8} {:>6} {:>7}",
         "clip", "frames", "clip s", "supports", "hands cm L/R", "CoM out", "limits", "wall s"
     );
@@ -171,26 +185,32 @@ fn print_table(done: &[Done], report: Report, jobs: usize, seconds: f64) {
             .file_name()
             .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
         match &d.result {
-            Ok(m) => println!(
-                "{:<48} {:>7} {:>7.1} {:>9} {:>13} {:>8} {:>6} {:>7.1}",
-                name,
-                m.clip_frames,
-                m.clip_duration,
-                format!("{}→{}", m.human_support_changes, m.robot_support_changes),
-                format!(
-                    "{}/{}",
-                    cm(hand_mean(m, "l_hand")),
-                    cm(hand_mean(m, "r_hand"))
-                ),
-                m.frames_com_outside,
-                m.joint_limit_violations + m.velocity_limit_violations,
-                d.seconds
-            ),
-            Err(_) => println!("{name:<48} FAILED (see above)"),
+            Ok(m) => {
+                let _ = writeln!(
+                    text,
+                    "{:<48} {:>7} {:>7.1} {:>9} {:>13} {:>8} {:>6} {:>7.1}",
+                    name,
+                    m.clip_frames,
+                    m.clip_duration,
+                    format!("{}→{}", m.human_support_changes, m.robot_support_changes),
+                    format!(
+                        "{}/{}",
+                        cm(hand_mean(m, "l_hand")),
+                        cm(hand_mean(m, "r_hand"))
+                    ),
+                    m.frames_com_outside,
+                    m.joint_limit_violations + m.velocity_limit_violations,
+                    d.seconds
+                );
+            }
+            Err(_) => {
+                let _ = writeln!(text, "{name:<48} FAILED (see above)");
+            }
         }
     }
     let ok = done.iter().filter(|d| d.result.is_ok()).count();
-    println!(
+    let _ = writeln!(
+        text,
         "{ok} of {} clips imitated in {seconds:.1} s on {jobs} threads; supports = human → robot support changes, CoM out = frames with the CoM outside the support polygon, limits = joint × frame violations",
         done.len()
     );

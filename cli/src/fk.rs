@@ -38,8 +38,10 @@ pub(crate) struct FkArgs {
 #[derive(Debug, Clone, Copy, ValueEnum)]
 enum Root {
     /// The right sole.
+    #[value(alias = "r_sole")]
     Right,
     /// The left sole.
+    #[value(alias = "l_sole")]
     Left,
 }
 

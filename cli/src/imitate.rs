@@ -1,5 +1,6 @@
 //! `taskstack imitate`: one clip, one robot, one output folder.
 
+use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Duration;
@@ -83,6 +84,7 @@ pub(crate) fn run(args: ImitateArgs, report: Report) -> Result<ExitCode> {
     let metrics = imitate_into(&clip, &out, &settings, &mut progress);
     bar.finish_and_clear();
     let metrics = metrics?;
+    let mut text = String::new();
     if report.json {
         let value = json!({
             "clip": clip,
@@ -90,16 +92,24 @@ pub(crate) fn run(args: ImitateArgs, report: Report) -> Result<ExitCode> {
             "files": OUTPUT_FILES,
             "metrics": serde_json::from_str::<serde_json::Value>(&taskstack::batch::metrics_json(&metrics, &clip))?,
         });
-        println!("{value}");
+        let _ = writeln!(text, "{value}");
     } else if !report.quiet {
-        print_summary(&metrics, &clip, &out, &settings);
+        print_summary(&mut text, &metrics, &clip, &out, &settings);
     }
+    crate::output(&text)?;
     Ok(ExitCode::SUCCESS)
 }
 
-fn print_summary(m: &ImitationMetrics, clip: &Path, out: &Path, settings: &Settings) {
+fn print_summary(
+    text: &mut String,
+    m: &ImitationMetrics,
+    clip: &Path,
+    out: &Path,
+    settings: &Settings,
+) {
     let hold_frames = m.frames - m.clip_frames;
-    println!(
+    let _ = writeln!(
+        text,
         "{} on {}: {} frames ({:.2} s) of the clip, then {} frames ({:.2} s) holding its last pose",
         clip.display(),
         settings.profile.name,
@@ -108,20 +118,24 @@ fn print_summary(m: &ImitationMetrics, clip: &Path, out: &Path, settings: &Setti
         hold_frames,
         m.duration - m.clip_duration
     );
-    println!(
+    let _ = writeln!(
+        text,
         "support changes: human {}, robot {} ({})",
         m.human_support_changes,
         m.robot_support_changes,
         m.robot_support_sequence.join(" → ")
     );
-    println!(
+    let _ = writeln!(
+        text,
         "distance of each effector to the scaled human over the clip, while its phase tracks it (cm):"
     );
-    println!(
+    let _ = writeln!(
+        text,
         "  {:8} {:>22} {:>22}",
         "", "single support", "double support"
     );
-    println!(
+    let _ = writeln!(
+        text,
         "  {:8} {:>22} {:>22}",
         "", "mean / max (frames)", "mean / max (frames)"
     );
@@ -130,23 +144,27 @@ fn print_summary(m: &ImitationMetrics, clip: &Path, out: &Path, settings: &Setti
             0 => "not tracked".to_owned(),
             n => format!("{:.1} / {:.1} ({n})", s.mean * 100.0, s.max * 100.0),
         };
-        println!(
+        let _ = writeln!(
+            text,
             "  {:8} {:>22} {:>22}",
             e.name,
             cell(&e.single_support),
             cell(&e.double_support)
         );
     }
-    println!(
+    let _ = writeln!(
+        text,
         "balance: CoM ground projection at least {:.1} mm inside the support polygon ({} frames outside)",
         m.min_com_margin * 1000.0,
         m.frames_com_outside
     );
-    println!(
+    let _ = writeln!(
+        text,
         "limits: {} joint-position and {} joint-velocity violations (joint × frame)",
         m.joint_limit_violations, m.velocity_limit_violations
     );
-    println!(
+    let _ = writeln!(
+        text,
         "standing feet: slip {:.2} mm / turn {:.3}° (support foot), {:.2} mm / {:.3}° (other foot)",
         m.max_support_slip * 1000.0,
         m.max_support_turn.to_degrees(),
@@ -154,14 +172,21 @@ fn print_summary(m: &ImitationMetrics, clip: &Path, out: &Path, settings: &Setti
         m.max_held_foot_turn.to_degrees()
     );
     let t = &m.travel;
-    println!(
+    let _ = writeln!(
+        text,
         "travel: scaled human {:.3} m, robot {:.3} m; steps: human {}, robot {}",
         t.scaled_human_m, t.robot_m, m.human_steps, m.robot_steps
     );
     let s = &m.solve_time_us;
-    println!(
+    let _ = writeln!(
+        text,
         "time per frame: median {:.0} µs, 99th percentile {:.0} µs",
         s.median, s.p99
     );
-    println!("wrote {}/{{{}}}", out.display(), OUTPUT_FILES.join(", "));
+    let _ = writeln!(
+        text,
+        "wrote {}/{{{}}}",
+        out.display(),
+        OUTPUT_FILES.join(", ")
+    );
 }

@@ -79,6 +79,16 @@ fn main() -> ExitCode {
     }
 }
 
+/// Writes `text` to stdout. A reader that went away (`taskstack … | head`) gives an error that
+/// `main` treats as success, instead of the panic of `println!`.
+pub(crate) fn output(text: &str) -> anyhow::Result<()> {
+    use std::io::Write;
+    let mut stdout = std::io::stdout().lock();
+    stdout.write_all(text.as_bytes())?;
+    stdout.flush()?;
+    Ok(())
+}
+
 /// A reader of our stdout went away (`taskstack … | head`): not an error of ours.
 fn is_broken_pipe(error: &anyhow::Error) -> bool {
     error.chain().any(|cause| {

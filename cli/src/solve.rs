@@ -1,6 +1,7 @@
 //! `taskstack solve`: a prioritized-IK benchmark problem solved frame by frame.
 
 use std::collections::BTreeMap;
+use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -35,10 +36,10 @@ pub(crate) struct SolveArgs {
 
 pub(crate) fn run(args: SolveArgs, report: Report) -> Result<ExitCode> {
     let path = &args.problem;
-    let text =
+    let source =
         std::fs::read_to_string(path).with_context(|| format!("problem {}", path.display()))?;
     let problem =
-        Problem::from_json(&text).with_context(|| format!("problem {}", path.display()))?;
+        Problem::from_json(&source).with_context(|| format!("problem {}", path.display()))?;
     let count = args
         .frames
         .map_or(problem.frames, |n| n as usize)
@@ -92,6 +93,7 @@ pub(crate) fn run(args: SolveArgs, report: Report) -> Result<ExitCode> {
             .unwrap_or(0.0)
     };
     let (median, p99, max) = (at(0.5), at(0.99), at(1.0));
+    let mut text = String::new();
     if report.json {
         let out = json!({
             "problem": problem.label,
@@ -106,21 +108,24 @@ pub(crate) fn run(args: SolveArgs, report: Report) -> Result<ExitCode> {
                 "time_per_frame_us": { "median": median, "p99": p99, "max": max },
             },
         });
-        println!("{out}");
+        let _ = writeln!(text, "{out}");
     } else if !report.quiet {
-        println!(
+        let _ = writeln!(
+            text,
             "{}: {count} frames × {repeats} runs, {converged} frames converged, {:.2} iterations per frame, {violations} limit violations",
             problem.label,
             iterations as f64 / count.max(1) as f64
         );
-        println!("worst error per task (m):");
+        let _ = writeln!(text, "worst error per task (m):");
         for (name, w) in names.iter().zip(&worst) {
-            println!("  {name:24} {w:.2e}");
+            let _ = writeln!(text, "  {name:24} {w:.2e}");
         }
-        println!(
+        let _ = writeln!(
+            text,
             "time per frame: median {median:.1} µs, 99th percentile {p99:.1} µs, max {max:.1} µs"
         );
     }
+    crate::output(&text)?;
     Ok(ExitCode::SUCCESS)
 }
 

@@ -274,11 +274,13 @@ pub(crate) fn run(args: ViewArgs, report: Report) -> Result<ExitCode> {
         );
     }
     let page = page.canonicalize().context("view.html")?;
+    let mut text = String::new();
     if report.json {
-        println!("{}", json!({ "view": page }));
+        text = format!("{}\n", json!({ "view": page }));
     } else if !report.quiet {
-        println!("{}", page.display());
+        text = format!("{}\n", page.display());
     }
+    crate::output(&text)?;
     if !args.no_open {
         open_in_browser(&page)?;
     }

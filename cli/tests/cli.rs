@@ -419,3 +419,22 @@ fn view_prints_the_page_of_an_output_folder() {
         &["not a folder"],
     );
 }
+
+#[test]
+fn a_reader_that_closes_the_pipe_is_not_an_error() {
+    use std::process::{Command, Stdio};
+    let problem = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../tests/data/bench/problem_ds.json");
+    // `taskstack --json solve … | head -c 0`: the reader is gone before the output is written.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_taskstack"))
+        .args(["--json", "solve", s(&problem)])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let output = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(0), "{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+}
