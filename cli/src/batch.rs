@@ -2,7 +2,7 @@
 
 use std::collections::HashMap;
 use std::fmt::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -48,18 +48,7 @@ struct Done {
 
 pub(crate) fn run(args: BatchArgs, report: Report) -> Result<ExitCode> {
     let clips = collect_clips(&args.inputs)?;
-    let mut folders: HashMap<PathBuf, &PathBuf> = HashMap::new();
-    for clip in &clips {
-        let out = args.out.join(clip.file_stem().unwrap_or(clip.as_os_str()));
-        if let Some(first) = folders.insert(out.clone(), clip) {
-            bail!(
-                "clips {} and {} would both write into {}",
-                first.display(),
-                clip.display(),
-                out.display()
-            );
-        }
-    }
+    let outputs = output_folders(&clips, &args.out)?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("output folder {}: cannot create it", args.out.display()))?;
     let settings = Settings {
@@ -69,12 +58,51 @@ pub(crate) fn run(args: BatchArgs, report: Report) -> Result<ExitCode> {
         map: args.options.skeleton_map()?,
     };
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let jobs = args
-        .jobs
-        .map_or(cores, |j| j as usize)
+    let jobs = (args.jobs.map_or(cores, |j| j as usize))
         .min(clips.len())
         .max(1);
-    let bar = ProgressBar::with_draw_target(Some(clips.len() as u64), ProgressDrawTarget::hidden());
+    let bar = progress_bar(clips.len(), report);
+    let start = Instant::now();
+    let done = imitate_all(&clips, &outputs, &settings, jobs, &bar);
+    bar.finish_and_clear();
+    let seconds = start.elapsed().as_secs_f64();
+    let mut text = String::new();
+    if report.json {
+        let _ = writeln!(text, "{}", batch_json(&done, jobs, seconds));
+    } else {
+        print_table(&mut text, &done, report, jobs, seconds);
+    }
+    crate::output(&text)?;
+    let failed = done.iter().any(|d| d.result.is_err());
+    Ok(if failed {
+        ExitCode::FAILURE
+    } else {
+        ExitCode::SUCCESS
+    })
+}
+
+/// Each clip's output folder, `out/<file stem>`; two clips with one folder are an error.
+fn output_folders(clips: &[PathBuf], out: &Path) -> Result<Vec<PathBuf>> {
+    let mut folders: HashMap<PathBuf, &PathBuf> = HashMap::new();
+    let mut outputs = Vec::with_capacity(clips.len());
+    for clip in clips {
+        let folder = out.join(clip.file_stem().unwrap_or(clip.as_os_str()));
+        if let Some(first) = folders.insert(folder.clone(), clip) {
+            bail!(
+                "clips {} and {} would both write into {}",
+                first.display(),
+                clip.display(),
+                folder.display()
+            );
+        }
+        outputs.push(folder);
+    }
+    Ok(outputs)
+}
+
+/// A bar counting clips, drawn on stderr for people only.
+fn progress_bar(clips: usize, report: Report) -> ProgressBar {
+    let bar = ProgressBar::with_draw_target(Some(clips as u64), ProgressDrawTarget::hidden());
     if report.human() {
         bar.set_draw_target(ProgressDrawTarget::stderr());
         bar.set_style(
@@ -82,56 +110,47 @@ pub(crate) fn run(args: BatchArgs, report: Report) -> Result<ExitCode> {
                 .unwrap_or_else(|_| ProgressStyle::default_bar()),
         );
     }
-    let start = Instant::now();
+    bar
+}
+
+/// Imitates every clip into its folder on `jobs` threads, each taking the next clip when it is
+/// free; the outcomes sorted by clip path.
+fn imitate_all(
+    clips: &[PathBuf],
+    outputs: &[PathBuf],
+    settings: &Settings,
+    jobs: usize,
+    bar: &ProgressBar,
+) -> Vec<Done> {
     let next = AtomicUsize::new(0);
     let done = Mutex::new(Vec::with_capacity(clips.len()));
     std::thread::scope(|scope| {
         for _ in 0..jobs {
             scope.spawn(|| {
-                while let Some(clip) = clips.get(next.fetch_add(1, Ordering::Relaxed)) {
-                    let out = args.out.join(clip.file_stem().unwrap_or(clip.as_os_str()));
+                loop {
+                    let i = next.fetch_add(1, Ordering::Relaxed);
+                    let (Some(clip), Some(out)) = (clips.get(i), outputs.get(i)) else {
+                        break;
+                    };
                     let began = Instant::now();
-                    let result = imitate_into(clip, &out, &settings, &mut |_| {});
+                    let result = imitate_into(clip, out, settings, &mut |_| {});
                     bar.set_message(format!("{}", clip.display()));
                     bar.inc(1);
                     let seconds = began.elapsed().as_secs_f64();
-                    let mut done = done.lock().unwrap_or_else(|e| e.into_inner());
-                    done.push(Done {
+                    let outcome = Done {
                         clip: clip.clone(),
-                        out,
+                        out: out.clone(),
                         result,
                         seconds,
-                    });
+                    };
+                    done.lock().unwrap_or_else(|e| e.into_inner()).push(outcome);
                 }
             });
         }
     });
-    bar.finish_and_clear();
     let mut done = done.into_inner().unwrap_or_else(|e| e.into_inner());
     done.sort_by(|a, b| a.clip.cmp(&b.clip));
-    let failed = done.iter().filter(|d| d.result.is_err()).count();
-    let mut text = String::new();
-    if report.json {
-        let _ = writeln!(
-            text,
-            "{}",
-            batch_json(&done, jobs, start.elapsed().as_secs_f64())
-        );
-    } else {
-        print_table(
-            &mut text,
-            &done,
-            report,
-            jobs,
-            start.elapsed().as_secs_f64(),
-        );
-    }
-    crate::output(&text)?;
-    Ok(if failed == 0 {
-        ExitCode::SUCCESS
-    } else {
-        ExitCode::FAILURE
-    })
+    done
 }
 
 /// The clips of the inputs: files as given, folders' .bvh and .csv files sorted.

@@ -125,33 +125,7 @@ fn print_summary(
         m.robot_support_changes,
         m.robot_support_sequence.join(" → ")
     );
-    let _ = writeln!(
-        text,
-        "distance of each effector to the scaled human over the clip, while its phase tracks it (cm):"
-    );
-    let _ = writeln!(
-        text,
-        "  {:8} {:>22} {:>22}",
-        "", "single support", "double support"
-    );
-    let _ = writeln!(
-        text,
-        "  {:8} {:>22} {:>22}",
-        "", "mean / max (frames)", "mean / max (frames)"
-    );
-    for e in &m.effectors_clip {
-        let cell = |s: &taskstack::imitation::metrics::MeanMax| match s.count {
-            0 => "not tracked".to_owned(),
-            n => format!("{:.1} / {:.1} ({n})", s.mean * 100.0, s.max * 100.0),
-        };
-        let _ = writeln!(
-            text,
-            "  {:8} {:>22} {:>22}",
-            e.name,
-            cell(&e.single_support),
-            cell(&e.double_support)
-        );
-    }
+    print_tracking(text, m);
     let _ = writeln!(
         text,
         "balance: CoM ground projection at least {:.1} mm inside the support polygon ({} frames outside)",
@@ -189,4 +163,36 @@ fn print_summary(
         out.display(),
         OUTPUT_FILES.join(", ")
     );
+}
+
+/// The tracking table: per effector, mean and maximum distance to the scaled human (cm) in
+/// single and double support, over the clip's frames whose phase tracks it.
+fn print_tracking(text: &mut String, m: &ImitationMetrics) {
+    let _ = writeln!(
+        text,
+        "distance of each effector to the scaled human over the clip, while its phase tracks it (cm):"
+    );
+    let _ = writeln!(
+        text,
+        "  {:8} {:>22} {:>22}",
+        "", "single support", "double support"
+    );
+    let _ = writeln!(
+        text,
+        "  {:8} {:>22} {:>22}",
+        "", "mean / max (frames)", "mean / max (frames)"
+    );
+    for e in &m.effectors_clip {
+        let cell = |s: &taskstack::imitation::metrics::MeanMax| match s.count {
+            0 => "not tracked".to_owned(),
+            n => format!("{:.1} / {:.1} ({n})", s.mean * 100.0, s.max * 100.0),
+        };
+        let _ = writeln!(
+            text,
+            "  {:8} {:>22} {:>22}",
+            e.name,
+            cell(&e.single_support),
+            cell(&e.double_support)
+        );
+    }
 }

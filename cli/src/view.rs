@@ -61,48 +61,8 @@ impl<W: Write> ViewWriter<W> {
         let right_sole = model.frame_id(&profile.foot(Side::Right).sole)?;
         let stand = &profile.stand;
         model.forward_kinematics(&mut data, stand)?;
-        let origin = |link: usize| data.link_placement(link).translation.vector;
-        // A segment per joint from its parent's origin to its child's, when they are apart.
-        let mut links: Vec<usize> = Vec::new();
-        let point =
-            |link: usize, links: &mut Vec<usize>| match links.iter().position(|&l| l == link) {
-                Some(i) => i,
-                None => {
-                    links.push(link);
-                    links.len() - 1
-                }
-            };
-        let mut segments = Vec::new();
-        for (j, joint) in model.joints().iter().enumerate() {
-            let (parent, child) = (joint.antecedent, j + 1);
-            if (origin(child) - origin(parent)).norm() >= MIN_SEGMENT {
-                let a = point(parent, &mut links);
-                let b = point(child, &mut links);
-                segments.push([a, b]);
-            }
-        }
-        let drawn = [&profile.hands[0], &profile.hands[1], &profile.torso];
-        let mut frames = Vec::new();
-        for name in drawn {
-            let id = model.frame_id(name)?;
-            let link = model.frames()[id.index()].link;
-            let to = data.frame_placement(id).translation.vector;
-            if (to - origin(link)).norm() >= MIN_SEGMENT {
-                let a = point(link, &mut links);
-                frames.push(id);
-                segments.push([a, usize::MAX - frames.len() + 1]);
-            }
-        }
-        // Frame points follow the link points in each frame's list.
-        let n = links.len();
-        for s in &mut segments {
-            if s[1] > usize::MAX / 2 {
-                s[1] = n + (usize::MAX - s[1]);
-            }
-        }
-        let height = (0..model.links().len())
-            .map(|l| origin(l).z)
-            .fold(0.0, f64::max);
+        let hands_and_torso = [&profile.hands[0], &profile.hands[1], &profile.torso];
+        let drawing = robot_drawing(&model, &data, &hands_and_torso.map(String::as_str))?;
         let human: Vec<[usize; 2]> = HumanJoint::ALL
             .iter()
             .filter_map(|j| j.antecedent().map(|a| [a.index(), j.index()]))
@@ -111,8 +71,8 @@ impl<W: Write> ViewWriter<W> {
         let run = json!({
             "title": title,
             "robot": profile.name,
-            "height_m": height,
-            "segments": segments,
+            "height_m": drawing.height,
+            "segments": drawing.segments,
             "human_segments": human,
             "human_joints": HumanJoint::ALL.iter().map(|j| j.name()).collect::<Vec<_>>(),
             "rate_hz": VIEW_RATE,
@@ -125,8 +85,8 @@ impl<W: Write> ViewWriter<W> {
             model,
             data,
             right_sole,
-            links,
-            frames,
+            links: drawing.links,
+            frames: drawing.frames,
             outlines,
             next_time: f64::NEG_INFINITY,
             written: 0,
@@ -210,6 +170,59 @@ impl<W: Write> ViewWriter<W> {
         self.out.flush()?;
         Ok(())
     }
+}
+
+/// What is drawn of the robot: the link origins and named frames whose world positions each
+/// frame lists (links first), the segments between them (indices into that list), and the
+/// robot's standing height (m).
+struct RobotDrawing {
+    links: Vec<usize>,
+    frames: Vec<FrameId>,
+    segments: Vec<[usize; 2]>,
+    height: f64,
+}
+
+/// A segment per joint from its parent link's origin to its child's, and one from each of
+/// `frame_names`' link to the frame, when they are at least [`MIN_SEGMENT`] apart in the
+/// posture of `data`.
+fn robot_drawing(model: &Model, data: &ModelData, frame_names: &[&str]) -> Result<RobotDrawing> {
+    let origin = |link: usize| data.link_placement(link).translation.vector;
+    let mut links: Vec<usize> = Vec::new();
+    let mut point = |link: usize| match links.iter().position(|&l| l == link) {
+        Some(i) => i,
+        None => {
+            links.push(link);
+            links.len() - 1
+        }
+    };
+    let mut segments = Vec::new();
+    for (j, joint) in model.joints().iter().enumerate() {
+        let (parent, child) = (joint.antecedent, j + 1);
+        if (origin(child) - origin(parent)).norm() >= MIN_SEGMENT {
+            segments.push([point(parent), point(child)]);
+        }
+    }
+    let (mut frames, mut to_frames) = (Vec::new(), Vec::new());
+    for name in frame_names {
+        let id = model.frame_id(name)?;
+        let link = model.frames()[id.index()].link;
+        if (data.frame_placement(id).translation.vector - origin(link)).norm() >= MIN_SEGMENT {
+            to_frames.push((point(link), frames.len()));
+            frames.push(id);
+        }
+    }
+    // Frame points follow the link points in each frame's list.
+    let n = links.len();
+    segments.extend(to_frames.into_iter().map(|(a, k)| [a, n + k]));
+    let height = (0..model.links().len())
+        .map(|l| origin(l).z)
+        .fold(0.0, f64::max);
+    Ok(RobotDrawing {
+        links,
+        frames,
+        segments,
+        height,
+    })
 }
 
 fn split_template() -> Result<(&'static str, &'static str)> {
