@@ -9,12 +9,9 @@
 //! With `--repeats R` the whole run is repeated R times from `q_init`; timing statistics pool all
 //! runs, the per-frame results are the last run's.
 
-use std::collections::BTreeMap;
 use std::process::ExitCode;
 
-use serde_json::json;
-use taskstack::problem::{Problem, Runner};
-use taskstack::solver::driver::StopReason;
+use taskstack::problem::{Problem, solve_frames};
 
 fn usage() -> ExitCode {
     eprintln!("usage: solve PROBLEM.json [--frames N] [--repeats R]");
@@ -54,81 +51,7 @@ fn run(
     repeats: usize,
 ) -> Result<(), Box<dyn std::error::Error>> {
     let problem = Problem::from_json(&std::fs::read_to_string(path)?)?;
-    let count = frames.unwrap_or(problem.frames).min(problem.frames);
-    let names = problem.task_names();
-    let levels = problem.task_levels();
-    let mut runner = Runner::new(&problem)?;
-    let mut times = Vec::with_capacity(count * repeats);
-    let mut per_frame = Vec::with_capacity(count);
-    let mut violations = 0usize;
-    let mut worst = vec![0.0_f64; names.len()];
-    let (mut converged, mut iterations) = (0usize, 0usize);
-    for repeat in 0..repeats {
-        let mut q = problem.q_init.clone();
-        let last = repeat + 1 == repeats;
-        for frame in 0..count {
-            let result = runner.solve_frame(frame, &mut q)?;
-            times.push(result.micros);
-            if !last {
-                continue;
-            }
-            violations += q
-                .iter()
-                .zip(problem.bounds.lower().iter().zip(problem.bounds.upper()))
-                .filter(|(v, (lo, hi))| *v < lo || *v > hi)
-                .count();
-            for (w, e) in worst.iter_mut().zip(&result.errors) {
-                *w = w.max(*e);
-            }
-            converged += usize::from(result.stop == StopReason::Converged);
-            iterations += result.iterations;
-            per_frame.push(json!({
-                "frame": frame,
-                "q": problem.to_joint_order(&q),
-                "errors": per_task(&names, |t| result.errors[t]),
-                "iterations": result.iterations,
-                "stop": format!("{:?}", result.stop).to_lowercase(),
-            }));
-        }
-    }
-    let (median, p99, max) = percentiles(&mut times);
-    let top_level_worst = worst
-        .iter()
-        .zip(&levels)
-        .filter(|(_, l)| **l == 0)
-        .fold(0.0_f64, |m, (w, _)| m.max(*w));
-    let out = json!({
-        "problem": problem.label,
-        "joint_order": problem.joint_order,
-        "levels": problem.level_names,
-        "frames": per_frame,
-        "summary": {
-            "frames": count,
-            "repeats": repeats,
-            "converged_frames": converged,
-            "mean_iterations": iterations as f64 / count.max(1) as f64,
-            "max_error_m": per_task(&names, |t| worst[t]),
-            "max_error_top_level_m": top_level_worst,
-            "limit_violations": violations,
-            "time_per_frame_us": { "median": median, "p99": p99, "max": max },
-        },
-    });
-    println!("{out}");
+    let solution = solve_frames(&problem, frames.unwrap_or(problem.frames), repeats)?;
+    println!("{}", solution.to_json(&problem, repeats));
     Ok(())
-}
-
-/// Median, 99th percentile and maximum of `values` (sorted in place; not empty).
-fn percentiles(values: &mut [f64]) -> (f64, f64, f64) {
-    values.sort_by(f64::total_cmp);
-    let at = |p: f64| values[((values.len() - 1) as f64 * p).round() as usize];
-    (at(0.5), at(0.99), values[values.len() - 1])
-}
-
-/// Per-task statistics in a JSON object keyed by task name.
-fn per_task(names: &[&str], values: impl Fn(usize) -> f64) -> BTreeMap<String, f64> {
-    names
-        .iter()
-        .enumerate()
-        .map(|(i, n)| (n.to_string(), values(i)))
-        .collect()
 }

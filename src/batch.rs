@@ -293,7 +293,13 @@ where
 }
 
 /// Time step of the held frames after a clip (s).
-const HOLD_STEP: f64 = 1.0 / 120.0;
+pub const HOLD_STEP: f64 = 1.0 / 120.0;
+
+/// Frames of a hold of `hold` seconds ([`HOLD_STEP`] apart): counted, not accumulated in
+/// floating point, so 0.5 s is 60 frames.
+pub fn hold_frames(hold: f64) -> u64 {
+    (hold / HOLD_STEP + 1e-6).floor() as u64
+}
 
 /// Imitates every frame of `source` (read from `path`, named in errors) with `imitator`, then
 /// holds the human's last pose for `hold` seconds (frames 1/120 s apart) so that the robot
@@ -315,8 +321,7 @@ pub fn imitate_clip(
     let mut recorder = MetricsRecorder::new(imitator);
     let mut frame = HumanFrame::new(0.0);
     let mut last: Option<HumanFrame> = None;
-    // The hold's frames: counted, not accumulated in floating point, so 0.5 s is 60 frames.
-    let hold_frames = (hold / HOLD_STEP + 1e-6).floor() as u64;
+    let hold_frames = hold_frames(hold);
     let mut held_frames = 0;
     let mut clip_end = None;
     for index in 0.. {
@@ -452,9 +457,7 @@ pub fn retarget_clip(
     std::fs::write(&metrics_path, metrics_json(&metrics, clip)).map_err(io(&metrics_path))?;
     let hand = |name: &str| {
         let e = metrics.effectors.iter().find(|e| e.name == name)?;
-        let (s, d) = (&e.single_support, &e.double_support);
-        let count = s.count + d.count;
-        (count > 0).then(|| (s.mean * s.count as f64 + d.mean * d.count as f64) / count as f64)
+        e.mean()
     };
     Ok(ClipSummary {
         frames: metrics.frames,
@@ -472,9 +475,15 @@ pub fn retarget_clip(
     })
 }
 
-/// The metrics of a run of `clip` as pretty-printed JSON (the fields of [`ImitationMetrics`]
-/// with their units in the key names; non-finite numbers become `null`).
+/// The metrics of a run of `clip` as pretty-printed JSON: [`metrics_value`].
 pub fn metrics_json(m: &ImitationMetrics, clip: &Path) -> String {
+    // A `Value` built by `json!` always serialises.
+    serde_json::to_string_pretty(&metrics_value(m, clip)).unwrap_or_default() + "\n"
+}
+
+/// The metrics of a run of `clip` as a JSON value (the fields of [`ImitationMetrics`] with
+/// their units in the key names; non-finite numbers become `null`).
+pub fn metrics_value(m: &ImitationMetrics, clip: &Path) -> Value {
     let mean_max = |m: &MeanMax| json!({ "mean": m.mean, "max": m.max, "frames": m.count });
     let spread = |s: &Spread| json!({ "min": s.min, "median": s.median, "p99": s.p99, "max": s.max, "count": s.count });
     let effector_map = |effectors: &[EffectorError]| -> serde_json::Map<String, Value> {
@@ -490,7 +499,7 @@ pub fn metrics_json(m: &ImitationMetrics, clip: &Path) -> String {
             .collect()
     };
     let effectors = effector_map(&m.effectors);
-    let value = json!({
+    json!({
         "clip": clip.file_name().map(|f| f.to_string_lossy().into_owned()),
         "frames": m.frames,
         "duration_s": m.duration,
@@ -524,7 +533,5 @@ pub fn metrics_json(m: &ImitationMetrics, clip: &Path) -> String {
             "queued_at_end": m.queued_steps_at_end,
         },
         "catch_up_s": m.catch_up_s,
-    });
-    // A `Value` built by `json!` always serialises.
-    serde_json::to_string_pretty(&value).unwrap_or_default() + "\n"
+    })
 }

@@ -472,3 +472,122 @@ impl<'p> Runner<'p> {
         })
     }
 }
+
+/// A problem solved over its frames, possibly several times ([`solve_frames`]).
+#[derive(Debug, Clone)]
+pub struct ProblemSolution {
+    /// Per frame of the last run: the posture (rad, in [`Problem::joint_order`]) and the
+    /// frame's result.
+    pub frames: Vec<(Vec<f64>, FrameResult)>,
+    /// Largest error of each task over the last run (m), in [`Problem::task_names`] order.
+    pub worst: Vec<f64>,
+    /// Joint positions outside their limits over the last run (joint × frame).
+    pub limit_violations: usize,
+    /// Frames of the last run whose driver converged.
+    pub converged_frames: usize,
+    /// Driver iterations over the last run.
+    pub iterations: usize,
+    /// Wall time of every frame of every run (µs), ascending.
+    pub times: Vec<f64>,
+}
+
+impl ProblemSolution {
+    /// The time of rank `round((n − 1) p)` in [`ProblemSolution::times`] (µs; 0 without frames).
+    pub fn time_quantile(&self, p: f64) -> f64 {
+        let rank = ((self.times.len().max(1) - 1) as f64 * p).round() as usize;
+        self.times.get(rank).copied().unwrap_or(0.0)
+    }
+
+    /// The result document of `problem` solved `repeats` times: per frame the posture, every
+    /// task's error (m), the iterations and the stop reason; a summary with the worst errors,
+    /// the limit violations and the time per frame (median, p99, max, µs).
+    pub fn to_json(&self, problem: &Problem, repeats: usize) -> Value {
+        let names = problem.task_names();
+        let per_task = |values: &[f64]| -> serde_json::Map<String, Value> {
+            (names.iter().zip(values))
+                .map(|(n, v)| (n.to_string(), Value::from(*v)))
+                .collect()
+        };
+        let frames: Vec<Value> = (self.frames.iter().enumerate())
+            .map(|(frame, (q, result))| {
+                serde_json::json!({
+                    "frame": frame,
+                    "q": q,
+                    "errors": per_task(&result.errors),
+                    "iterations": result.iterations,
+                    "stop": format!("{:?}", result.stop).to_lowercase(),
+                })
+            })
+            .collect();
+        let top_level_worst = (self.worst.iter().zip(problem.task_levels()))
+            .filter(|(_, level)| *level == 0)
+            .fold(0.0_f64, |m, (w, _)| m.max(*w));
+        let count = self.frames.len();
+        serde_json::json!({
+            "problem": problem.label,
+            "joint_order": problem.joint_order,
+            "levels": problem.level_names,
+            "frames": frames,
+            "summary": {
+                "frames": count,
+                "repeats": repeats,
+                "converged_frames": self.converged_frames,
+                "mean_iterations": self.iterations as f64 / count.max(1) as f64,
+                "max_error_m": per_task(&self.worst),
+                "max_error_top_level_m": top_level_worst,
+                "limit_violations": self.limit_violations,
+                "time_per_frame_us": {
+                    "median": self.time_quantile(0.5),
+                    "p99": self.time_quantile(0.99),
+                    "max": self.time_quantile(1.0),
+                },
+            },
+        })
+    }
+}
+
+/// Solves the first `count` frames of `problem` (all of them if fewer) `repeats` times, each run
+/// warm-started frame by frame from [`Problem::q_init`]; the times pool all runs, the rest is
+/// the last run's.
+///
+/// # Errors
+/// [`Runner::new`]'s and [`Runner::solve_frame`]'s.
+pub fn solve_frames(
+    problem: &Problem,
+    count: usize,
+    repeats: usize,
+) -> Result<ProblemSolution, ProblemError> {
+    let count = count.min(problem.frames);
+    let mut runner = Runner::new(problem)?;
+    let mut solution = ProblemSolution {
+        frames: Vec::with_capacity(count),
+        worst: vec![0.0; problem.task_names().len()],
+        limit_violations: 0,
+        converged_frames: 0,
+        iterations: 0,
+        times: Vec::with_capacity(count * repeats),
+    };
+    for repeat in 0..repeats {
+        let mut q = problem.q_init.clone();
+        let last = repeat + 1 == repeats;
+        for frame in 0..count {
+            let result = runner.solve_frame(frame, &mut q)?;
+            solution.times.push(result.micros);
+            if !last {
+                continue;
+            }
+            let bounds = problem.bounds.lower().iter().zip(problem.bounds.upper());
+            solution.limit_violations += (q.iter().zip(bounds))
+                .filter(|(v, (lo, hi))| *v < lo || *v > hi)
+                .count();
+            for (w, e) in solution.worst.iter_mut().zip(&result.errors) {
+                *w = w.max(*e);
+            }
+            solution.converged_frames += usize::from(result.stop == StopReason::Converged);
+            solution.iterations += result.iterations;
+            solution.frames.push((problem.to_joint_order(&q), result));
+        }
+    }
+    solution.times.sort_by(f64::total_cmp);
+    Ok(solution)
+}

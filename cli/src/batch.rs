@@ -177,10 +177,7 @@ fn collect_clips(inputs: &[PathBuf]) -> Result<Vec<PathBuf>> {
 }
 
 fn hand_mean(m: &ImitationMetrics, name: &str) -> Option<f64> {
-    let e = m.effectors_clip.iter().find(|e| e.name == name)?;
-    let (s, d) = (&e.single_support, &e.double_support);
-    let n = s.count + d.count;
-    (n > 0).then(|| (s.mean * s.count as f64 + d.mean * d.count as f64) / n as f64)
+    m.effectors_clip.iter().find(|e| e.name == name)?.mean()
 }
 
 fn print_table(text: &mut String, done: &[Done], report: Report, jobs: usize, seconds: f64) {
@@ -241,9 +238,11 @@ fn batch_json(done: &[Done], jobs: usize, seconds: f64) -> serde_json::Value {
         .map(|d| match &d.result {
             Ok(m) => json!({
                 "clip": d.clip, "out": d.out, "ok": true, "wall_time_s": d.seconds,
-                "metrics": serde_json::from_str::<serde_json::Value>(&taskstack::batch::metrics_json(m, &d.clip)).unwrap_or_default(),
+                "metrics": taskstack::batch::metrics_value(m, &d.clip),
             }),
-            Err(e) => json!({ "clip": d.clip, "out": d.out, "ok": false, "error": format!("{e:#}") }),
+            Err(e) => {
+                json!({ "clip": d.clip, "out": d.out, "ok": false, "error": format!("{e:#}") })
+            }
         })
         .collect();
     json!({ "clips": clips, "threads": jobs, "wall_time_s": seconds })

@@ -11,7 +11,7 @@ use serde_json::{Map, Value, json};
 use taskstack::human::Side;
 use taskstack::model::{Model, UrdfOptions};
 
-use crate::options::ImitationOptions;
+use crate::options::robot_profile;
 
 /// Forward kinematics of a robot, as JSON lines on stdin and stdout.
 ///
@@ -50,12 +50,11 @@ pub(crate) fn run(args: FkArgs) -> Result<ExitCode> {
         Some(path) => Model::from_urdf_file(path, &UrdfOptions::default())
             .with_context(|| format!("--urdf {}", path.display()))?,
         None => {
-            let options = ImitationOptions::for_robot(&args.robot);
             let side = match args.root {
                 Root::Right => Side::Right,
                 Root::Left => Side::Left,
             };
-            options.profile()?.model(side).clone()
+            robot_profile(&args.robot)?.model(side).clone()
         }
     };
     let mut data = model.new_data();

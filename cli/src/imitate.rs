@@ -90,7 +90,7 @@ pub(crate) fn run(args: ImitateArgs, report: Report) -> Result<ExitCode> {
             "clip": clip,
             "out": out,
             "files": OUTPUT_FILES,
-            "metrics": serde_json::from_str::<serde_json::Value>(&taskstack::batch::metrics_json(&metrics, &clip))?,
+            "metrics": taskstack::batch::metrics_value(&metrics, &clip),
         });
         let _ = writeln!(text, "{value}");
     } else if !report.quiet {

@@ -56,12 +56,7 @@ pub(crate) struct ImitationOptions {
 impl ImitationOptions {
     /// The robot named by `--robot`.
     pub(crate) fn profile(&self) -> Result<BipedProfile> {
-        Ok(match self.robot.as_str() {
-            "nao" => nao::profile(),
-            "g1" => g1::profile(),
-            path => BipedProfile::from_toml_file(path)
-                .with_context(|| format!("--robot {path}: not nao, g1 or a readable profile"))?,
-        })
+        robot_profile(&self.robot)
     }
 
     /// The skeleton map of `--skeleton`, read once for every clip.
@@ -88,6 +83,16 @@ impl ImitationOptions {
         config.footsteps.follow = self.walk;
         config
     }
+}
+
+/// The robot of a `--robot` option: `nao`, `g1` or a profile file.
+pub(crate) fn robot_profile(robot: &str) -> Result<BipedProfile> {
+    Ok(match robot {
+        "nao" => nao::profile(),
+        "g1" => g1::profile(),
+        path => BipedProfile::from_toml_file(path)
+            .with_context(|| format!("--robot {path}: not nao, g1 or a readable profile"))?,
+    })
 }
 
 /// Opens a clip, by the map if one is given; the error names the file.
@@ -137,22 +142,5 @@ fn hold(text: &str) -> Result<f64, String> {
         Ok(value)
     } else {
         Err(format!("{value} s is not within 0–{MAX_HOLD} s"))
-    }
-}
-
-impl ImitationOptions {
-    /// The default options with `--robot robot` (for commands that only need the robot).
-    pub(crate) fn for_robot(robot: &str) -> Self {
-        Self {
-            robot: robot.to_owned(),
-            walk: false,
-            hold: 0.0,
-            velocity_fraction: 0.1,
-            upper_body_fraction: None,
-            task_speed: None,
-            tracking_speed: None,
-            iterations: 1,
-            skeleton: None,
-        }
     }
 }

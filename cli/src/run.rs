@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use serde_json::json;
-use taskstack::batch::{JointsWriter, imitate_clip, metrics_json};
+use taskstack::batch::{JointsWriter, hold_frames, imitate_clip, metrics_json};
 use taskstack::imitation::metrics::ImitationMetrics;
 use taskstack::imitation::support::SupportConfig;
 use taskstack::io::skeleton_map::SkeletonMap;
@@ -28,9 +28,6 @@ pub(crate) const OUTPUT_FILES: [&str; 7] = [
     "phases.svg",
     "joints.svg",
 ];
-
-/// Frames per second of the hold after a clip (the library's hold step).
-const HOLD_RATE: f64 = 120.0;
 
 /// What every clip of a run shares.
 #[derive(Debug, Clone)]
@@ -58,7 +55,7 @@ pub(crate) fn imitate_into(
     progress: &mut dyn FnMut(Progress),
 ) -> Result<ImitationMetrics> {
     let source = open_clip(clip, settings.map.as_ref())?;
-    let hold_frames = (settings.hold * HOLD_RATE) as u64;
+    let hold_frames = hold_frames(settings.hold);
     progress(Progress::Start(
         source.declared_frames().map(|n| n + hold_frames),
     ));

@@ -177,6 +177,16 @@ pub struct EffectorError {
     pub double_support: MeanMax,
 }
 
+impl EffectorError {
+    /// Mean over the frames of single and double support together (m); `None` if it was never
+    /// tracked.
+    pub fn mean(&self) -> Option<f64> {
+        let (s, d) = (&self.single_support, &self.double_support);
+        let count = s.count + d.count;
+        (count > 0).then(|| (s.mean * s.count as f64 + d.mean * d.count as f64) / count as f64)
+    }
+}
+
 /// The metrics of a run.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ImitationMetrics {
