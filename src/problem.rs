@@ -31,7 +31,7 @@ use thiserror::Error;
 use crate::model::{Axis, Model, ModelError};
 use crate::robots::nao;
 use crate::solver::driver::{DriverSettings, PositionDriver, StopReason};
-use crate::solver::{JointBounds, Solver, SolverError};
+use crate::solver::{JointBounds, Method, Settings, Solver, SolverError};
 use crate::tasks::{self, ComTask, PositionTask, TaskError, TaskSet};
 
 /// The schema this module reads.
@@ -113,6 +113,9 @@ pub struct Problem {
     pub frames: usize,
     /// Driver settings from the file's stopping rule.
     pub settings: DriverSettings,
+    /// How each iteration's stack is solved: strict priorities (default, what the files ask
+    /// for) or weighted damped least squares, to compare the two.
+    pub method: Method,
     tasks: Vec<ProblemTask>,
     /// Name of each level, highest priority first.
     pub level_names: Vec<String>,
@@ -232,6 +235,7 @@ impl Problem {
             bounds,
             frames,
             settings,
+            method: Method::Prioritized,
             tasks,
             level_names,
             model,
@@ -428,7 +432,11 @@ impl<'p> Runner<'p> {
             set = set.level(name, tasks);
         }
         let set = set.posture_gradient(POSTURE_GAIN, &problem.q_ref)?;
-        let solver = Solver::new(&set.shape())?;
+        let settings = Settings {
+            method: problem.method,
+            ..Settings::default()
+        };
+        let solver = Solver::with_settings(&set.shape(), settings)?;
         let driver = PositionDriver::new(&solver, problem.settings)?;
         Ok(Self {
             problem,

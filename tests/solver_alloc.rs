@@ -6,7 +6,8 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use taskstack::solver::driver::{DriverSettings, PositionDriver, TaskModel};
 use taskstack::solver::{
-    JointBounds, JointLimitAvoidance, JointTracking, Solver, SolverError, StackShape, TaskStack,
+    JointBounds, JointLimitAvoidance, JointTracking, Method, Settings, Solver, SolverError,
+    StackShape, TaskStack,
 };
 
 struct Counting;
@@ -75,13 +76,24 @@ impl TaskModel for Linear {
     }
 }
 
+/// Both methods in one test: the allocation counter is global, a second test thread would
+/// count into it.
 #[test]
 fn warmed_up_solves_do_not_allocate() {
+    warmed_up_solves_do_not_allocate_with(Method::Prioritized);
+    warmed_up_solves_do_not_allocate_with(Method::WeightedDls { damping: 0.05 });
+}
+
+fn warmed_up_solves_do_not_allocate_with(method: Method) {
     // The paper's RS stack shape: CoM (2 rows), then hands + free ankle (9 rows).
     let shape = StackShape::new(N)
         .with_level("balance", &[("com_xy", 2)])
         .with_level("tracking", &[("l_hand", 3), ("r_hand", 3), ("l_ankle", 3)]);
-    let mut solver = Solver::new(&shape).unwrap();
+    let settings = Settings {
+        method,
+        ..Settings::default()
+    };
+    let mut solver = Solver::with_settings(&shape, settings).unwrap();
     let lower = [-0.3; N];
     let upper = [0.3; N];
     let bounds = JointBounds::with_velocity(&lower, &upper, &[2.0; N]).unwrap();

@@ -118,7 +118,7 @@ fn number(text: &str) -> Result<f64, String> {
     }
 }
 
-fn positive(text: &str) -> Result<f64, String> {
+pub(crate) fn positive(text: &str) -> Result<f64, String> {
     let value = number(text)?;
     if value > 0.0 {
         Ok(value)

@@ -7,6 +7,7 @@ use std::process::ExitCode;
 use anyhow::{Context, Result};
 use clap::Args;
 use taskstack::problem::{Problem, solve_frames};
+use taskstack::solver::Method;
 
 use crate::Report;
 
@@ -29,13 +30,37 @@ pub(crate) struct SolveArgs {
     /// per-frame results are the last run's.
     #[arg(long, value_name = "R", default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=10_000))]
     repeats: u64,
+    /// How each iteration is solved: `prioritized` (strict priorities, what the problem files
+    /// ask for) or `dls` (all levels as one damped least-squares problem with Chan & Dubey's
+    /// weighted least-norm joint-limit avoidance; no priorities).
+    #[arg(long, value_enum, default_value_t = SolveMethod::Prioritized)]
+    method: SolveMethod,
+    /// Damping factor λ of --method dls (m per rad).
+    #[arg(long, value_name = "LAMBDA", default_value_t = 0.01, value_parser = crate::options::positive,
+          allow_negative_numbers = true)]
+    damping: f64,
+}
+
+/// The solver method of `taskstack solve`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub(crate) enum SolveMethod {
+    /// Strict priorities by null-space projection.
+    Prioritized,
+    /// Weighted damped least squares (Chan & Dubey 1995).
+    Dls,
 }
 
 pub(crate) fn run(args: SolveArgs, report: Report) -> Result<ExitCode> {
     let path = &args.problem;
     let in_file = || format!("problem {}", path.display());
     let source = std::fs::read_to_string(path).with_context(in_file)?;
-    let problem = Problem::from_json(&source).with_context(in_file)?;
+    let mut problem = Problem::from_json(&source).with_context(in_file)?;
+    problem.method = match args.method {
+        SolveMethod::Prioritized => Method::Prioritized,
+        SolveMethod::Dls => Method::WeightedDls {
+            damping: args.damping,
+        },
+    };
     let count = args.frames.map_or(problem.frames, |n| n as usize);
     let repeats = args.repeats as usize;
     let solution = solve_frames(&problem, count, repeats).with_context(in_file)?;

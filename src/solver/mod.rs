@@ -85,6 +85,6 @@ mod stack;
 pub use bounds::JointBounds;
 pub use error::SolverError;
 pub use gradient::{GradientFunction, JointLimitAvoidance, JointTracking};
-pub use prioritized::{Settings, Solver};
+pub use prioritized::{Method, Settings, Solver, limit_criterion_gradient, limit_weight};
 pub use report::{LevelReport, Solution, SolveReport};
 pub use stack::{LevelMut, LevelSpec, StackShape, TaskSpec, TaskStack};

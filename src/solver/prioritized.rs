@@ -43,6 +43,36 @@ use super::householder::{
 use super::report::{Solution, SolveReport};
 use super::stack::{StackShape, TaskStack, check_finite_slice, check_len};
 
+mod weighted_dls;
+
+pub use weighted_dls::{limit_criterion_gradient, limit_weight};
+
+/// How the stack is solved.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum Method {
+    /// Strict priorities by null-space projection (the method described above). Default.
+    #[default]
+    Prioritized,
+    /// Every level's rows in one damped least-squares problem with Chan & Dubey's (1995)
+    /// weighted least-norm joint-limit avoidance: no priorities, but a bounded step near
+    /// singularities and joints slowed down as they near a limit.
+    ///
+    /// `q̇ = g + W⁻¹ Jᵀ (J W⁻¹ Jᵀ + λ² I)⁻¹ (ẋ − J g)`, `J` and `ẋ` all levels stacked,
+    /// `g = Σ κ_k ∇f_k` the gradient term: the minimizer of `‖J q̇ − ẋ‖² + λ² ‖q̇ − g‖²_W`. With
+    /// `W = I`, `‖q̇ − g‖ ≤ ‖ẋ − J g‖ / (2λ)` however ill-conditioned `J` is. `W` is diagonal,
+    /// `w_i = 1 + |∂H/∂q_i|` while `|∂H/∂q_i|` grows (the joint nears a limit; see
+    /// [`limit_weight`]) and 1 otherwise, with
+    /// `H(q) = Σ_i (q_max,i − q_min,i)² / (4 (q_max,i − q_i)(q_i − q_min,i))`. The clamping loop
+    /// and [`Settings::scale_to_fit`] apply as for the prioritized method, so no limit is
+    /// violated. The level reports give each level's residual; their rank is the level's row
+    /// count. Cost: an `m × m` Cholesky factorization per pass (`m` the total rows).
+    WeightedDls {
+        /// Damping factor `λ` (task units per rad, e.g. m): larger is slower and steadier.
+        /// Must be finite and > 0.
+        damping: f64,
+    },
+}
+
 /// Directions whose remaining norm is below this fraction of their level's largest row norm are
 /// rounding noise, whatever [`Settings::rank_tolerance`] says.
 const RELATIVE_RANK_TOLERANCE: f64 = 1e-12;
@@ -75,6 +105,8 @@ pub struct Settings {
     /// at their bounds, but can leave them few joints when a lower level asks for much more than
     /// the limits allow.
     pub scale_to_fit: bool,
+    /// Strict priorities (default) or weighted damped least squares.
+    pub method: Method,
 }
 
 impl Default for Settings {
@@ -85,6 +117,7 @@ impl Default for Settings {
             max_damping: 2e-2,
             feasibility_tolerance: 1e-8,
             scale_to_fit: false,
+            method: Method::Prioritized,
         }
     }
 }
@@ -110,7 +143,11 @@ impl Settings {
         check("rank_tolerance", self.rank_tolerance, true)?;
         check("damping_threshold", self.damping_threshold, false)?;
         check("max_damping", self.max_damping, false)?;
-        check("feasibility_tolerance", self.feasibility_tolerance, false)
+        check("feasibility_tolerance", self.feasibility_tolerance, false)?;
+        match self.method {
+            Method::Prioritized => Ok(()),
+            Method::WeightedDls { damping } => check("damping", damping, true),
+        }
     }
 }
 
@@ -162,6 +199,10 @@ pub struct Solver {
     /// The part of the step due to the clamped joints' fixed velocities, and a copy of those.
     base_velocity: Vec<f64>,
     saved_fixed: Vec<f64>,
+    /// Weighted DLS: the `m × m` Gram matrix, `W⁻¹`, and `|∂H/∂q|` of the previous solve.
+    gram: Vec<f64>,
+    inverse_weight: Vec<f64>,
+    previous_criterion: Vec<f64>,
     report: SolveReport,
 }
 
@@ -201,6 +242,9 @@ impl Solver {
             row_scale: 0.0,
             base_velocity: vec![0.0; n],
             saved_fixed: vec![0.0; n],
+            gram: vec![0.0; total * total],
+            inverse_weight: vec![1.0; n],
+            previous_criterion: vec![0.0; n],
             report: SolveReport::with_capacity(levels, n),
             stack,
             settings,
@@ -270,12 +314,15 @@ impl Solver {
         self.report.clamped.clear();
         self.report.clamping_iterations = 0;
         self.scales.fill(1.0);
+        if let Method::WeightedDls { .. } = self.settings.method {
+            self.update_limit_weights(q, bounds);
+        }
         if self.settings.scale_to_fit {
             self.fit_scales();
         }
         loop {
             self.report.clamping_iterations += 1;
-            self.prioritized_pass();
+            self.pass();
             // Clamp the worst violator only, then solve again: clamping every violator at once
             // lets a near-singular raw solution decide the fate of joints it would not need.
             let mut worst: Option<(usize, f64, f64)> = None;
@@ -304,15 +351,17 @@ impl Solver {
         })
     }
 
-    /// Solves the stack without any joint limit (no clamping loop).
+    /// Solves the stack without any joint limit (no clamping loop; the weighted DLS method
+    /// uses unit weights).
     pub fn solve_unbounded(&mut self) -> Result<Solution<'_>, SolverError> {
         self.stack.check_finite()?;
+        self.inverse_weight.fill(1.0);
         self.clamped.fill(false);
         self.fixed_velocity.fill(0.0);
         self.report.clamped.clear();
         self.report.clamping_iterations = 1;
         self.scales.fill(1.0);
-        self.prioritized_pass();
+        self.pass();
         self.finish_report();
         Ok(Solution {
             velocity: &self.velocity,
@@ -331,14 +380,14 @@ impl Solver {
         let parts = self.scales.len();
         for _ in 0..=n {
             self.scales.fill(0.0);
-            self.prioritized_pass();
+            self.pass();
             self.base_velocity.copy_from_slice(&self.velocity);
             self.saved_fixed.copy_from_slice(&self.fixed_velocity);
             self.fixed_velocity.fill(0.0);
             for k in 0..parts {
                 self.scales.fill(0.0);
                 self.scales[k] = 1.0;
-                self.prioritized_pass();
+                self.pass();
                 self.contributions[k * n..(k + 1) * n].copy_from_slice(&self.velocity);
             }
             self.fixed_velocity.copy_from_slice(&self.saved_fixed);
@@ -398,6 +447,14 @@ impl Solver {
             for (v, c) in self.velocity.iter_mut().zip(part) {
                 *v += scale * c;
             }
+        }
+    }
+
+    /// One solve by the configured method over the joints not clamped; writes `self.velocity`.
+    fn pass(&mut self) {
+        match self.settings.method {
+            Method::Prioritized => self.prioritized_pass(),
+            Method::WeightedDls { damping } => self.weighted_dls_pass(damping),
         }
     }
 
