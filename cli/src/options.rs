@@ -5,6 +5,8 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use clap::Args;
 use taskstack::ImitatorConfig;
+use taskstack::imitation::config::ImitationMethod;
+use taskstack::imitation::koenemann::KoenemannConfig;
 use taskstack::io::clip::Clip;
 use taskstack::io::skeleton_map::SkeletonMap;
 use taskstack::robots::{BipedProfile, g1, nao};
@@ -51,6 +53,20 @@ pub(crate) struct ImitationOptions {
     /// unit scale, up axis, frames to skip, human joint = BVH joint name).
     #[arg(long, value_name = "MAP.toml")]
     pub(crate) skeleton: Option<PathBuf>,
+    /// The imitation method: `poubel` (support phases and task tables, Poubel et al. 2014) or
+    /// `koenemann` (posture mapping, CoM offset control and foot retargeting, Koenemann et al.
+    /// 2014). Same outputs and metrics for both.
+    #[arg(long, value_enum, default_value_t = MethodName::Poubel)]
+    pub(crate) method: MethodName,
+}
+
+/// The imitation methods by name.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub(crate) enum MethodName {
+    /// Poubel et al.: support phases and task tables.
+    Poubel,
+    /// Koenemann et al.: posture mapping and stabilization.
+    Koenemann,
 }
 
 impl ImitationOptions {
@@ -72,7 +88,12 @@ impl ImitationOptions {
 
     /// The imitator settings of these options (support detection is set per clip).
     pub(crate) fn imitator_config(&self) -> ImitatorConfig {
+        let method = match self.method {
+            MethodName::Poubel => ImitationMethod::Poubel,
+            MethodName::Koenemann => ImitationMethod::Koenemann(KoenemannConfig::default()),
+        };
         let mut config = ImitatorConfig {
+            method,
             velocity_fraction: self.velocity_fraction,
             upper_body_velocity_fraction: self.upper_body_fraction,
             max_task_speed: self.task_speed,

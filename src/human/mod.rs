@@ -28,6 +28,10 @@
 
 use nalgebra::Vector3;
 
+mod com;
+
+pub use com::centre_of_mass;
+
 /// A named point of the human skeleton. Left and right are the human's own sides.
 ///
 /// The discriminant is the joint's index in [`HumanJoint::ALL`] and in a [`HumanFrame`].

@@ -2,6 +2,7 @@
 
 use super::error::ImitationError;
 use super::footsteps::FootstepConfig;
+use super::koenemann::KoenemannConfig;
 use super::phase::PhaseConfig;
 use super::shaping::MotionLimits;
 use super::support::SupportConfig;
@@ -9,9 +10,26 @@ use super::tables::TaskTables;
 use crate::robots::FootArea;
 use crate::solver::Settings;
 
+/// Which method imitates.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum ImitationMethod {
+    /// Poubel et al.'s support phases and task tables, one prioritized IK step per frame
+    /// (default; the other settings are this method's unless they say otherwise).
+    #[default]
+    Poubel,
+    /// Koenemann et al.'s posture mapping, CoM offset control and foot retargeting. It uses
+    /// `support`, `step_envelope`, `velocity_fraction`, `upper_body_velocity_fraction`,
+    /// `motion` (the swing foot's touchdown), `max_task_speed` (the swing foot's speed),
+    /// `max_tracking_speed` (the hands' speed), `nominal_dt` and `initial_q`; not the tables,
+    /// phases, footsteps, iterations or solver settings.
+    Koenemann(KoenemannConfig),
+}
+
 /// Settings of the imitator. Defaults are the paper's where it gives them.
 #[derive(Debug, Clone)]
 pub struct ImitatorConfig {
+    /// The method (default: Poubel et al.'s).
+    pub method: ImitationMethod,
     /// Support detection (default: optical motion capture).
     pub support: SupportConfig,
     /// Where a foot may be put down relative to the other; `None` (default): the profile's
@@ -75,6 +93,7 @@ pub struct ImitatorConfig {
 impl Default for ImitatorConfig {
     fn default() -> Self {
         Self {
+            method: ImitationMethod::Poubel,
             support: SupportConfig::optical(),
             step_envelope: None,
             min_segment: 1e-9,
@@ -145,6 +164,11 @@ impl ImitatorConfig {
         }
         if let Some((name, value)) = self.motion.invalid_field() {
             return invalid(name, value, "motion limits must be finite and > 0");
+        }
+        if let ImitationMethod::Koenemann(k) = &self.method
+            && let Some((name, value, reason)) = k.invalid_field()
+        {
+            return invalid(name, value, reason);
         }
         if self.iterations_per_frame == 0 {
             return invalid("iterations_per_frame", 0.0, "must be >= 1");

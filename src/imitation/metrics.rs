@@ -22,10 +22,8 @@
 use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 
 use super::imitator::{Imitator, RobotFrame};
-use super::output::effector_frames;
 use super::phase::SupportPhase;
 use super::support::HumanSupport;
-use super::tables::{PointTarget, Task};
 use super::travel::{HandTrace, Stance, StepCounter, Travel, TravelRecorder, robot_stance};
 use crate::solver::JointBounds;
 
@@ -389,27 +387,11 @@ fn rotation_angle(r: &nalgebra::Rotation3<f64>) -> f64 {
 }
 
 impl MetricsRecorder {
-    /// A recorder for the runs of `imitator`: its tables (which effectors each phase tracks),
+    /// A recorder for the runs of `imitator`: which effectors each phase tracks,
     /// joint bounds and feet are read once here.
     pub fn new(imitator: &Imitator) -> Self {
         let profile = imitator.profile();
-        let frames = effector_frames(profile);
-        let tracked = SupportPhase::ALL.map(|phase| {
-            let tasks: Vec<&Task> = imitator
-                .table(phase)
-                .levels
-                .iter()
-                .flat_map(|l| &l.tasks)
-                .collect();
-            let mut tracked = [false; 4];
-            for (t, ((_, joint), name)) in tracked.iter_mut().zip(EFFECTORS.iter().zip(frames)) {
-                *t = tasks.iter().any(|task| {
-                    matches!(task, Task::Point { frame, target: PointTarget::Scaled(j), .. }
-                        if frame == name && j == joint)
-                });
-            }
-            tracked
-        });
+        let tracked = SupportPhase::ALL.map(|phase| imitator.tracked_effectors(phase));
         Self {
             tracked,
             bounds: imitator.bounds().clone(),

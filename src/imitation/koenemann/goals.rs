@@ -1,0 +1,262 @@
+//! The IK goals of the method and their rows: points and sole normals in the torso frame (the
+//! frame the posture mapping speaks in) or in the root sole's frame (the floor), solved by
+//! weighted damped least squares ([`Method::WeightedDls`]) to a tolerance.
+//!
+//! Rows relative to the torso `(R_t, p_t)` of the root-sole model: for a point `x`,
+//! `d/dt Rₜᵀ(x − pₜ) = Rₜᵀ (J_x − J_t + [x − pₜ]× J_ωt) q̇`; for a frame's z axis `z`,
+//! `d/dt Rₜᵀ z = Rₜᵀ ((J_ω − J_ωt) q̇ × z)`. A normal goal has two rows: the change of `z`
+//! along two directions across it (turning about `z` itself is free: the 5-DoF foot goal of
+//! §V.C), weighted by [`NORMAL_WEIGHT`] so that one tolerance reads 1 mm or 0.033 rad.
+
+use faer::Mat;
+use nalgebra::{IsometryMatrix3, Rotation3, Vector3};
+
+use crate::imitation::error::ImitationError;
+use crate::model::{FrameId, Model, ModelData};
+use crate::solver::driver::{DriverReport, DriverSettings, PositionDriver, TaskModel};
+use crate::solver::{JointBounds, Method, Settings, Solver, SolverError, StackShape, TaskStack};
+
+/// Metres per radian of a normal or orientation row: Koenemann et al.'s tolerances, 1 mm and
+/// 0.033 rad, become one.
+pub(super) const NORMAL_WEIGHT: f64 = 0.001 / 0.033;
+
+/// One goal.
+#[derive(Debug, Clone, Copy)]
+pub(super) enum Goal {
+    /// The point at `offset` (frame axes) from `frame` at `target` in the torso frame (3 rows).
+    TorsoPoint {
+        frame: FrameId,
+        offset: Vector3<f64>,
+        target: Vector3<f64>,
+    },
+    /// `frame`'s z axis along the unit `normal` in the torso frame (2 rows).
+    TorsoNormal {
+        frame: FrameId,
+        normal: Vector3<f64>,
+    },
+    /// The point at `offset` from `frame` at `target` in the root frame (3 rows).
+    RootPoint {
+        frame: FrameId,
+        offset: Vector3<f64>,
+        target: Vector3<f64>,
+    },
+    /// `frame`'s z axis along the unit `normal` in the root frame (2 rows).
+    RootNormal {
+        frame: FrameId,
+        normal: Vector3<f64>,
+    },
+    /// `frame`'s orientation at `target` in the root frame (3 rows).
+    RootOrientation {
+        frame: FrameId,
+        target: Rotation3<f64>,
+    },
+}
+
+impl Goal {
+    fn rows(&self) -> usize {
+        match self {
+            Goal::TorsoNormal { .. } | Goal::RootNormal { .. } => 2,
+            _ => 3,
+        }
+    }
+}
+
+/// A fixed list of goals with its solver, driver and scratch: one IK problem of the method.
+#[derive(Debug)]
+pub(super) struct GoalIk {
+    pub(super) goals: Vec<Goal>,
+    solver: Solver,
+    driver: PositionDriver,
+    /// Torso point and angular Jacobians, a frame's point and angular Jacobians (3 × n).
+    scratch: [Mat<f64>; 4],
+}
+
+impl GoalIk {
+    /// An IK for goals shaped like `goals` (their kinds fix the rows; targets change per frame):
+    /// one level solved by `method`, or with `first` goals in a level above the rest (for
+    /// [`Method::Prioritized`]).
+    pub(super) fn new(
+        goals: Vec<Goal>,
+        first: Option<usize>,
+        nv: usize,
+        method: Method,
+        settings: DriverSettings,
+    ) -> Result<Self, SolverError> {
+        let names: Vec<String> = (0..goals.len()).map(|k| format!("goal {k}")).collect();
+        let tasks: Vec<(&str, usize)> = names
+            .iter()
+            .zip(&goals)
+            .map(|(n, g)| (n.as_str(), g.rows()))
+            .collect();
+        let shape = match first {
+            Some(k) => StackShape::new(nv)
+                .with_level("held", &tasks[..k])
+                .with_level("goals", &tasks[k..]),
+            None => StackShape::new(nv).with_level("goals", &tasks),
+        };
+        let solver = Solver::with_settings(
+            &shape,
+            Settings {
+                method,
+                ..Settings::default()
+            },
+        )?;
+        let driver = PositionDriver::new(&solver, settings)?;
+        Ok(GoalIk {
+            goals,
+            solver,
+            driver,
+            scratch: std::array::from_fn(|_| Mat::zeros(3, nv)),
+        })
+    }
+
+    /// Moves `q` toward the goals (warm start), within the position limits of `bounds`.
+    pub(super) fn run(
+        &mut self,
+        model: &Model,
+        data: &mut ModelData,
+        torso: FrameId,
+        q: &mut [f64],
+        bounds: &JointBounds,
+    ) -> Result<&DriverReport, ImitationError> {
+        let mut rows = GoalRows {
+            model,
+            data,
+            torso,
+            goals: &self.goals,
+            scratch: &mut self.scratch,
+        };
+        self.driver.run(&mut self.solver, &mut rows, q, bounds)
+    }
+}
+
+/// The goals as a [`TaskModel`].
+struct GoalRows<'a> {
+    model: &'a Model,
+    data: &'a mut ModelData,
+    torso: FrameId,
+    goals: &'a [Goal],
+    scratch: &'a mut [Mat<f64>; 4],
+}
+
+impl TaskModel for GoalRows<'_> {
+    type Error = ImitationError;
+
+    fn evaluate(&mut self, q: &[f64], stack: &mut TaskStack) -> Result<(), ImitationError> {
+        let model = self.model;
+        model.forward_kinematics(self.data, q)?;
+        let data = &*self.data;
+        let torso = *data.frame_placement(self.torso);
+        let [jt, jwt, jx, jw] = &mut *self.scratch;
+        model.point_jacobian(data, self.torso, &Vector3::zeros(), jt.as_mut())?;
+        model.orientation_jacobian(data, self.torso, jwt.as_mut())?;
+        let rt = torso.rotation.inverse();
+        let (mut level, mut first) = (0, 0);
+        for goal in self.goals {
+            let rows = goal.rows();
+            if first == stack.level_mut(level).rows() {
+                (level, first) = (level + 1, 0);
+            }
+            let mut rows_of = stack.level_mut(level);
+            let (mut jac, error) = rows_of.rows_mut(first, rows);
+            first += rows;
+            match *goal {
+                Goal::TorsoPoint {
+                    frame,
+                    offset,
+                    target,
+                }
+                | Goal::RootPoint {
+                    frame,
+                    offset,
+                    target,
+                } => {
+                    let x = model.point_position(data, frame, &offset)?;
+                    model.point_jacobian(data, frame, &offset, jx.as_mut())?;
+                    let in_torso = matches!(goal, Goal::TorsoPoint { .. });
+                    let current = if in_torso {
+                        rt * (x - torso.translation.vector)
+                    } else {
+                        x
+                    };
+                    let lever = x - torso.translation.vector;
+                    for k in 0..q.len() {
+                        let col = column(jx, k);
+                        let col = match in_torso {
+                            true => rt * (col - column(jt, k) + lever.cross(&column(jwt, k))),
+                            false => col,
+                        };
+                        for r in 0..3 {
+                            jac[(r, k)] = col[r];
+                        }
+                    }
+                    for r in 0..3 {
+                        error[r] = target[r] - current[r];
+                    }
+                }
+                Goal::TorsoNormal { frame, normal } | Goal::RootNormal { frame, normal } => {
+                    let in_torso = matches!(goal, Goal::TorsoNormal { .. });
+                    let z_root = data.frame_placement(frame).rotation * Vector3::z();
+                    let z = if in_torso { rt * z_root } else { z_root };
+                    model.orientation_jacobian(data, frame, jw.as_mut())?;
+                    let across = across_basis(&z);
+                    for k in 0..q.len() {
+                        let omega = match in_torso {
+                            true => column(jw, k) - column(jwt, k),
+                            false => column(jw, k),
+                        };
+                        let dz = omega.cross(&z_root);
+                        let dz = if in_torso { rt * dz } else { dz };
+                        for (r, t) in across.iter().enumerate() {
+                            jac[(r, k)] = NORMAL_WEIGHT * t.dot(&dz);
+                        }
+                    }
+                    for (r, t) in across.iter().enumerate() {
+                        error[r] = NORMAL_WEIGHT * t.dot(&(normal - z));
+                    }
+                }
+                Goal::RootOrientation { frame, target } => {
+                    // ½ Σ cᵢ × cᵢ*, the columns of the current and target rotations: the
+                    // rotation vector for small errors, and never NaN.
+                    let current = data.frame_placement(frame).rotation;
+                    let (c, t) = (current.matrix(), target.matrix());
+                    let e = (0..3).fold(Vector3::zeros(), |e, i| {
+                        e + c.column(i).cross(&t.column(i)) * 0.5
+                    });
+                    model.orientation_jacobian(data, frame, jw.as_mut())?;
+                    for k in 0..q.len() {
+                        for r in 0..3 {
+                            jac[(r, k)] = NORMAL_WEIGHT * jw[(r, k)];
+                        }
+                    }
+                    for r in 0..3 {
+                        error[r] = NORMAL_WEIGHT * e[r];
+                    }
+                }
+            }
+        }
+        stack.clear_gradient();
+        Ok(())
+    }
+}
+
+/// Column `k` of a 3 × n matrix.
+fn column(m: &Mat<f64>, k: usize) -> Vector3<f64> {
+    Vector3::new(m[(0, k)], m[(1, k)], m[(2, k)])
+}
+
+/// Two unit vectors across the unit `z`, orthogonal to each other.
+fn across_basis(z: &Vector3<f64>) -> [Vector3<f64>; 2] {
+    let helper = if z.x.abs() < 0.9 {
+        Vector3::x()
+    } else {
+        Vector3::y()
+    };
+    let a = z.cross(&helper).normalize();
+    [a, z.cross(&a)]
+}
+
+/// The placement of frame `frame` of `data` seen from the torso frame `torso`.
+pub(super) fn in_torso(data: &ModelData, torso: FrameId, frame: FrameId) -> IsometryMatrix3<f64> {
+    data.frame_placement(torso).inverse() * data.frame_placement(frame)
+}

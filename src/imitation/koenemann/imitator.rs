@@ -1,0 +1,792 @@
+//! The per-frame pipeline of Koenemann et al.'s method (see the module docs of
+//! [`super`]): state, targets, the three IK problems, and the robot frame it writes.
+
+use std::time::Instant;
+
+use nalgebra::{IsometryMatrix3, Vector3};
+
+use super::KoenemannConfig;
+use super::goals::{Goal, GoalIk, in_torso};
+use super::mapping::{Limbs, Posture, PostureMapping};
+use super::offset::offset;
+use super::retarget::{FootRetargeting, retarget_double, support_normal};
+use super::support_mode::{SupportMode, target_offset};
+use crate::human::{HumanFrame, HumanJoint, Side, centre_of_mass};
+use crate::imitation::config::ImitatorConfig;
+use crate::imitation::error::ImitationError;
+use crate::imitation::imitator::{Shared, effector_ids, frame_dt, human_stance};
+use crate::imitation::metrics::CONTACT_HEIGHT;
+use crate::imitation::output::RobotFrame;
+use crate::imitation::phase::{Landing, SupportPhase, TakeOff};
+use crate::imitation::shaping::{MotionLimits, SwingHeight};
+use crate::imitation::support::{HumanSupport, SupportDetector};
+use crate::model::{FrameId, Model, ModelData, ModelError};
+use crate::robots::{BipedProfile, FootArea, RobotPoint, SolePlacement};
+use crate::solver::driver::DriverSettings;
+use crate::solver::{JointBounds, Method};
+
+/// Smallest height of a swing sole above the floor while the human's foot is up (m).
+const SWING_CLEARANCE: f64 = 0.01;
+/// Passes of the legs' IK with the CoM, hence the normal, recomputed.
+const STABILIZE_PASSES: usize = 3;
+
+/// Frames of one model.
+#[derive(Debug)]
+struct Frames {
+    torso: FrameId,
+    soles: [FrameId; 2],
+    ankles: [FrameId; 2],
+    hands: [FrameId; 2],
+    effectors: [FrameId; 4],
+}
+
+/// Robot geometry the method needs, measured once at the standing posture.
+#[derive(Debug)]
+struct Body {
+    /// Shoulders and hips in the torso frame (m), `[left, right]`.
+    shoulders: [Vector3<f64>; 2],
+    hips: [Vector3<f64>; 2],
+    limbs: Limbs,
+    /// Sole centres in the sole frames.
+    centres: [Vector3<f64>; 2],
+    /// Each ankle in its sole frame.
+    ankles: [Vector3<f64>; 2],
+    /// Each ankle relative to its hip standing (torso axes).
+    stance: [Vector3<f64>; 2],
+}
+
+/// Koenemann et al.'s imitator.
+#[derive(Debug)]
+pub(crate) struct KoenemannImitator {
+    pub(crate) shared: Shared,
+    config: KoenemannConfig,
+    frames: [Frames; 2],
+    body: Body,
+    mapping: Option<PostureMapping>,
+    detector: SupportDetector,
+    arms: GoalIk,
+    /// Goals of 3 + 2 + 3 + 2 rows: single support, landing, the paper's double support.
+    feet: GoalIk,
+    /// Goals of 3 + 2 + 3 + 3 rows: double support keeping the stance.
+    stance: GoalIk,
+    position_bounds: JointBounds,
+    tracking_speed: f64,
+    foot_speed: f64,
+    motion: MotionLimits,
+    step_envelope: FootArea,
+    q_start: Vec<f64>,
+    mode: SupportMode,
+    /// The foot coming down after single support, until it is on the floor.
+    landing: Option<Side>,
+    /// Commanded offset `o'` and the offset achieved at the last frame.
+    command: f64,
+    measured: f64,
+    /// Post-processed hand targets (torso frame).
+    hands: Option<[Vector3<f64>; 2]>,
+    /// Post-processed swing ankle target (root frame).
+    swing_target: Option<Vector3<f64>>,
+    swing: SwingHeight,
+    /// Placement of the non-root sole held in double support (root frame).
+    hold: IsometryMatrix3<f64>,
+}
+
+fn frames(profile: &BipedProfile, root: Side) -> Result<Frames, ModelError> {
+    let model = profile.model(root);
+    let id = |name: &str| model.frame_id(name);
+    let [lf, rf] = &profile.feet;
+    let [lh, rh] = &profile.hands;
+    Ok(Frames {
+        torso: id(&profile.torso)?,
+        soles: [id(&lf.sole)?, id(&rf.sole)?],
+        ankles: [id(&lf.ankle)?, id(&rf.ankle)?],
+        hands: [id(lh)?, id(rh)?],
+        effectors: effector_ids(profile)?[root.index()],
+    })
+}
+
+/// The robot point standing for `joint` in the profile, in the root frame of `data`.
+fn robot_point(
+    profile: &BipedProfile,
+    model: &Model,
+    data: &ModelData,
+    joint: HumanJoint,
+) -> Result<Vector3<f64>, ImitationError> {
+    let point = (profile.points.iter().find(|(j, _)| *j == joint))
+        .map(|(_, p)| p)
+        .ok_or_else(|| ImitationError::InvalidParameter {
+            name: "profile.points",
+            value: joint.index() as f64,
+            reason: "the method needs the shoulders, elbows, hips and knees mapped",
+        })?;
+    let at = |name: &str| -> Result<Vector3<f64>, ModelError> {
+        Ok(data
+            .frame_placement(model.frame_id(name)?)
+            .translation
+            .vector)
+    };
+    Ok(match point {
+        RobotPoint::Frame(a) => at(a)?,
+        RobotPoint::Midpoint(a, b) => (at(a)? + at(b)?) * 0.5,
+    })
+}
+
+impl Body {
+    fn measure(profile: &BipedProfile, q: &[f64]) -> Result<Self, ImitationError> {
+        let model = profile.model(Side::Right);
+        let mut data = model.new_data();
+        model.forward_kinematics(&mut data, q)?;
+        let f = frames(profile, Side::Right)?;
+        let torso = data.frame_placement(f.torso).inverse();
+        let point = |j| robot_point(profile, model, &data, j);
+        use HumanJoint as J;
+        let pair = |l, r| -> Result<[Vector3<f64>; 2], ImitationError> {
+            Ok([point(l)?, point(r)?].map(|p| torso.transform_point(&p.into()).coords))
+        };
+        let shoulders = pair(J::LShoulder, J::RShoulder)?;
+        let elbows = pair(J::LElbow, J::RElbow)?;
+        let hips = pair(J::LHip, J::RHip)?;
+        let knees = pair(J::LKnee, J::RKnee)?;
+        let hands = f
+            .hands
+            .map(|h| in_torso(&data, f.torso, h).translation.vector);
+        let ankles = f
+            .ankles
+            .map(|a| in_torso(&data, f.torso, a).translation.vector);
+        let length = |a: &[Vector3<f64>; 2], b: &[Vector3<f64>; 2], c: &[Vector3<f64>; 2]| {
+            [0, 1].map(|k| (b[k] - a[k]).norm() + (c[k] - b[k]).norm())
+        };
+        let sole_ankle = |s: Side| {
+            let k = s.index();
+            (data.frame_placement(f.soles[k]).inverse() * data.frame_placement(f.ankles[k]))
+                .translation
+                .vector
+        };
+        Ok(Body {
+            shoulders,
+            hips,
+            limbs: Limbs {
+                arms: length(&shoulders, &elbows, &hands),
+                legs: length(&hips, &knees, &ankles),
+            },
+            centres: Side::BOTH.map(|s| {
+                let [x, y] = profile.sole_centre(s);
+                Vector3::new(x, y, 0.0)
+            }),
+            ankles: Side::BOTH.map(sole_ankle),
+            stance: [0, 1].map(|k| ankles[k] - hips[k]),
+        })
+    }
+}
+
+impl KoenemannImitator {
+    pub(crate) fn new(
+        profile: BipedProfile,
+        config: &ImitatorConfig,
+        method: KoenemannConfig,
+    ) -> Result<Self, ImitationError> {
+        let (shared, position_bounds) = Shared::new(profile, config)?;
+        let profile = &shared.profile;
+        let body = Body::measure(profile, &shared.q)?;
+        let frames = [frames(profile, Side::Left)?, frames(profile, Side::Right)?];
+        let nv = shared.q.len();
+        let arm_settings = DriverSettings {
+            gain: 1.0,
+            dt: 1.0,
+            tolerance: 1e-4,
+            stall_tolerance: 1e-7,
+            max_iterations: method.arm_iterations,
+            max_task_error: 0.05,
+            max_joint_step: 0.1,
+        };
+        let leg_settings = DriverSettings {
+            tolerance: method.tolerance,
+            max_iterations: method.max_leg_iterations,
+            max_task_error: 0.02,
+            max_joint_step: 0.05,
+            ..arm_settings
+        };
+        let f = &frames[Side::Right.index()];
+        let point = |frame| Goal::TorsoPoint {
+            frame,
+            offset: Vector3::zeros(),
+            target: Vector3::zeros(),
+        };
+        let normal = |frame| Goal::TorsoNormal {
+            frame,
+            normal: Vector3::z(),
+        };
+        let orientation = Goal::RootOrientation {
+            frame: f.soles[0],
+            target: Default::default(),
+        };
+        let dls = Method::WeightedDls {
+            damping: method.damping,
+        };
+        let arms = GoalIk::new(f.hands.map(point).to_vec(), None, nv, dls, arm_settings)?;
+        let feet_goals = vec![
+            point(f.soles[0]),
+            normal(f.soles[0]),
+            point(f.soles[1]),
+            normal(f.soles[1]),
+        ];
+        let feet = GoalIk::new(feet_goals, None, nv, dls, leg_settings)?;
+        // The held sole first, strictly: the closed chain of double support must not give way.
+        let hold = Goal::RootPoint {
+            frame: f.soles[1],
+            offset: Vector3::zeros(),
+            target: Vector3::zeros(),
+        };
+        let stance_goals = vec![hold, orientation, point(f.soles[0]), normal(f.soles[0])];
+        let stance = GoalIk::new(stance_goals, Some(2), nv, Method::Prioritized, leg_settings)?;
+        let tuning = profile.tuning;
+        // The left sole in the right-rooted model (the root at the start).
+        let hold = shared.output.left_sole;
+        Ok(KoenemannImitator {
+            detector: SupportDetector::new(config.support)?,
+            tracking_speed: config.max_tracking_speed.unwrap_or(tuning.tracking_speed),
+            foot_speed: config.max_task_speed.unwrap_or(tuning.task_speed),
+            motion: config.motion,
+            step_envelope: config.step_envelope.unwrap_or(profile.step_envelope),
+            q_start: shared.q.clone(),
+            config: method,
+            frames,
+            body,
+            mapping: None,
+            arms,
+            feet,
+            stance,
+            position_bounds,
+            mode: SupportMode::Double,
+            landing: None,
+            command: 0.5,
+            measured: 0.5,
+            hands: None,
+            swing_target: None,
+            swing: SwingHeight::at(0.0),
+            hold,
+            shared,
+        })
+    }
+
+    /// Imitates one human frame.
+    pub(crate) fn step(&mut self, frame: &HumanFrame) -> Result<&RobotFrame, ImitationError> {
+        let start = Instant::now();
+        let dt = frame_dt(
+            self.shared.previous_time,
+            frame.time,
+            self.shared.nominal_dt,
+        )?;
+        let human = self.detector.update(frame);
+        self.q_start.copy_from_slice(&self.shared.q);
+        let posture = Posture::of_human(frame);
+        if self.mapping.is_none() && posture.is_some() {
+            self.mapping = PostureMapping::calibrate(
+                frame,
+                &self.body.limbs,
+                self.body.stance,
+                self.config.calibration,
+            );
+        }
+        let mapped = match (&self.mapping, &posture) {
+            (Some(mapping), Some(p)) => Some(mapping.map(p)),
+            _ => None,
+        };
+        self.update_mode(frame, human, dt)?;
+        self.shared.refresh()?;
+        self.track_hands(mapped.as_ref(), dt)?;
+        self.stabilize(mapped.as_ref(), dt)?;
+        self.limit_velocities(dt);
+        self.shared.refresh()?;
+        self.measure();
+        self.write_output(frame, human, mapped.as_ref())?;
+        self.shared.previous_time = Some(frame.time);
+        self.shared.output.micros = start.elapsed().as_secs_f64() * 1e6;
+        Ok(&self.shared.output)
+    }
+
+    /// Fig. 4 and the offset command; the root follows the support foot.
+    fn update_mode(
+        &mut self,
+        frame: &HumanFrame,
+        human: HumanSupport,
+        dt: f64,
+    ) -> Result<(), ImitationError> {
+        let tolerance = self.config.offset_tolerance;
+        let next = self.mode.next(human, self.measured, tolerance);
+        if let (SupportMode::Left | SupportMode::Right, SupportMode::Double) = (self.mode, next) {
+            let support = if self.mode == SupportMode::Left {
+                Side::Left
+            } else {
+                Side::Right
+            };
+            self.landing = Some(support.other());
+            self.swing = SwingHeight::at(self.swing_sole_height(support.other()));
+        }
+        if let SupportMode::Left | SupportMode::Right = next {
+            self.landing = None;
+        }
+        self.mode = next;
+        if self.landing.is_none() {
+            let target = match next {
+                SupportMode::Left => 0.0,
+                SupportMode::Right => 1.0,
+                SupportMode::Double => {
+                    target_offset(human, human_offset(frame).unwrap_or(0.5), self.command)
+                }
+            };
+            self.command = self.config.offset_speed.step(self.command, target, dt);
+        }
+        let root = match (next, self.landing) {
+            (SupportMode::Left, _) => Side::Left,
+            (SupportMode::Right, _) => Side::Right,
+            (SupportMode::Double, Some(swing)) => swing.other(),
+            (SupportMode::Double, None) => self.shared.root,
+        };
+        if root != self.shared.root {
+            self.shared.switch_root(root)?;
+            self.swing_target = None;
+        }
+        Ok(())
+    }
+
+    /// Height of `side`'s sole origin above the root sole (m).
+    fn swing_sole_height(&self, side: Side) -> f64 {
+        let (data, f) = self.current();
+        data.frame_placement(f.soles[side.index()]).translation.z
+    }
+
+    fn current(&self) -> (&ModelData, &Frames) {
+        let root = self.shared.root.index();
+        (&self.shared.data[root], &self.frames[root])
+    }
+
+    /// The hand targets: mapped, at most `tracking_speed` from the last ones, outside the torso;
+    /// then the arms' IK.
+    fn track_hands(&mut self, mapped: Option<&Posture>, dt: f64) -> Result<(), ImitationError> {
+        let (data, f) = self.current();
+        let current = f
+            .hands
+            .map(|h| in_torso(data, f.torso, h).translation.vector);
+        let wanted = match mapped {
+            Some(m) => [0, 1].map(|k| self.body.shoulders[k] + m.hands[k]),
+            None => self.hands.unwrap_or(current),
+        };
+        let previous = self.hands.unwrap_or(current);
+        let reach = self.tracking_speed * dt;
+        let radius = 0.5 * (self.body.hips[0] - self.body.hips[1]).norm();
+        let targets = [0, 1].map(|k| {
+            let step = wanted[k] - previous[k];
+            let moved = previous[k] + step * (reach / step.norm().max(reach));
+            outside_torso(moved, radius, &self.body)
+        });
+        self.hands = Some(targets);
+        let root = self.shared.root.index();
+        let f = &self.frames[root];
+        for (goal, (&frame, target)) in self.arms.goals.iter_mut().zip(f.hands.iter().zip(targets))
+        {
+            *goal = Goal::TorsoPoint {
+                frame,
+                offset: Vector3::zeros(),
+                target,
+            };
+        }
+        let model = self.shared.profile.model(self.shared.root);
+        self.arms.run(
+            model,
+            &mut self.shared.data[root],
+            f.torso,
+            &mut self.shared.q,
+            &self.position_bounds,
+        )?;
+        Ok(())
+    }
+
+    /// §V.C: the feet's goals for the mode, and the legs' IK, with the CoM recomputed between
+    /// passes.
+    fn stabilize(&mut self, mapped: Option<&Posture>, dt: f64) -> Result<(), ImitationError> {
+        for _ in 0..STABILIZE_PASSES {
+            self.shared.refresh()?;
+            let (data, f) = self.current();
+            let ankles_now = f
+                .ankles
+                .map(|a| in_torso(data, f.torso, a).translation.vector);
+            let ankles = match mapped {
+                Some(m) => [0, 1].map(|k| self.body.hips[k] + m.feet[k]),
+                None => ankles_now,
+            };
+            // Mapped ankle targets carried to the sole centres by the feet's current offsets.
+            let centres_now = Side::BOTH.map(|s| self.centre_in_torso(s));
+            let centres = [0, 1].map(|k| ankles[k] + (centres_now[k] - ankles_now[k]));
+            let com = self.com_in_torso()?;
+            let solved = match (self.mode, self.landing) {
+                (SupportMode::Left, _) => {
+                    self.single(Side::Left, &com, &centres, &ankles, false, dt)?
+                }
+                (SupportMode::Right, _) => {
+                    self.single(Side::Right, &com, &centres, &ankles, false, dt)?
+                }
+                (SupportMode::Double, Some(swing)) => {
+                    self.single(swing.other(), &com, &centres, &ankles, true, dt)?
+                }
+                (SupportMode::Double, None) => self.double(&com, centres, &centres_now)?,
+            };
+            if solved {
+                break;
+            }
+        }
+        Ok(())
+    }
+
+    /// Single support on `support` (or the landing of the other foot): the support sole tilts
+    /// so the CoM is above its centre; the swing ankle goes to its post-processed target, flat.
+    /// Returns whether the CoM's normal changed by less than the tolerance over the pass.
+    fn single(
+        &mut self,
+        support: Side,
+        com: &Vector3<f64>,
+        centres: &[Vector3<f64>; 2],
+        ankles: &[Vector3<f64>; 2],
+        landing: bool,
+        dt: f64,
+    ) -> Result<bool, ImitationError> {
+        let (s, w) = (support.index(), support.other().index());
+        let normal = support_normal(com, &centres[s], &centres[s], 0.0).unwrap_or(Vector3::z());
+        let swing = self.swing_ankle_target(support, ankles[w], landing, dt);
+        let root = self.shared.root.index();
+        let f = &self.frames[root];
+        self.feet.goals.copy_from_slice(&[
+            Goal::TorsoPoint {
+                frame: f.soles[s],
+                offset: self.body.centres[s],
+                target: centres[s],
+            },
+            Goal::TorsoNormal {
+                frame: f.soles[s],
+                normal,
+            },
+            Goal::RootPoint {
+                frame: f.ankles[w],
+                offset: Vector3::zeros(),
+                target: swing,
+            },
+            Goal::RootNormal {
+                frame: f.soles[w],
+                normal: Vector3::z(),
+            },
+        ]);
+        let model = self.shared.profile.model(self.shared.root);
+        self.feet.run(
+            model,
+            &mut self.shared.data[root],
+            f.torso,
+            &mut self.shared.q,
+            &self.position_bounds,
+        )?;
+        self.normal_settled(support, &normal)
+    }
+
+    /// Whether the CoM is now above `support`'s centre within the tolerance (the normal of the
+    /// new CoM within 0.033 rad of the one solved for).
+    fn normal_settled(
+        &mut self,
+        support: Side,
+        normal: &Vector3<f64>,
+    ) -> Result<bool, ImitationError> {
+        self.shared.refresh()?;
+        let com = self.com_in_torso()?;
+        let centre = self.centre_in_torso(support);
+        let now = support_normal(&com, &centre, &centre, 0.0).unwrap_or(*normal);
+        Ok(now.angle(normal) <= self.config.tolerance / super::goals::NORMAL_WEIGHT)
+    }
+
+    /// The swing ankle's target in the root frame: the mapped one, at most `foot_speed` from
+    /// the last, above the floor, beside the support foot; while landing, at its last place on
+    /// the floor's step envelope, lowered at the touchdown speed.
+    fn swing_ankle_target(
+        &mut self,
+        support: Side,
+        mapped: Vector3<f64>,
+        landing: bool,
+        dt: f64,
+    ) -> Vector3<f64> {
+        let (data, f) = self.current();
+        let w = support.other().index();
+        let torso = data.frame_placement(f.torso);
+        let wanted = torso.transform_point(&mapped.into()).coords;
+        let current = data.frame_placement(f.ankles[w]).translation.vector;
+        let previous = self.swing_target.unwrap_or(current);
+        let reach = self.foot_speed * dt;
+        let step = wanted - previous;
+        let mut target = previous + step * (reach / step.norm().max(reach));
+        let ankle_height = self.body.ankles[w].z;
+        // The sole's place relative to the support sole (the root), clipped.
+        let sole_offset = target.xy() - self.body.ankles[w].xy();
+        let placement = SolePlacement {
+            xy: sole_offset,
+            yaw: 0.0,
+        };
+        let clipped = if landing {
+            self.step_envelope.clip(support.other(), placement)
+        } else {
+            let lateral = FootArea {
+                x_min: f64::NEG_INFINITY,
+                x_max: f64::INFINITY,
+                lateral_max: f64::INFINITY,
+                yaw_max: 0.0,
+                ..self.step_envelope
+            };
+            lateral.clip(support.other(), placement)
+        };
+        target.x = clipped.xy.x + self.body.ankles[w].x;
+        target.y = clipped.xy.y + self.body.ankles[w].y;
+        if landing {
+            self.swing.advance(0.0, dt, &self.motion);
+            target.z = ankle_height + self.swing.height();
+        } else {
+            target.z = target.z.max(ankle_height + SWING_CLEARANCE);
+        }
+        self.swing_target = Some(target);
+        target
+    }
+
+    /// Double support: the feet's goals from the retargeting rule. Returns whether the CoM's
+    /// offset is within tolerance of the command after the pass.
+    fn double(
+        &mut self,
+        com: &Vector3<f64>,
+        mapped: [Vector3<f64>; 2],
+        now: &[Vector3<f64>; 2],
+    ) -> Result<bool, ImitationError> {
+        let rule = self.config.retargeting;
+        let root = self.shared.root;
+        let (r, o) = (root.index(), root.other().index());
+        let f = &self.frames[r];
+        let targets = match rule {
+            FootRetargeting::ShiftBothFeet => {
+                // The stance as it is, placed where the mapping puts its middle.
+                let (middle, half) = ((mapped[0] + mapped[1]) * 0.5, (now[1] - now[0]) * 0.5);
+                retarget_double(rule, com, [middle - half, middle + half], self.command)
+            }
+            FootRetargeting::MoveOneFoot => retarget_double(rule, com, mapped, self.command),
+        };
+        let normal =
+            support_normal(com, &targets[0], &targets[1], self.command).unwrap_or(Vector3::z());
+        let centre = |k: usize| Goal::TorsoPoint {
+            frame: f.soles[k],
+            offset: self.body.centres[k],
+            target: targets[k],
+        };
+        let ik = match rule {
+            FootRetargeting::ShiftBothFeet => {
+                self.stance.goals.copy_from_slice(&[
+                    Goal::RootPoint {
+                        frame: f.soles[o],
+                        offset: Vector3::zeros(),
+                        target: self.hold.translation.vector,
+                    },
+                    Goal::RootOrientation {
+                        frame: f.soles[o],
+                        target: self.hold.rotation,
+                    },
+                    centre(r),
+                    Goal::TorsoNormal {
+                        frame: f.soles[r],
+                        normal,
+                    },
+                ]);
+                &mut self.stance
+            }
+            FootRetargeting::MoveOneFoot => {
+                self.feet.goals.copy_from_slice(&[
+                    centre(0),
+                    Goal::TorsoNormal {
+                        frame: f.soles[0],
+                        normal,
+                    },
+                    centre(1),
+                    Goal::TorsoNormal {
+                        frame: f.soles[1],
+                        normal,
+                    },
+                ]);
+                &mut self.feet
+            }
+        };
+        let model = self.shared.profile.model(root);
+        ik.run(
+            model,
+            &mut self.shared.data[r],
+            f.torso,
+            &mut self.shared.q,
+            &self.position_bounds,
+        )?;
+        self.shared.refresh()?;
+        let com = self.com_in_torso()?;
+        let achieved =
+            support_normal(&com, &targets[0], &targets[1], self.command).unwrap_or(normal);
+        Ok(achieved.angle(&normal) <= self.config.tolerance / super::goals::NORMAL_WEIGHT)
+    }
+
+    /// The CoM in the torso frame (current forward kinematics).
+    fn com_in_torso(&self) -> Result<Vector3<f64>, ImitationError> {
+        let (data, f) = self.current();
+        let com = self.shared.profile.model(self.shared.root).com(data)?;
+        Ok(data
+            .frame_placement(f.torso)
+            .inverse_transform_point(&com.into())
+            .coords)
+    }
+
+    /// The centre of `side`'s sole in the torso frame.
+    fn centre_in_torso(&self, side: Side) -> Vector3<f64> {
+        let (data, f) = self.current();
+        let k = side.index();
+        let sole = in_torso(data, f.torso, f.soles[k]);
+        sole.transform_point(&self.body.centres[k].into()).coords
+    }
+
+    /// §V.D: every joint within its velocity limit for `dt`; the legs scaled together.
+    fn limit_velocities(&mut self, dt: f64) {
+        let velocity = self.shared.bounds.velocity();
+        let mut legs = 1.0_f64;
+        for (i, &leg) in self.shared.legs.iter().enumerate() {
+            let delta = (self.shared.q[i] - self.q_start[i]).abs();
+            if leg && delta > velocity[i] * dt {
+                legs = legs.min(velocity[i] * dt / delta);
+            }
+        }
+        for (i, &leg) in self.shared.legs.iter().enumerate() {
+            let delta = self.shared.q[i] - self.q_start[i];
+            let reach = velocity[i] * dt;
+            self.shared.q[i] = self.q_start[i]
+                + if leg {
+                    delta * legs
+                } else {
+                    delta.clamp(-reach, reach)
+                };
+        }
+        self.shared.bounds.clamp_position(&mut self.shared.q);
+    }
+
+    /// The offset achieved (the CoM's ground projection between the sole centres) and the
+    /// landing foot's contact: once it is down, it is held where it landed.
+    fn measure(&mut self) {
+        let (data, f) = self.current();
+        let centre = |k: usize| {
+            let sole = data.frame_placement(f.soles[k]);
+            let mut p = sole.transform_point(&self.body.centres[k].into()).coords;
+            p.z = 0.0;
+            p
+        };
+        let measured = match self.shared.profile.model(self.shared.root).com(data) {
+            Ok(com) => offset(&Vector3::new(com.x, com.y, 0.0), &centre(0), &centre(1)),
+            Err(_) => None,
+        };
+        let landed = self.landing.and_then(|swing| {
+            let sole = *data.frame_placement(f.soles[swing.index()]);
+            let outline = &self.shared.profile.foot(swing).outline;
+            let down = outline.iter().all(|&[x, y]| {
+                sole.transform_point(&Vector3::new(x, y, 0.0).into()).z <= CONTACT_HEIGHT
+            });
+            down.then_some(sole)
+        });
+        self.measured = measured.unwrap_or(self.measured);
+        if let Some(sole) = landed {
+            self.landing = None;
+            self.hold = sole;
+            self.swing_target = None;
+        }
+    }
+
+    /// The robot's phase in [`SupportPhase`] terms.
+    fn phase(&self, human: HumanSupport) -> SupportPhase {
+        let tolerance = self.config.offset_tolerance;
+        match (self.mode, self.landing) {
+            (SupportMode::Left, _) => SupportPhase::Left,
+            (SupportMode::Right, _) => SupportPhase::Right,
+            (SupportMode::Double, Some(Side::Right)) => {
+                SupportPhase::LeftToDouble(Landing::LowerFoot)
+            }
+            (SupportMode::Double, Some(Side::Left)) => {
+                SupportPhase::RightToDouble(Landing::LowerFoot)
+            }
+            (SupportMode::Double, None) => match human {
+                HumanSupport::Left if self.command > tolerance => {
+                    SupportPhase::DoubleToLeft(TakeOff::ComToFoot)
+                }
+                HumanSupport::Right if self.command < 1.0 - tolerance => {
+                    SupportPhase::DoubleToRight(TakeOff::ComToFoot)
+                }
+                _ => SupportPhase::Double,
+            },
+        }
+    }
+
+    fn write_output(
+        &mut self,
+        frame: &HumanFrame,
+        human: HumanSupport,
+        mapped: Option<&Posture>,
+    ) -> Result<(), ImitationError> {
+        let phase = self.phase(human);
+        let root = self.shared.root.index();
+        let f = &self.frames[root];
+        let data = &self.shared.data[root];
+        let torso = *data.frame_placement(f.torso);
+        let out = &mut self.shared.output;
+        out.reference = [None; HumanJoint::COUNT];
+        let to_root = |p: Vector3<f64>| torso.transform_point(&p.into()).coords;
+        if let Some(m) = mapped {
+            use HumanJoint as J;
+            for (k, (hand, ankle)) in [(J::LHand, J::LAnkle), (J::RHand, J::RAnkle)]
+                .into_iter()
+                .enumerate()
+            {
+                out.reference[hand.index()] = Some(to_root(self.body.shoulders[k] + m.hands[k]));
+                out.reference[ankle.index()] = Some(to_root(self.body.hips[k] + m.feet[k]));
+            }
+        }
+        out.task_count = 0;
+        out.human_stance = human_stance(frame);
+        out.leg_ratio = self
+            .mapping
+            .as_ref()
+            .map_or(1.0, |m| 0.5 * (m.ratios().legs[0] + m.ratios().legs[1]));
+        out.pending_steps = 0;
+        out.human_support = human;
+        let effectors = f.effectors;
+        self.shared.write_output(frame.time, phase, &effectors)
+    }
+}
+
+/// Human offset (eq. 6) of the estimated CoM between the foot centres (ankle–toe midpoints, or
+/// the ankles), on the ground plane.
+fn human_offset(frame: &HumanFrame) -> Option<f64> {
+    use HumanJoint as J;
+    let foot = |ankle: J, toe: J| -> Option<Vector3<f64>> {
+        let a = frame.get(ankle)?;
+        let mut c = frame.get(toe).map_or(a, |t| (a + t) * 0.5);
+        c.z = 0.0;
+        Some(c)
+    };
+    let mut com = centre_of_mass(frame)?;
+    com.z = 0.0;
+    offset(&com, &foot(J::LAnkle, J::LToe)?, &foot(J::RAnkle, J::RToe)?)
+}
+
+/// `p` pushed out of the torso's vertical cylinder of `radius` around the torso's z axis,
+/// between the hips and the shoulders (torso frame).
+fn outside_torso(p: Vector3<f64>, radius: f64, body: &Body) -> Vector3<f64> {
+    let (low, high) = (body.hips[0].z, body.shoulders[0].z);
+    let across = p.xy().norm();
+    if p.z < low || p.z > high || across >= radius {
+        return p;
+    }
+    let direction = if across > 1e-9 {
+        p.xy() / across
+    } else {
+        nalgebra::Vector2::new(1.0, 0.0)
+    };
+    let xy = direction * radius;
+    Vector3::new(xy.x, xy.y, p.z)
+}

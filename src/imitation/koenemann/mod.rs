@@ -1,0 +1,115 @@
+//! Koenemann, Burget and Bennewitz's real-time whole-body imitation (ICRA 2014) as the
+//! imitator's second method ([`ImitationMethod::Koenemann`](super::config::ImitationMethod)).
+//!
+//! Per human frame:
+//!
+//! 1. **Posture mapping** ([`mapping`], §III–IV.B, eq. 1–5): the hands relative to the
+//!    shoulders and the feet relative to the hips, scaled by the limb ratios from a T-pose
+//!    calibration, become targets in the robot's torso frame. The arms follow by weighted
+//!    damped least squares ([`Method::WeightedDls`](crate::solver::Method::WeightedDls), a fixed
+//!    30 iterations as in the paper).
+//! 2. **CoM control** ([`offset`], §V.A, eq. 6): the robot's CoM offset between its feet moves
+//!    toward the human's (or toward the support foot when the human stands on one), its speed
+//!    a negative quadratic of the offset.
+//! 3. **Support mode** ([`support_mode`], §V.B, Fig. 4): single support only when the human is
+//!    on that foot and the robot's offset has reached it.
+//! 4. **Retargeting** ([`retarget`], §V.C, eq. 7): in double support the feet move (in the
+//!    torso frame) so the CoM's offset is the commanded one, and both soles take the normal
+//!    that puts the CoM above that point; in single support the support sole tilts so the CoM
+//!    is above its centre. The legs follow by damped least squares to 1 mm and 0.033 rad
+//!    (the 5-DoF foot goals of the paper: turning about the normal is free).
+//! 5. **Post-processing** (§V.D): the hands' and the swing foot's targets move at most at a
+//!    speed limit, the hands stay out of the torso, the swing foot stays above the floor and
+//!    out of the other foot's way (the profile's step envelope), and every joint within its
+//!    velocity limit (the legs slowed down together, so their posture keeps its balance).
+//!
+//! Departures from the paper, each because the physics judge showed the need or the paper is
+//! silent: the feet keep their stance in double support by default
+//! ([`FootRetargeting::ShiftBothFeet`]; the paper's one-foot rule slides a loaded foot);
+//! a foot coming down after single support lands flat at the touchdown speed of
+//! [`MotionLimits`](super::shaping::MotionLimits) before the offset leaves its end; the
+//! human's CoM is estimated from the skeleton ([`crate::human::centre_of_mass`]) where the
+//! paper had the Xsens suit's.
+
+pub(super) mod goals;
+pub(super) mod imitator;
+pub mod mapping;
+pub mod offset;
+pub mod retarget;
+pub mod support_mode;
+
+pub use mapping::Calibration;
+pub use offset::OffsetSpeed;
+pub use retarget::FootRetargeting;
+
+/// Settings of Koenemann et al.'s method.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct KoenemannConfig {
+    /// The human's reference posture (default: the first frame if it is a T-pose).
+    pub calibration: Calibration,
+    /// How double support meets the commanded offset (default: both feet shift, no slide).
+    pub retargeting: FootRetargeting,
+    /// The offset's speed limit.
+    pub offset_speed: OffsetSpeed,
+    /// The offset counts as at a foot within this of 0 or 1. Default 0.05.
+    pub offset_tolerance: f64,
+    /// Damping `λ` of the least-squares IK (m). Default 0.01 (the paper's 0.3 is for its own
+    /// scaling of the Jacobian, which it does not give).
+    pub damping: f64,
+    /// Iterations of the arms' IK per frame (paper: 30).
+    pub arm_iterations: usize,
+    /// Largest number of iterations of the legs' stabilizing IK per frame (the paper runs it
+    /// to tolerance: 1784 at worst). Default 200.
+    pub max_leg_iterations: usize,
+    /// Tolerance of the legs' IK (m; a normal's error counts 0.033 rad as 1 mm). Default 1e-3.
+    pub tolerance: f64,
+}
+
+impl Default for KoenemannConfig {
+    fn default() -> Self {
+        KoenemannConfig {
+            calibration: Calibration::Auto,
+            retargeting: FootRetargeting::ShiftBothFeet,
+            offset_speed: OffsetSpeed::default(),
+            offset_tolerance: 0.05,
+            damping: 0.01,
+            arm_iterations: 30,
+            max_leg_iterations: 200,
+            tolerance: 1e-3,
+        }
+    }
+}
+
+impl KoenemannConfig {
+    /// The first invalid field, with its value and why.
+    pub(super) fn invalid_field(&self) -> Option<(&'static str, f64, &'static str)> {
+        if let Some((name, value)) = self.offset_speed.invalid_field() {
+            return Some((name, value, "must be finite and > 0 (border at most 1)"));
+        }
+        let positive = [
+            ("koenemann.damping", self.damping),
+            ("koenemann.tolerance", self.tolerance),
+        ];
+        if let Some((name, v)) = positive
+            .into_iter()
+            .find(|(_, v)| !(v.is_finite() && *v > 0.0))
+        {
+            return Some((name, v, "must be finite and > 0"));
+        }
+        if !(0.0..0.5).contains(&self.offset_tolerance) {
+            return Some((
+                "koenemann.offset_tolerance",
+                self.offset_tolerance,
+                "must be in [0, 0.5)",
+            ));
+        }
+        let counts = [
+            ("koenemann.arm_iterations", self.arm_iterations),
+            ("koenemann.max_leg_iterations", self.max_leg_iterations),
+        ];
+        counts
+            .into_iter()
+            .find(|(_, n)| *n == 0)
+            .map(|(name, n)| (name, n as f64, "must be >= 1"))
+    }
+}

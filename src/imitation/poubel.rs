@@ -1,0 +1,460 @@
+//! The online imitator (Poubel §III–IV): one human frame in, one robot posture out.
+//!
+//! Per frame:
+//!
+//! 1. **Support detection** ([`SupportDetector`]) tells which of the human's feet are on the ground.
+//! 2. **Phase machine** ([`PhaseMachine`]) decides the robot's support phase or transition step from
+//!    the human support and what the robot achieved at the previous frame ([`Measurements`]).
+//! 3. **Model switch**: the phase's table names the sole the model is rooted at (`RFoot` or
+//!    `LFoot`). On a switch the new root's world placement is computed from the old model's forward
+//!    kinematics at the current `q` (`ʷT_b = ʷT_a · ᵃT_b(q)`), so the robot does not move in the
+//!    world: the support foot does not slip. Both models share the variables, so `q` carries over.
+//! 4. **Scaling** ([`Scaler`], eq. 1) of the human frame into the support-sole frame, re-expressed in
+//!    the model root's frame when the two differ (during a take-off toward the foot that is not
+//!    the root yet); human joint angles (the profile's [`HumanJointAngles`]) for the joint-tracking task.
+//! 5. **IK**: the phase's [`TaskTable`] is turned into the stack of a solver prepared for it: CoM
+//!    xy first, then the Cartesian tasks, then the gradient tasks (joint limits, human joints) in
+//!    the remaining null space, with the clamping loop. One Gauss–Newton step per frame
+//!    (configurable) with the joint velocities limited to a fraction of the robot's rated
+//!    velocities (the paper ran at 10 %), so the output trajectory is executable as it is: a
+//!    transition takes the time it needs and the robot catches up afterwards.
+//!
+//! Everything is allocated in [`Imitator::new`]; [`Imitator::step`] allocates nothing.
+//!
+//! World frame: the right sole's frame at the first frame (x forward, y left, z up, metres).
+
+use std::time::Instant;
+
+use nalgebra::{IsometryMatrix3, Vector2, Vector3};
+
+use super::footsteps::{FootstepPlanner, GroundPose};
+use super::imitator::{Shared, effector_ids, frame_dt, ground_pose, human_stance};
+use super::phase::{Measurements, PhaseMachine, Settling, SupportPhase, TakeOff};
+use super::phase_solver::{Criteria, FrameTargets, PhaseSolver};
+use super::scaler::{RobotSkeleton, ScaleConfig, Scaler};
+use super::shaping::{ComReference, MotionLimits, SwingHeight};
+use super::support::{HumanSupport, SupportDetector};
+use super::tables::{PointTarget, Task, TaskTable, TaskTables};
+use crate::human::{HumanFrame, Side};
+use crate::model::FrameId;
+use crate::robots::{BipedProfile, HumanJointAngles};
+use crate::solver::driver::DriverSettings;
+use crate::solver::{JointLimitAvoidance, JointTracking, Settings};
+
+use super::config::ImitatorConfig;
+use super::error::ImitationError;
+use super::output::{EFFECTORS, RobotFrame, effector_frames};
+
+/// Poubel et al.'s imitator.
+pub(crate) struct PoubelImitator {
+    pub(crate) shared: Shared,
+    /// The frames of [`EFFECTORS`] in each model: `effectors[root]`.
+    effectors: [[FrameId; 4]; 2],
+    phases: Vec<PhaseSolver>,
+    detector: SupportDetector,
+    scaler: Scaler,
+    /// The profile's human joint-angle map, if it has one.
+    angles: Option<Box<dyn HumanJointAngles>>,
+    machine: PhaseMachine,
+    iterations: usize,
+    max_task_speed: f64,
+    max_tracking_speed: f64,
+    limits: JointLimitAvoidance,
+    tracking: JointTracking,
+    human_q: Vec<f64>,
+    /// The standing posture of each leg joint (`None` off the legs): the joint-tracking
+    /// reference of the legs.
+    stance: Vec<Option<f64>>,
+    phase: SupportPhase,
+    measurements: Measurements,
+    /// Whether the torso has stopped approaching its target in this step.
+    posture_settling: Settling,
+    footsteps: FootstepPlanner,
+    motion: MotionLimits,
+    /// The shaped CoM ground projection (world frame); `None` before the first frame.
+    com_reference: Option<ComReference>,
+    /// The shaped height of the swing foot above the ground.
+    swing: SwingHeight,
+}
+
+impl std::fmt::Debug for PoubelImitator {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("PoubelImitator")
+            .field("robot", &self.shared.profile.name)
+            .field("phase", &self.phase)
+            .field("root", &self.shared.root)
+            .field("time", &self.shared.previous_time)
+            .finish_non_exhaustive()
+    }
+}
+
+/// A solver per phase (in [`SupportPhase::ALL`] order) for `tables`.
+fn phase_solvers(
+    tables: &TaskTables,
+    profile: &BipedProfile,
+    q: &[f64],
+    solver: Settings,
+) -> Result<Vec<PhaseSolver>, ImitationError> {
+    // Scale to fit: when the velocity limits bind, the whole step slows down uniformly instead
+    // of the clamping loop pinning joints the balance level needs.
+    let settings = Settings {
+        scale_to_fit: true,
+        ..solver
+    };
+    SupportPhase::ALL
+        .iter()
+        .map(|&phase| PhaseSolver::new(tables.table(phase), profile, q, settings))
+        .collect()
+}
+
+impl PoubelImitator {
+    /// An imitator for `profile` (validated by the caller with `config`).
+    pub(crate) fn new(
+        profile: BipedProfile,
+        mut config: ImitatorConfig,
+    ) -> Result<Self, ImitationError> {
+        let tables = match config.tables.take() {
+            Some(tables) => tables,
+            None => TaskTables::executable(&config.phase, &profile),
+        };
+        // Position limits only matter to the limit-avoidance gradient and the start clamp.
+        let (mut shared, position_bounds) = Shared::new(profile, &config)?;
+        let (profile, q) = (&shared.profile, &shared.q);
+        let model = profile.model(Side::Right);
+        // The legs are pulled toward the standing posture, not the human's leg angles: those
+        // would only drive the closed chain of double support against itself, and with no pull
+        // at all the free height of the pelvis drifts until the knees are straight (singular).
+        let stance = shared
+            .legs
+            .iter()
+            .zip(q)
+            .map(|(&l, &v)| l.then_some(v))
+            .collect();
+        let phases = phase_solvers(&tables, profile, q, config.solver)?;
+        let angles = profile.joint_angles.map(|build| build(model)).transpose()?;
+        let effectors = effector_ids(profile)?;
+        let tuning = profile.tuning;
+        let area = config.step_envelope.unwrap_or(profile.step_envelope);
+        let scale = ScaleConfig {
+            min_segment: config.min_segment,
+            ..ScaleConfig::new(area)
+        };
+        let scaler = Scaler::new(RobotSkeleton::of(profile)?, scale)?;
+        let tracking = JointTracking::new(q)?;
+        let human_q = q.clone();
+        shared.reserve_output(phases_sizes(&phases));
+        Ok(Self {
+            detector: SupportDetector::new(config.support)?,
+            scaler,
+            angles,
+            machine: PhaseMachine::new(config.phase)?,
+            limits: JointLimitAvoidance::new(&position_bounds),
+            tracking,
+            stance,
+            human_q,
+            iterations: config.iterations_per_frame,
+            max_task_speed: config.max_task_speed.unwrap_or(tuning.task_speed),
+            max_tracking_speed: config.max_tracking_speed.unwrap_or(tuning.tracking_speed),
+            phases,
+            effectors,
+            phase: SupportPhase::Double,
+            measurements: Measurements {
+                com_error: f64::INFINITY,
+                posture_error: 0.0,
+                posture_settled: false,
+                swing_toe_height: 0.0,
+                swing_heel_height: 0.0,
+            },
+            posture_settling: Settling::new(),
+            footsteps: FootstepPlanner::new(config.footsteps, area),
+            motion: config.motion,
+            com_reference: None,
+            swing: SwingHeight::at(0.0),
+            shared,
+        })
+    }
+
+    /// The task table of `phase`.
+    pub(crate) fn table(&self, phase: SupportPhase) -> &TaskTable {
+        &self.phases[phase.index()].table
+    }
+
+    /// The task names of `phase`'s table, in stack order.
+    pub(crate) fn task_names(&self, phase: SupportPhase) -> impl Iterator<Item = String> + '_ {
+        self.phases[phase.index()].task_names()
+    }
+
+    /// Which of [`EFFECTORS`] `phase`'s table tracks against the scaled human.
+    pub(crate) fn tracked_effectors(&self, phase: SupportPhase) -> [bool; 4] {
+        let frames = effector_frames(&self.shared.profile);
+        let tasks = || self.table(phase).levels.iter().flat_map(|l| &l.tasks);
+        let mut tracked = [false; 4];
+        for (t, ((_, joint), name)) in tracked.iter_mut().zip(EFFECTORS.iter().zip(frames)) {
+            *t = tasks().any(|task| {
+                matches!(task, Task::Point { frame, target: PointTarget::Scaled(j), .. }
+                    if frame == name && j == joint)
+            });
+        }
+        tracked
+    }
+
+    /// Imitates one human frame: returns the robot's posture for it.
+    ///
+    /// # Errors
+    /// [`ImitationError::TimeGoesBack`] when `frame.time` is below the previous frame's, a
+    /// scaler error for a non-finite time or joint, and solver or model errors (never expected
+    /// from valid input; the imitator is then in an unspecified but safe state).
+    pub(crate) fn step(&mut self, frame: &HumanFrame) -> Result<&RobotFrame, ImitationError> {
+        let start = Instant::now();
+        let dt = frame_dt(
+            self.shared.previous_time,
+            frame.time,
+            self.shared.nominal_dt,
+        )?;
+        let human = self.detector.update(frame);
+        let feet = [
+            ground_pose(&self.shared.output.left_sole),
+            ground_pose(&self.shared.output.right_sole),
+        ];
+        let leg_ratio = self.scaler.leg_ratio();
+        let wanted = (self.footsteps).update(frame, human, leg_ratio, feet, self.phase, dt);
+        let phase = self.machine.update(wanted, &self.measurements);
+        let changed = phase != self.phase || self.shared.previous_time.is_none();
+        self.shared
+            .switch_root(self.phases[phase.index()].table.model_root)?;
+        self.scale(frame, human)?;
+        if changed {
+            self.hold_targets(phase);
+        }
+        let (com_target, goal_distance) = self.shape_references(phase, dt)?;
+        self.solve(phase, com_target, dt)?;
+        self.measure(phase, changed, goal_distance, dt);
+        self.write_output(frame, human, phase)?;
+        self.phase = phase;
+        self.shared.previous_time = Some(frame.time);
+        self.shared.output.micros = start.elapsed().as_secs_f64() * 1e6;
+        Ok(&self.shared.output)
+    }
+
+    /// Scales the human frame into the root frame (`output.reference`) and sets the
+    /// joint-tracking reference from its joint angles, the legs at their standing posture.
+    fn scale(&mut self, frame: &HumanFrame, human: HumanSupport) -> Result<(), ImitationError> {
+        let scaled = self.scaler.scale(frame, human)?;
+        if let Some(angles) = &mut self.angles {
+            angles.compute(scaled.directions(), &mut self.human_q)?;
+        }
+        for (human, stance) in self.human_q.iter_mut().zip(&self.stance) {
+            if let Some(stance) = stance {
+                *human = *stance;
+            }
+        }
+        self.tracking.set_reference(&self.human_q)?;
+        // The scaler's output frame is the sole of its stance; the model's is the root sole.
+        let root = self.shared.root.index();
+        let root_t_base = if scaled.base() == self.shared.root {
+            IsometryMatrix3::identity()
+        } else {
+            *self.shared.data[root].frame_placement(self.shared.soles[root][scaled.base().index()])
+        };
+        for (out, (_, p)) in self.shared.output.reference.iter_mut().zip(scaled.points()) {
+            *out = p.map(|p| root_t_base.transform_point(&p.into()).coords);
+        }
+        Ok(())
+    }
+
+    /// The target footprint of the step being taken, in the root frame.
+    fn footstep_in_root(&self) -> Option<GroundPose> {
+        let (_, world) = self.footsteps.target()?;
+        let ground = Vector3::new(world.xy.x, world.xy.y, 0.0);
+        let xy = (self
+            .shared
+            .world_t_root
+            .inverse_transform_point(&ground.into()))
+        .coords
+        .xy();
+        Some(GroundPose {
+            xy,
+            yaw: world.yaw - ground_pose(&self.shared.world_t_root).yaw,
+        })
+    }
+
+    /// One frame of IK for `phase`: the driver's iterations from the current `q` toward the
+    /// frame's targets, with the frame's velocity budget; task errors and the solve report go
+    /// into the output.
+    fn solve(
+        &mut self,
+        phase: SupportPhase,
+        com_target: Vector2<f64>,
+        dt: f64,
+    ) -> Result<(), ImitationError> {
+        // The velocity budget of the frame, split over its iterations.
+        let step_dt = dt / self.iterations as f64;
+        let settings = DriverSettings {
+            gain: 1.0 / step_dt,
+            dt: step_dt,
+            max_iterations: self.iterations,
+            tolerance: 0.0,
+            stall_tolerance: 0.0,
+            max_task_error: self.max_task_speed * step_dt,
+            max_joint_step: f64::INFINITY,
+        };
+        let targets = FrameTargets {
+            reference: &self.shared.output.reference,
+            com: com_target,
+            swing_lift: self.swing.height(),
+            footstep: self.footstep_in_root(),
+            tracking_step: self.max_tracking_speed * step_dt,
+        };
+        let criteria = Criteria {
+            limits: &self.limits,
+            tracking: &self.tracking,
+        };
+        let model = self.shared.profile.model(self.shared.root);
+        let data = &mut self.shared.data[self.shared.root.index()];
+        let ps = &mut self.phases[phase.index()];
+        let report = ps.run(
+            model,
+            data,
+            targets,
+            criteria,
+            &mut self.shared.q,
+            &self.shared.bounds,
+            settings,
+        )?;
+        let out = &mut self.shared.output;
+        out.stop = report.stop;
+        let errors = report.task_errors();
+        out.task_count = errors.len().min(out.task_errors.len());
+        out.task_errors[..out.task_count].copy_from_slice(&errors[..out.task_count]);
+        out.record_solve(ps.report());
+        Ok(())
+    }
+
+    /// Measurements for the phase machine after the solve: the CoM's distance to the phase's
+    /// goal, the torso's posture error and whether it has settled, the swing foot's heights.
+    fn measure(&mut self, phase: SupportPhase, changed: bool, goal_distance: f64, dt: f64) {
+        let ps = &self.phases[phase.index()];
+        let errors = &self.shared.output.task_errors[..self.shared.output.task_count];
+        let posture_error = ps.posture_error(errors);
+        if changed {
+            self.posture_settling = Settling::new();
+        }
+        let swing = phase.swing_foot().unwrap_or(self.shared.root.other());
+        let [toe, heel] = self.swing_heights(swing, phase);
+        self.measurements = Measurements {
+            com_error: ps.com_error(errors) + goal_distance,
+            posture_error,
+            posture_settled: self.posture_settling.update(posture_error, dt),
+            swing_toe_height: toe,
+            swing_heel_height: heel,
+        };
+    }
+
+    /// Heights above the ground (m) of the `swing` sole's outline corners, front then rear: the
+    /// lowest of each while lifting, else the one farthest from the ground, above or below. A
+    /// lift is done when the lowest corner is at ρ, a landing when every corner is on the
+    /// ground (flat, so that the foot can become the support without tilting or sinking the
+    /// world).
+    fn swing_heights(&self, swing: Side, phase: SupportPhase) -> [f64; 2] {
+        let root = self.shared.root.index();
+        let sole = self.shared.data[root].frame_placement(self.shared.soles[root][swing.index()]);
+        let [centre_x, _] = self.shared.profile.sole_centre(swing);
+        let lifting = matches!(
+            phase,
+            SupportPhase::DoubleToRight(TakeOff::LiftFoot)
+                | SupportPhase::DoubleToLeft(TakeOff::LiftFoot)
+        );
+        let pick = |a: f64, b: f64| match lifting {
+            true => a.min(b),
+            false if a.abs() >= b.abs() => a,
+            false => b,
+        };
+        let outline = &self.shared.profile.foot(swing).outline;
+        let height = |front: bool| {
+            outline
+                .iter()
+                .filter(|[x, _]| (*x >= centre_x) == front)
+                .map(|&[x, y]| sole.transform_point(&Vector3::new(x, y, 0.0).into()).z)
+                .reduce(pick)
+                .unwrap_or(0.0)
+        };
+        [height(true), height(false)]
+    }
+
+    /// The output: the shared world-frame part, then the human's support and stance, the
+    /// scale and the pending steps.
+    fn write_output(
+        &mut self,
+        frame: &HumanFrame,
+        human: HumanSupport,
+        phase: SupportPhase,
+    ) -> Result<(), ImitationError> {
+        let effectors = self.effectors[self.shared.root.index()];
+        self.shared.write_output(frame.time, phase, &effectors)?;
+        let out = &mut self.shared.output;
+        out.human_support = human;
+        out.human_stance = human_stance(frame);
+        out.leg_ratio = self.scaler.leg_ratio();
+        out.pending_steps = self.footsteps.steps_pending();
+        Ok(())
+    }
+
+    /// At the start of a step: the held targets of `phase`'s tasks become the frames' current
+    /// positions and headings, and the swing height the swing sole's current height.
+    fn hold_targets(&mut self, phase: SupportPhase) {
+        let root = self.shared.root.index();
+        let data = &self.shared.data[root];
+        self.phases[phase.index()].hold(data);
+        let swing = phase.swing_foot().unwrap_or(self.shared.root.other());
+        let sole = data.frame_placement(self.shared.soles[root][swing.index()]);
+        self.swing = SwingHeight::at(sole.translation.vector.z);
+    }
+
+    /// Advances the shaped CoM reference toward `phase`'s CoM goal and the swing height toward
+    /// its lift. Returns the CoM target for the balance task in the root frame and the distance
+    /// (m) the reference still has to go to the goal.
+    fn shape_references(
+        &mut self,
+        phase: SupportPhase,
+        dt: f64,
+    ) -> Result<(Vector2<f64>, f64), ImitationError> {
+        let root = self.shared.root.index();
+        let model = self.shared.profile.model(self.shared.root);
+        let data = &self.shared.data[root];
+        let ps = &self.phases[phase.index()];
+        if let Some(lift) = ps.lift() {
+            self.swing.advance(lift, dt, &self.motion);
+        }
+        let Some(goal) = ps.com_goal(data) else {
+            return Ok((Vector2::zeros(), 0.0));
+        };
+        let to_world = |p: Vector2<f64>| {
+            self.shared
+                .world_t_root
+                .transform_point(&Vector3::new(p.x, p.y, 0.0).into())
+                .coords
+                .xy()
+        };
+        let goal_world = to_world(goal);
+        let com = to_world(model.com(data)?.xy());
+        let reference = self
+            .com_reference
+            .get_or_insert_with(|| ComReference::at_rest(com));
+        reference.advance(goal_world, dt, &self.motion);
+        let r = reference.position();
+        let target = self
+            .shared
+            .world_t_root
+            .inverse_transform_point(&Vector3::new(r.x, r.y, 0.0).into())
+            .coords
+            .xy();
+        Ok((target, (goal_world - r).norm()))
+    }
+}
+
+/// The largest task and level counts over the phases: the output's capacity.
+fn phases_sizes(phases: &[PhaseSolver]) -> [usize; 2] {
+    let tasks = phases.iter().map(PhaseSolver::task_count).max();
+    let levels = phases.iter().map(|p| p.table.levels.len()).max();
+    [tasks.unwrap_or(0), levels.unwrap_or(0)]
+}
