@@ -200,6 +200,20 @@ impl Shared {
         self.output = RobotFrame::at_start(&self.q, left_sole, &sizes);
     }
 
+    /// The time step ending at `time` (s): the nominal one for the first frame and for a
+    /// repeated time.
+    pub(crate) fn frame_dt(&self, time: f64) -> Result<f64, ImitationError> {
+        if !time.is_finite() {
+            return Err(super::scaler::ScaleError::NonFiniteTime(time).into());
+        }
+        match self.previous_time {
+            None => Ok(self.nominal_dt),
+            Some(previous) if time > previous => Ok(time - previous),
+            Some(previous) if time == previous => Ok(self.nominal_dt),
+            Some(previous) => Err(ImitationError::TimeGoesBack { time, previous }),
+        }
+    }
+
     /// Forward kinematics of the root's model at `q`.
     pub(crate) fn refresh(&mut self) -> Result<(), ImitationError> {
         let root = self.root.index();
@@ -255,24 +269,6 @@ impl Shared {
         out.root = self.root;
         out.world_t_root = world_t_root;
         Ok(())
-    }
-}
-
-/// The time step ending at `time` (s) after the frame at `previous`: `nominal` for the first
-/// frame and for a repeated time.
-pub(crate) fn frame_dt(
-    previous: Option<f64>,
-    time: f64,
-    nominal: f64,
-) -> Result<f64, ImitationError> {
-    if !time.is_finite() {
-        return Err(super::scaler::ScaleError::NonFiniteTime(time).into());
-    }
-    match previous {
-        None => Ok(nominal),
-        Some(previous) if time > previous => Ok(time - previous),
-        Some(previous) if time == previous => Ok(nominal),
-        Some(previous) => Err(ImitationError::TimeGoesBack { time, previous }),
     }
 }
 

@@ -28,7 +28,7 @@ use std::time::Instant;
 use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 
 use super::footsteps::{FootstepPlanner, GroundPose};
-use super::imitator::{Shared, effector_ids, frame_dt, ground_pose, human_stance};
+use super::imitator::{Shared, effector_ids, ground_pose, human_stance};
 use super::phase::{Measurements, PhaseMachine, Settling, SupportPhase, TakeOff};
 use super::phase_solver::{Criteria, FrameTargets, PhaseSolver};
 use super::scaler::{RobotSkeleton, ScaleConfig, Scaler};
@@ -206,11 +206,7 @@ impl PoubelImitator {
     /// from valid input; the imitator is then in an unspecified but safe state).
     pub(crate) fn step(&mut self, frame: &HumanFrame) -> Result<&RobotFrame, ImitationError> {
         let start = Instant::now();
-        let dt = frame_dt(
-            self.shared.previous_time,
-            frame.time,
-            self.shared.nominal_dt,
-        )?;
+        let dt = self.shared.frame_dt(frame.time)?;
         let human = self.detector.update(frame);
         let feet = [
             ground_pose(&self.shared.output.left_sole),

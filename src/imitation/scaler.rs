@@ -123,7 +123,7 @@ pub struct RobotSkeleton {
 /// The position (m, model root frame) of each mapped human joint's robot point, for the forward
 /// kinematics in `data`. Errors: unknown frames, a joint mapped twice, a leg joint or MidHip
 /// unmapped.
-fn reference_points(
+pub(crate) fn reference_points(
     model: &Model,
     data: &ModelData,
     points: &[(HumanJoint, RobotPoint)],

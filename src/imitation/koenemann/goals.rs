@@ -12,6 +12,7 @@ use faer::Mat;
 use nalgebra::{IsometryMatrix3, Rotation3, Vector3};
 
 use crate::imitation::error::ImitationError;
+use crate::imitation::imitator::Shared;
 use crate::model::{FrameId, Model, ModelData};
 use crate::solver::driver::{DriverReport, DriverSettings, PositionDriver, TaskModel};
 use crate::solver::{JointBounds, Method, Settings, Solver, SolverError, StackShape, TaskStack};
@@ -110,18 +111,20 @@ impl GoalIk {
         })
     }
 
-    /// Moves `q` toward the goals (warm start), within the position limits of `bounds`.
+    /// Moves the shared `q` toward the goals (warm start) in the root's model, whose torso
+    /// frame is `torso`, within the position limits of `bounds`. Leaves the root's forward
+    /// kinematics current at the final `q`.
     pub(super) fn run(
         &mut self,
-        model: &Model,
-        data: &mut ModelData,
+        shared: &mut Shared,
         torso: FrameId,
-        q: &mut [f64],
         bounds: &JointBounds,
     ) -> Result<&DriverReport, ImitationError> {
+        let root = shared.root;
+        let q = &mut shared.q;
         let mut rows = GoalRows {
-            model,
-            data,
+            model: shared.profile.model(root),
+            data: &mut shared.data[root.index()],
             torso,
             goals: &self.goals,
             scratch: &mut self.scratch,

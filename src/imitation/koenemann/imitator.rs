@@ -14,14 +14,15 @@ use super::support_mode::{SupportMode, target_offset};
 use crate::human::{HumanFrame, HumanJoint, Side, centre_of_mass};
 use crate::imitation::config::ImitatorConfig;
 use crate::imitation::error::ImitationError;
-use crate::imitation::imitator::{Shared, effector_ids, frame_dt, human_stance};
+use crate::imitation::imitator::{Shared, effector_ids, human_stance};
 use crate::imitation::metrics::CONTACT_HEIGHT;
 use crate::imitation::output::RobotFrame;
 use crate::imitation::phase::{Landing, SupportPhase, TakeOff};
+use crate::imitation::scaler::reference_points;
 use crate::imitation::shaping::{MotionLimits, SwingHeight};
 use crate::imitation::support::{HumanSupport, SupportDetector};
-use crate::model::{FrameId, Model, ModelData, ModelError};
-use crate::robots::{BipedProfile, FootArea, RobotPoint, SolePlacement};
+use crate::model::{FrameId, ModelData, ModelError};
+use crate::robots::{BipedProfile, FootArea, SolePlacement};
 use crate::solver::driver::DriverSettings;
 use crate::solver::{JointBounds, Method};
 
@@ -104,32 +105,6 @@ fn frames(profile: &BipedProfile, root: Side) -> Result<Frames, ModelError> {
     })
 }
 
-/// The robot point standing for `joint` in the profile, in the root frame of `data`.
-fn robot_point(
-    profile: &BipedProfile,
-    model: &Model,
-    data: &ModelData,
-    joint: HumanJoint,
-) -> Result<Vector3<f64>, ImitationError> {
-    let point = (profile.points.iter().find(|(j, _)| *j == joint))
-        .map(|(_, p)| p)
-        .ok_or_else(|| ImitationError::InvalidParameter {
-            name: "profile.points",
-            value: joint.index() as f64,
-            reason: "the method needs the shoulders, elbows, hips and knees mapped",
-        })?;
-    let at = |name: &str| -> Result<Vector3<f64>, ModelError> {
-        Ok(data
-            .frame_placement(model.frame_id(name)?)
-            .translation
-            .vector)
-    };
-    Ok(match point {
-        RobotPoint::Frame(a) => at(a)?,
-        RobotPoint::Midpoint(a, b) => (at(a)? + at(b)?) * 0.5,
-    })
-}
-
 impl Body {
     fn measure(profile: &BipedProfile, q: &[f64]) -> Result<Self, ImitationError> {
         let model = profile.model(Side::Right);
@@ -137,7 +112,14 @@ impl Body {
         model.forward_kinematics(&mut data, q)?;
         let f = frames(profile, Side::Right)?;
         let torso = data.frame_placement(f.torso).inverse();
-        let point = |j| robot_point(profile, model, &data, j);
+        let points = reference_points(model, &data, &profile.points)?;
+        let point = |joint: HumanJoint| {
+            points[joint.index()].ok_or(ImitationError::InvalidParameter {
+                name: "profile.points",
+                value: joint.index() as f64,
+                reason: "the method needs the shoulders, elbows, hips and knees mapped",
+            })
+        };
         use HumanJoint as J;
         let pair = |l, r| -> Result<[Vector3<f64>; 2], ImitationError> {
             Ok([point(l)?, point(r)?].map(|p| torso.transform_point(&p.into()).coords))
@@ -271,11 +253,7 @@ impl KoenemannImitator {
     /// Imitates one human frame.
     pub(crate) fn step(&mut self, frame: &HumanFrame) -> Result<&RobotFrame, ImitationError> {
         let start = Instant::now();
-        let dt = frame_dt(
-            self.shared.previous_time,
-            frame.time,
-            self.shared.nominal_dt,
-        )?;
+        let dt = self.shared.frame_dt(frame.time)?;
         let human = self.detector.update(frame);
         self.q_start.copy_from_slice(&self.shared.q);
         let posture = Posture::of_human(frame);
@@ -291,8 +269,9 @@ impl KoenemannImitator {
             (Some(mapping), Some(p)) => Some(mapping.map(p)),
             _ => None,
         };
+        // The root's forward kinematics are current: from the last step's end, the root
+        // switch, or the start; every IK run below leaves them current at its final q.
         self.update_mode(frame, human, dt)?;
-        self.shared.refresh()?;
         self.track_hands(mapped.as_ref(), dt)?;
         self.stabilize(mapped.as_ref(), dt)?;
         self.limit_velocities(dt);
@@ -375,8 +354,7 @@ impl KoenemannImitator {
         let reach = self.tracking_speed * dt;
         let radius = 0.5 * (self.body.hips[0] - self.body.hips[1]).norm();
         let targets = [0, 1].map(|k| {
-            let step = wanted[k] - previous[k];
-            let moved = previous[k] + step * (reach / step.norm().max(reach));
+            let moved = step_toward(previous[k], wanted[k], reach);
             outside_torso(moved, radius, &self.body)
         });
         self.hands = Some(targets);
@@ -390,14 +368,8 @@ impl KoenemannImitator {
                 target,
             };
         }
-        let model = self.shared.profile.model(self.shared.root);
-        self.arms.run(
-            model,
-            &mut self.shared.data[root],
-            f.torso,
-            &mut self.shared.q,
-            &self.position_bounds,
-        )?;
+        self.arms
+            .run(&mut self.shared, f.torso, &self.position_bounds)?;
         Ok(())
     }
 
@@ -405,7 +377,6 @@ impl KoenemannImitator {
     /// passes.
     fn stabilize(&mut self, mapped: Option<&Posture>, dt: f64) -> Result<(), ImitationError> {
         for _ in 0..STABILIZE_PASSES {
-            self.shared.refresh()?;
             let (data, f) = self.current();
             let ankles_now = f
                 .ankles
@@ -474,14 +445,8 @@ impl KoenemannImitator {
                 normal: Vector3::z(),
             },
         ]);
-        let model = self.shared.profile.model(self.shared.root);
-        self.feet.run(
-            model,
-            &mut self.shared.data[root],
-            f.torso,
-            &mut self.shared.q,
-            &self.position_bounds,
-        )?;
+        self.feet
+            .run(&mut self.shared, f.torso, &self.position_bounds)?;
         self.normal_settled(support, &normal)
     }
 
@@ -492,7 +457,6 @@ impl KoenemannImitator {
         support: Side,
         normal: &Vector3<f64>,
     ) -> Result<bool, ImitationError> {
-        self.shared.refresh()?;
         let com = self.com_in_torso()?;
         let centre = self.centre_in_torso(support);
         let now = support_normal(&com, &centre, &centre, 0.0).unwrap_or(*normal);
@@ -516,8 +480,7 @@ impl KoenemannImitator {
         let current = data.frame_placement(f.ankles[w]).translation.vector;
         let previous = self.swing_target.unwrap_or(current);
         let reach = self.foot_speed * dt;
-        let step = wanted - previous;
-        let mut target = previous + step * (reach / step.norm().max(reach));
+        let mut target = step_toward(previous, wanted, reach);
         let ankle_height = self.body.ankles[w].z;
         // The sole's place relative to the support sole (the root), clipped.
         let sole_offset = target.xy() - self.body.ankles[w].xy();
@@ -612,15 +575,7 @@ impl KoenemannImitator {
                 &mut self.feet
             }
         };
-        let model = self.shared.profile.model(root);
-        ik.run(
-            model,
-            &mut self.shared.data[r],
-            f.torso,
-            &mut self.shared.q,
-            &self.position_bounds,
-        )?;
-        self.shared.refresh()?;
+        ik.run(&mut self.shared, f.torso, &self.position_bounds)?;
         let com = self.com_in_torso()?;
         let achieved =
             support_normal(&com, &targets[0], &targets[1], self.command).unwrap_or(normal);
@@ -772,6 +727,12 @@ fn human_offset(frame: &HumanFrame) -> Option<f64> {
     let mut com = centre_of_mass(frame)?;
     com.z = 0.0;
     offset(&com, &foot(J::LAnkle, J::LToe)?, &foot(J::RAnkle, J::RToe)?)
+}
+
+/// `from` moved toward `to` by at most `reach` (m).
+fn step_toward(from: Vector3<f64>, to: Vector3<f64>, reach: f64) -> Vector3<f64> {
+    let step = to - from;
+    from + step * (reach / step.norm().max(reach))
 }
 
 /// `p` pushed out of the torso's vertical cylinder of `radius` around the torso's z axis,
