@@ -6,10 +6,13 @@
 //! `d/dt Rₜᵀ(x − pₜ) = Rₜᵀ (J_x − J_t + [x − pₜ]× J_ωt) q̇`; for a frame's z axis `z`,
 //! `d/dt Rₜᵀ z = Rₜᵀ ((J_ω − J_ωt) q̇ × z)`. A normal goal has two rows: the change of `z`
 //! along two directions across it (turning about `z` itself is free: the 5-DoF foot goal of
-//! §V.C), weighted by [`NORMAL_WEIGHT`] so that one tolerance reads 1 mm or 0.033 rad.
+//! §V.C), weighted by [`NORMAL_WEIGHT`] so that one tolerance reads 1 mm or 0.033 rad. The
+//! CoM's ground projection in the root frame, `J_CoM,xy q̇`, is the stability goal: it states
+//! eq. 7 on the floor (the CoM above the point at offset `o'`) instead of through the soles'
+//! normals in the torso frame, so one strict level meets it exactly.
 
 use faer::Mat;
-use nalgebra::{IsometryMatrix3, Rotation3, Vector3};
+use nalgebra::{IsometryMatrix3, Rotation3, Vector2, Vector3};
 
 use crate::imitation::error::ImitationError;
 use crate::imitation::imitator::Shared;
@@ -51,12 +54,14 @@ pub(super) enum Goal {
         frame: FrameId,
         target: Rotation3<f64>,
     },
+    /// The CoM's ground projection at `target` (x, y in the root frame, m; 2 rows).
+    RootCom { target: Vector2<f64> },
 }
 
 impl Goal {
     fn rows(&self) -> usize {
         match self {
-            Goal::TorsoNormal { .. } | Goal::RootNormal { .. } => 2,
+            Goal::TorsoNormal { .. } | Goal::RootNormal { .. } | Goal::RootCom { .. } => 2,
             _ => 3,
         }
     }
@@ -66,6 +71,8 @@ impl Goal {
 #[derive(Debug)]
 pub(super) struct GoalIk {
     pub(super) goals: Vec<Goal>,
+    /// The joints the problem may move; the others keep their place.
+    moving: Vec<bool>,
     solver: Solver,
     driver: PositionDriver,
     /// Torso point and angular Jacobians, a frame's point and angular Jacobians (3 × n).
@@ -73,13 +80,14 @@ pub(super) struct GoalIk {
 }
 
 impl GoalIk {
-    /// An IK for goals shaped like `goals` (their kinds fix the rows; targets change per frame):
-    /// one level solved by `method`, or with `first` goals in a level above the rest (for
-    /// [`Method::Prioritized`]).
+    /// An IK for goals shaped like `goals` (their kinds fix the rows; targets change per frame)
+    /// solved by `method`: the first `levels[0]` goals in the top level, the next `levels[1]`
+    /// below them, and so on, the remaining goals in the last level (`&[]`: one level). Only
+    /// the joints `moving` marks move (its length is the model's number of joints).
     pub(super) fn new(
         goals: Vec<Goal>,
-        first: Option<usize>,
-        nv: usize,
+        levels: &[usize],
+        moving: Vec<bool>,
         method: Method,
         settings: DriverSettings,
     ) -> Result<Self, SolverError> {
@@ -89,12 +97,14 @@ impl GoalIk {
             .zip(&goals)
             .map(|(n, g)| (n.as_str(), g.rows()))
             .collect();
-        let shape = match first {
-            Some(k) => StackShape::new(nv)
-                .with_level("held", &tasks[..k])
-                .with_level("goals", &tasks[k..]),
-            None => StackShape::new(nv).with_level("goals", &tasks),
-        };
+        let nv = moving.len();
+        let mut shape = StackShape::new(nv);
+        let mut first = 0;
+        for &count in levels {
+            shape = shape.with_level("priority", &tasks[first..first + count]);
+            first += count;
+        }
+        let shape = shape.with_level("goals", &tasks[first..]);
         let solver = Solver::with_settings(
             &shape,
             Settings {
@@ -105,6 +115,7 @@ impl GoalIk {
         let driver = PositionDriver::new(&solver, settings)?;
         Ok(GoalIk {
             goals,
+            moving,
             solver,
             driver,
             scratch: std::array::from_fn(|_| Mat::zeros(3, nv)),
@@ -127,6 +138,7 @@ impl GoalIk {
             data: &mut shared.data[root.index()],
             torso,
             goals: &self.goals,
+            moving: &self.moving,
             scratch: &mut self.scratch,
         };
         self.driver.run(&mut self.solver, &mut rows, q, bounds)
@@ -139,6 +151,7 @@ struct GoalRows<'a> {
     data: &'a mut ModelData,
     torso: FrameId,
     goals: &'a [Goal],
+    moving: &'a [bool],
     scratch: &'a mut [Mat<f64>; 4],
 }
 
@@ -218,6 +231,12 @@ impl TaskModel for GoalRows<'_> {
                         error[r] = NORMAL_WEIGHT * t.dot(&(normal - z));
                     }
                 }
+                Goal::RootCom { target } => {
+                    let com = model.com(data)?;
+                    model.com_jacobian_rows(data, 2, jac.as_mut())?;
+                    error[0] = target.x - com.x;
+                    error[1] = target.y - com.y;
+                }
                 Goal::RootOrientation { frame, target } => {
                     // ½ Σ cᵢ × cᵢ*, the columns of the current and target rotations: the
                     // rotation vector for small errors, and never NaN.
@@ -235,6 +254,11 @@ impl TaskModel for GoalRows<'_> {
                     for r in 0..3 {
                         error[r] = NORMAL_WEIGHT * e[r];
                     }
+                }
+            }
+            for k in (0..q.len()).filter(|&k| !self.moving[k]) {
+                for r in 0..rows {
+                    jac[(r, k)] = 0.0;
                 }
             }
         }

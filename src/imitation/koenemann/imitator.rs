@@ -3,7 +3,7 @@
 
 use std::time::Instant;
 
-use nalgebra::{IsometryMatrix3, Vector3};
+use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 
 use super::KoenemannConfig;
 use super::goals::{Goal, GoalIk, in_torso};
@@ -28,8 +28,6 @@ use crate::solver::{JointBounds, Method};
 
 /// Smallest height of a swing sole above the floor while the human's foot is up (m).
 const SWING_CLEARANCE: f64 = 0.01;
-/// Passes of the legs' IK with the CoM, hence the normal, recomputed.
-const STABILIZE_PASSES: usize = 3;
 
 /// Frames of one model.
 #[derive(Debug)]
@@ -66,9 +64,11 @@ pub(crate) struct KoenemannImitator {
     mapping: Option<PostureMapping>,
     detector: SupportDetector,
     arms: GoalIk,
-    /// Goals of 3 + 2 + 3 + 2 rows: single support, landing, the paper's double support.
+    /// The CoM strictly, then 3 + 2 + 3 + 2 rows: single support, landing, the paper's double
+    /// support.
     feet: GoalIk,
-    /// Goals of 3 + 2 + 3 + 3 rows: double support keeping the stance.
+    /// The held sole (3 + 3 rows), then the CoM, then 3 + 2 rows: double support keeping the
+    /// stance.
     stance: GoalIk,
     position_bounds: JointBounds,
     tracking_speed: f64,
@@ -170,7 +170,6 @@ impl KoenemannImitator {
         let profile = &shared.profile;
         let body = Body::measure(profile, &shared.q)?;
         let frames = [frames(profile, Side::Left)?, frames(profile, Side::Right)?];
-        let nv = shared.q.len();
         let arm_settings = DriverSettings {
             gain: 1.0,
             dt: 1.0,
@@ -204,22 +203,50 @@ impl KoenemannImitator {
         let dls = Method::WeightedDls {
             damping: method.damping,
         };
-        let arms = GoalIk::new(f.hands.map(point).to_vec(), None, nv, dls, arm_settings)?;
+        let all = vec![true; shared.q.len()];
+        let arms = GoalIk::new(f.hands.map(point).to_vec(), &[], all, dls, arm_settings)?;
+        let com = Goal::RootCom {
+            target: Default::default(),
+        };
         let feet_goals = vec![
+            com,
             point(f.soles[0]),
             normal(f.soles[0]),
             point(f.soles[1]),
             normal(f.soles[1]),
         ];
-        let feet = GoalIk::new(feet_goals, None, nv, dls, leg_settings)?;
-        // The held sole first, strictly: the closed chain of double support must not give way.
+        // The CoM first, strictly: statically stable by construction. Below it the prioritized
+        // solver's least squares stand in for the paper's DLS: they are exact where the goals
+        // agree and converge in a few iterations where DLS needs tens (see `taskstack solve`).
+        // The legs alone: the CoM rows would move the arms and head too.
+        let legs = shared.legs.clone();
+        let feet = GoalIk::new(
+            feet_goals,
+            &[1],
+            legs.clone(),
+            Method::Prioritized,
+            leg_settings,
+        )?;
+        // The held sole above all: the closed chain of double support must not give way.
         let hold = Goal::RootPoint {
             frame: f.soles[1],
             offset: Vector3::zeros(),
             target: Vector3::zeros(),
         };
-        let stance_goals = vec![hold, orientation, point(f.soles[0]), normal(f.soles[0])];
-        let stance = GoalIk::new(stance_goals, Some(2), nv, Method::Prioritized, leg_settings)?;
+        let stance_goals = vec![
+            hold,
+            orientation,
+            com,
+            point(f.soles[0]),
+            normal(f.soles[0]),
+        ];
+        let stance = GoalIk::new(
+            stance_goals,
+            &[2, 1],
+            legs,
+            Method::Prioritized,
+            leg_settings,
+        )?;
         let tuning = profile.tuning;
         // The left sole in the right-rooted model (the root at the start).
         let hold = shared.output.left_sole;
@@ -373,44 +400,33 @@ impl KoenemannImitator {
         Ok(())
     }
 
-    /// §V.C: the feet's goals for the mode, and the legs' IK, with the CoM recomputed between
-    /// passes.
+    /// §V.C: the feet's goals for the mode, and the legs' IK.
     fn stabilize(&mut self, mapped: Option<&Posture>, dt: f64) -> Result<(), ImitationError> {
-        for _ in 0..STABILIZE_PASSES {
-            let (data, f) = self.current();
-            let ankles_now = f
-                .ankles
-                .map(|a| in_torso(data, f.torso, a).translation.vector);
-            let ankles = match mapped {
-                Some(m) => [0, 1].map(|k| self.body.hips[k] + m.feet[k]),
-                None => ankles_now,
-            };
-            // Mapped ankle targets carried to the sole centres by the feet's current offsets.
-            let centres_now = Side::BOTH.map(|s| self.centre_in_torso(s));
-            let centres = [0, 1].map(|k| ankles[k] + (centres_now[k] - ankles_now[k]));
-            let com = self.com_in_torso()?;
-            let solved = match (self.mode, self.landing) {
-                (SupportMode::Left, _) => {
-                    self.single(Side::Left, &com, &centres, &ankles, false, dt)?
-                }
-                (SupportMode::Right, _) => {
-                    self.single(Side::Right, &com, &centres, &ankles, false, dt)?
-                }
-                (SupportMode::Double, Some(swing)) => {
-                    self.single(swing.other(), &com, &centres, &ankles, true, dt)?
-                }
-                (SupportMode::Double, None) => self.double(&com, centres, &centres_now)?,
-            };
-            if solved {
-                break;
+        let (data, f) = self.current();
+        let ankles_now = f
+            .ankles
+            .map(|a| in_torso(data, f.torso, a).translation.vector);
+        let ankles = match mapped {
+            Some(m) => [0, 1].map(|k| self.body.hips[k] + m.feet[k]),
+            None => ankles_now,
+        };
+        // Mapped ankle targets carried to the sole centres by the feet's current offsets.
+        let centres_now = Side::BOTH.map(|s| self.centre_in_torso(s));
+        let centres = [0, 1].map(|k| ankles[k] + (centres_now[k] - ankles_now[k]));
+        let com = self.com_in_torso()?;
+        match (self.mode, self.landing) {
+            (SupportMode::Left, _) => self.single(Side::Left, &com, &centres, &ankles, false, dt),
+            (SupportMode::Right, _) => self.single(Side::Right, &com, &centres, &ankles, false, dt),
+            (SupportMode::Double, Some(swing)) => {
+                self.single(swing.other(), &com, &centres, &ankles, true, dt)
             }
+            (SupportMode::Double, None) => self.double(&com, centres, &centres_now),
         }
-        Ok(())
     }
 
-    /// Single support on `support` (or the landing of the other foot): the support sole tilts
-    /// so the CoM is above its centre; the swing ankle goes to its post-processed target, flat.
-    /// Returns whether the CoM's normal changed by less than the tolerance over the pass.
+    /// Single support on `support` (or the landing of the other foot): the CoM above the
+    /// support sole's centre, strictly; below it the support sole at its mapped place with
+    /// the normal of eq. 7 (offset 0 or 1), the swing ankle at its post-processed target, flat.
     fn single(
         &mut self,
         support: Side,
@@ -419,13 +435,15 @@ impl KoenemannImitator {
         ankles: &[Vector3<f64>; 2],
         landing: bool,
         dt: f64,
-    ) -> Result<bool, ImitationError> {
+    ) -> Result<(), ImitationError> {
         let (s, w) = (support.index(), support.other().index());
         let normal = support_normal(com, &centres[s], &centres[s], 0.0).unwrap_or(Vector3::z());
         let swing = self.swing_ankle_target(support, ankles[w], landing, dt);
+        let above = self.floor_centres()[s];
         let root = self.shared.root.index();
         let f = &self.frames[root];
         self.feet.goals.copy_from_slice(&[
+            Goal::RootCom { target: above },
             Goal::TorsoPoint {
                 frame: f.soles[s],
                 offset: self.body.centres[s],
@@ -447,20 +465,7 @@ impl KoenemannImitator {
         ]);
         self.feet
             .run(&mut self.shared, f.torso, &self.position_bounds)?;
-        self.normal_settled(support, &normal)
-    }
-
-    /// Whether the CoM is now above `support`'s centre within the tolerance (the normal of the
-    /// new CoM within 0.033 rad of the one solved for).
-    fn normal_settled(
-        &mut self,
-        support: Side,
-        normal: &Vector3<f64>,
-    ) -> Result<bool, ImitationError> {
-        let com = self.com_in_torso()?;
-        let centre = self.centre_in_torso(support);
-        let now = support_normal(&com, &centre, &centre, 0.0).unwrap_or(*normal);
-        Ok(now.angle(normal) <= self.config.tolerance / super::goals::NORMAL_WEIGHT)
+        Ok(())
     }
 
     /// The swing ankle's target in the root frame: the mapped one, at most `foot_speed` from
@@ -512,18 +517,18 @@ impl KoenemannImitator {
         target
     }
 
-    /// Double support: the feet's goals from the retargeting rule. Returns whether the CoM's
-    /// offset is within tolerance of the command after the pass.
+    /// Double support: the CoM strictly above the point at the commanded offset between the
+    /// soles on the floor; below it the feet's goals from the retargeting rule (in the torso
+    /// frame, with the common normal of eq. 7).
     fn double(
         &mut self,
         com: &Vector3<f64>,
         mapped: [Vector3<f64>; 2],
         now: &[Vector3<f64>; 2],
-    ) -> Result<bool, ImitationError> {
+    ) -> Result<(), ImitationError> {
         let rule = self.config.retargeting;
         let root = self.shared.root;
         let (r, o) = (root.index(), root.other().index());
-        let f = &self.frames[r];
         let targets = match rule {
             FootRetargeting::ShiftBothFeet => {
                 // The stance as it is, placed where the mapping puts its middle.
@@ -534,11 +539,18 @@ impl KoenemannImitator {
         };
         let normal =
             support_normal(com, &targets[0], &targets[1], self.command).unwrap_or(Vector3::z());
+        let above = self.floor_point(&targets, self.command);
+        let f = &self.frames[r];
         let centre = |k: usize| Goal::TorsoPoint {
             frame: f.soles[k],
             offset: self.body.centres[k],
             target: targets[k],
         };
+        let sole_normal = |k: usize| Goal::TorsoNormal {
+            frame: f.soles[k],
+            normal,
+        };
+        let com_goal = Goal::RootCom { target: above };
         let ik = match rule {
             FootRetargeting::ShiftBothFeet => {
                 self.stance.goals.copy_from_slice(&[
@@ -551,35 +563,49 @@ impl KoenemannImitator {
                         frame: f.soles[o],
                         target: self.hold.rotation,
                     },
+                    com_goal,
                     centre(r),
-                    Goal::TorsoNormal {
-                        frame: f.soles[r],
-                        normal,
-                    },
+                    sole_normal(r),
                 ]);
                 &mut self.stance
             }
             FootRetargeting::MoveOneFoot => {
                 self.feet.goals.copy_from_slice(&[
+                    com_goal,
                     centre(0),
-                    Goal::TorsoNormal {
-                        frame: f.soles[0],
-                        normal,
-                    },
+                    sole_normal(0),
                     centre(1),
-                    Goal::TorsoNormal {
-                        frame: f.soles[1],
-                        normal,
-                    },
+                    sole_normal(1),
                 ]);
                 &mut self.feet
             }
         };
         ik.run(&mut self.shared, f.torso, &self.position_bounds)?;
-        let com = self.com_in_torso()?;
-        let achieved =
-            support_normal(&com, &targets[0], &targets[1], self.command).unwrap_or(normal);
-        Ok(achieved.angle(&normal) <= self.config.tolerance / super::goals::NORMAL_WEIGHT)
+        Ok(())
+    }
+
+    /// The sole centres on the floor (x, y in the root frame, m), `[left, right]`.
+    fn floor_centres(&self) -> [Vector2<f64>; 2] {
+        let (data, f) = self.current();
+        [0, 1].map(|k| {
+            let sole = data.frame_placement(f.soles[k]);
+            sole.transform_point(&self.body.centres[k].into())
+                .coords
+                .xy()
+        })
+    }
+
+    /// The point at offset `o` between the sole centres `targets` (torso frame) once on the
+    /// floor: the targets placed by the current torso, then moved so the root sole's centre
+    /// stays where it is (the root sole does not move on the floor).
+    fn floor_point(&self, targets: &[Vector3<f64>; 2], o: f64) -> Vector2<f64> {
+        let (data, f) = self.current();
+        let torso = data.frame_placement(f.torso);
+        let placed = targets.map(|t| torso.transform_point(&t.into()).coords.xy());
+        let r = self.shared.root.index();
+        let shift = self.floor_centres()[r] - placed[r];
+        let [left, right] = placed.map(|p| p + shift);
+        left + (right - left) * o
     }
 
     /// The CoM in the torso frame (current forward kinematics).
