@@ -29,15 +29,39 @@ fn the_offset_speed_is_largest_at_the_middle_and_small_at_the_feet() {
     let speed = OffsetSpeed {
         max: 2.0,
         border: 0.1,
+        acceleration: f64::INFINITY,
     };
     assert_eq!(speed.at(0.5), 2.0);
     assert!((speed.at(0.0) - 0.2).abs() < 1e-12);
     assert!((speed.at(1.0) - 0.2).abs() < 1e-12);
     // v(0.25) = 2 (0.1 + 0.9 · 4 · 0.25 · 0.75) = 2 · 0.775.
     assert!((speed.at(0.25) - 1.55).abs() < 1e-12);
-    // A step never passes its target.
-    assert_eq!(speed.step(0.5, 0.52, 0.1), 0.52);
-    assert!((speed.step(0.5, 0.0, 0.1) - 0.3).abs() < 1e-12);
+    // A step never passes its target, and stops there.
+    assert_eq!(speed.step(0.5, 0.0, 0.52, 0.1), (0.52, 0.0));
+    let (o, rate) = speed.step(0.5, 0.0, 0.0, 0.1);
+    assert!((o - 0.3).abs() < 1e-12 && rate == -2.0, "{o} {rate}");
+}
+
+#[test]
+fn the_offset_rate_changes_by_at_most_the_acceleration_and_brakes_before_its_target() {
+    let speed = OffsetSpeed {
+        max: 2.0,
+        border: 0.1,
+        acceleration: 6.0,
+    };
+    // From rest at 0.5 toward 1: the rate may reach v(0.5) = 2 but gains only 6 · 0.1 = 0.6.
+    let (o, rate) = speed.step(0.5, 0.0, 1.0, 0.1);
+    assert!(
+        (rate - 0.6).abs() < 1e-12 && (o - 0.56).abs() < 1e-12,
+        "{o} {rate}"
+    );
+    // At 2 /s, 0.1 short of the target: the stopping speed √(2 · 6 · 0.1) ≈ 1.095 < 2, so the
+    // rate drops, by 6 · 0.01 = 0.06 in 10 ms.
+    let (o, rate) = speed.step(0.5, 2.0, 0.6, 0.01);
+    assert!(
+        (rate - 1.94).abs() < 1e-12 && (o - 0.5194).abs() < 1e-12,
+        "{o} {rate}"
+    );
 }
 
 #[test]

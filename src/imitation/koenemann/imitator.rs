@@ -79,8 +79,9 @@ pub(crate) struct KoenemannImitator {
     mode: SupportMode,
     /// The foot coming down after single support, until it is on the floor.
     landing: Option<Side>,
-    /// Commanded offset `o'` and the offset achieved at the last frame.
+    /// Commanded offset `o'`, its rate (1/s) and the offset achieved at the last frame.
     command: f64,
+    command_rate: f64,
     measured: f64,
     /// Post-processed hand targets (torso frame).
     hands: Option<[Vector3<f64>; 2]>,
@@ -268,6 +269,7 @@ impl KoenemannImitator {
             mode: SupportMode::Double,
             landing: None,
             command: 0.5,
+            command_rate: 0.0,
             measured: 0.5,
             hands: None,
             swing_target: None,
@@ -340,7 +342,10 @@ impl KoenemannImitator {
                     target_offset(human, human_offset(frame).unwrap_or(0.5), self.command)
                 }
             };
-            self.command = self.config.offset_speed.step(self.command, target, dt);
+            (self.command, self.command_rate) =
+                self.config
+                    .offset_speed
+                    .step(self.command, self.command_rate, target, dt);
         }
         let root = match (next, self.landing) {
             (SupportMode::Left, _) => Side::Left,
