@@ -81,6 +81,7 @@ impl OffsetSpeed {
         if !(self.border > 0.0 && self.border <= 1.0) {
             return Some(("offset_speed.border", self.border));
         }
-        (!(self.acceleration > 0.0)).then_some(("offset_speed.acceleration", self.acceleration))
+        (self.acceleration.is_nan() || self.acceleration <= 0.0)
+            .then_some(("offset_speed.acceleration", self.acceleration))
     }
 }
