@@ -10,21 +10,29 @@
 //!    30 iterations as in the paper).
 //! 2. **CoM control** ([`offset`], §V.A, eq. 6): the robot's CoM offset between its feet moves
 //!    toward the human's (or toward the support foot when the human stands on one), its speed
-//!    a negative quadratic of the offset.
+//!    a negative quadratic of the offset, its acceleration bounded.
 //! 3. **Support mode** ([`support_mode`], §V.B, Fig. 4): single support only when the human is
 //!    on that foot and the robot's offset has reached it.
 //! 4. **Retargeting** ([`retarget`], §V.C, eq. 7): in double support the feet move (in the
 //!    torso frame) so the CoM's offset is the commanded one, and both soles take the normal
 //!    that puts the CoM above that point; in single support the support sole tilts so the CoM
-//!    is above its centre. The legs follow by damped least squares to 1 mm and 0.033 rad
-//!    (the 5-DoF foot goals of the paper: turning about the normal is free).
+//!    is above its centre. The legs' IK (leg joints only) meets, strictly and in this order:
+//!    the other sole held where it stands (double support); the CoM's ground projection at
+//!    the point at the commanded offset between the soles (above the support sole's centre in
+//!    single support), which is what eq. 7's normal means on the floor; then, as well as it
+//!    can, the retargeted soles in the torso frame with their normals (the 5-DoF foot goals of
+//!    the paper: turning about the normal is free) and the swing foot, to 1 mm and 0.033 rad.
 //! 5. **Post-processing** (§V.D): the hands' and the swing foot's targets move at most at a
 //!    speed limit, the hands stay out of the torso, the swing foot stays above the floor and
 //!    out of the other foot's way (the profile's step envelope), and every joint within its
 //!    velocity limit (the legs slowed down together, so their posture keeps its balance).
 //!
 //! Departures from the paper, each because the physics judge showed the need or the paper is
-//! silent: the feet keep their stance in double support by default
+//! silent: stability is a strict CoM level rather than the soles' normals alone (in torso
+//! coordinates the normals' fixed point couples the torso's tilt with its shift and diverged:
+//! on CMU 05_02 the offset went to −0.33 with 0.93 commanded), and the legs' levels are solved
+//! by the strict hierarchy, exact and a few iterations, where the paper's DLS needs tens; the
+//! offset's acceleration is bounded; the feet keep their stance in double support by default
 //! ([`FootRetargeting::ShiftBothFeet`]; the paper's one-foot rule slides a loaded foot);
 //! a foot coming down after single support lands flat at the touchdown speed of
 //! [`MotionLimits`](super::shaping::MotionLimits) before the offset leaves its end; the
@@ -53,8 +61,8 @@ pub struct KoenemannConfig {
     pub offset_speed: OffsetSpeed,
     /// The offset counts as at a foot within this of 0 or 1. Default 0.05.
     pub offset_tolerance: f64,
-    /// Damping `λ` of the least-squares IK (m). Default 0.01 (the paper's 0.3 is for its own
-    /// scaling of the Jacobian, which it does not give).
+    /// Damping `λ` of the arms' least-squares IK (m). Default 0.01 (the paper's 0.3 is for its
+    /// own scaling of the Jacobian, which it does not give).
     pub damping: f64,
     /// Iterations of the arms' IK per frame (paper: 30).
     pub arm_iterations: usize,
@@ -84,7 +92,11 @@ impl KoenemannConfig {
     /// The first invalid field, with its value and why.
     pub(super) fn invalid_field(&self) -> Option<(&'static str, f64, &'static str)> {
         if let Some((name, value)) = self.offset_speed.invalid_field() {
-            return Some((name, value, "must be finite and > 0 (border at most 1)"));
+            return Some((
+                name,
+                value,
+                "must be > 0 (max finite, border at most 1, acceleration may be infinite)",
+            ));
         }
         let positive = [
             ("koenemann.damping", self.damping),
