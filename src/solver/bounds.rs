@@ -117,6 +117,26 @@ impl JointBounds {
         }
     }
 
+    /// Copies the position limits of `other` (same number of joints) into `self`, narrowed to
+    /// what its velocity limits reach from `q` in `dt` seconds: `[max(q_min, q − v Δt),
+    /// min(q_max, q + v Δt)]`, or the nearest position limit when `q` is outside its range by
+    /// more than that; the velocity limits are copied too. For a position-level solve that must
+    /// end within one frame's motion. Allocation-free.
+    pub(crate) fn copy_within_reach(&mut self, other: &JointBounds, q: &[f64], dt: f64) {
+        for i in 0..self.lower.len() {
+            let reach = other.velocity[i] * dt;
+            let (lo, hi) = (other.lower[i], other.upper[i]);
+            let (from, to) = (lo.max(q[i] - reach), hi.min(q[i] + reach));
+            (self.lower[i], self.upper[i]) = if from <= to {
+                (from, to)
+            } else {
+                let nearest = q[i].clamp(lo, hi);
+                (nearest, nearest)
+            };
+            self.velocity[i] = other.velocity[i];
+        }
+    }
+
     /// Clamps `q` into the position limits in place.
     pub fn clamp_position(&self, q: &mut [f64]) {
         for ((qi, &lo), &hi) in q.iter_mut().zip(&self.lower).zip(&self.upper) {

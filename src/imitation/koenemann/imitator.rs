@@ -26,6 +26,9 @@ use crate::robots::{BipedProfile, FootArea, SolePlacement};
 use crate::solver::driver::DriverSettings;
 use crate::solver::{JointBounds, Method};
 
+/// How far the held sole may be from its place after a frame (m; its orientation's error in
+/// radians times [`super::goals::NORMAL_WEIGHT`]).
+const HOLD_TOLERANCE: f64 = 1e-6;
 /// Smallest height of a swing sole above the floor while the human's foot is up (m).
 const SWING_CLEARANCE: f64 = 0.01;
 
@@ -64,13 +67,17 @@ pub(crate) struct KoenemannImitator {
     mapping: Option<PostureMapping>,
     detector: SupportDetector,
     arms: GoalIk,
-    /// The CoM strictly, then 3 + 2 + 3 + 2 rows: single support, landing, the paper's double
-    /// support.
+    /// The CoM strictly, then 3 + 2 rows (the swing foot), then 3 + 2 rows (the support sole
+    /// in the torso frame): single support, landing, the paper's double support.
     feet: GoalIk,
     /// The held sole (3 + 3 rows), then the CoM, then 3 + 2 rows: double support keeping the
     /// stance.
     stance: GoalIk,
+    /// The held sole alone (3 + 3 rows): puts it back after the legs are slowed down.
+    settle: GoalIk,
     position_bounds: JointBounds,
+    /// The position limits narrowed to what the velocity limits reach in the frame.
+    frame_bounds: JointBounds,
     tracking_speed: f64,
     foot_speed: f64,
     motion: MotionLimits,
@@ -223,7 +230,7 @@ impl KoenemannImitator {
         let legs = shared.legs.clone();
         let feet = GoalIk::new(
             feet_goals,
-            &[1],
+            &[1, 2],
             legs.clone(),
             Method::Prioritized,
             leg_settings,
@@ -234,6 +241,19 @@ impl KoenemannImitator {
             offset: Vector3::zeros(),
             target: Vector3::zeros(),
         };
+        let settle_goals = vec![hold, orientation];
+        let settle_settings = DriverSettings {
+            tolerance: HOLD_TOLERANCE,
+            max_iterations: 10,
+            ..leg_settings
+        };
+        let settle = GoalIk::new(
+            settle_goals,
+            &[],
+            legs.clone(),
+            Method::Prioritized,
+            settle_settings,
+        )?;
         let stance_goals = vec![
             hold,
             orientation,
@@ -265,6 +285,8 @@ impl KoenemannImitator {
             arms,
             feet,
             stance,
+            settle,
+            frame_bounds: position_bounds.clone(),
             position_bounds,
             mode: SupportMode::Double,
             landing: None,
@@ -304,6 +326,7 @@ impl KoenemannImitator {
         self.track_hands(mapped.as_ref(), dt)?;
         self.stabilize(mapped.as_ref(), dt)?;
         self.limit_velocities(dt);
+        self.settle_hold(dt)?;
         self.shared.refresh()?;
         self.measure();
         self.write_output(frame, human, mapped.as_ref())?;
@@ -429,9 +452,10 @@ impl KoenemannImitator {
         }
     }
 
-    /// Single support on `support` (or the landing of the other foot): the CoM above the
-    /// support sole's centre, strictly; below it the support sole at its mapped place with
-    /// the normal of eq. 7 (offset 0 or 1), the swing ankle at its post-processed target, flat.
+    /// Single support on `support` (or the landing of the other foot), in priority order: the
+    /// CoM above the support sole's centre; the swing ankle at its post-processed target, flat
+    /// (so a landing foot comes down); the support sole at its mapped place in the torso frame
+    /// with the normal of eq. 7 (offset 0 or 1).
     fn single(
         &mut self,
         support: Side,
@@ -449,15 +473,6 @@ impl KoenemannImitator {
         let f = &self.frames[root];
         self.feet.goals.copy_from_slice(&[
             Goal::RootCom { target: above },
-            Goal::TorsoPoint {
-                frame: f.soles[s],
-                offset: self.body.centres[s],
-                target: centres[s],
-            },
-            Goal::TorsoNormal {
-                frame: f.soles[s],
-                normal,
-            },
             Goal::RootPoint {
                 frame: f.ankles[w],
                 offset: Vector3::zeros(),
@@ -466,6 +481,15 @@ impl KoenemannImitator {
             Goal::RootNormal {
                 frame: f.soles[w],
                 normal: Vector3::z(),
+            },
+            Goal::TorsoPoint {
+                frame: f.soles[s],
+                offset: self.body.centres[s],
+                target: centres[s],
+            },
+            Goal::TorsoNormal {
+                frame: f.soles[s],
+                normal,
             },
         ]);
         self.feet
@@ -575,12 +599,13 @@ impl KoenemannImitator {
                 &mut self.stance
             }
             FootRetargeting::MoveOneFoot => {
+                // The other sole's goals above the root's: they are the ones that move it.
                 self.feet.goals.copy_from_slice(&[
                     com_goal,
-                    centre(0),
-                    sole_normal(0),
-                    centre(1),
-                    sole_normal(1),
+                    centre(o),
+                    sole_normal(o),
+                    centre(r),
+                    sole_normal(r),
                 ]);
                 &mut self.feet
             }
@@ -652,6 +677,35 @@ impl KoenemannImitator {
                 };
         }
         self.shared.bounds.clamp_position(&mut self.shared.q);
+    }
+
+    /// In double support, the held sole put back where it stands, within the frame's velocity
+    /// limits: slowing the legs down moves them along a straight line in joint space, which
+    /// leaves the closed chain of the two feet by the square of the step (millimetres after a
+    /// large correction).
+    fn settle_hold(&mut self, dt: f64) -> Result<(), ImitationError> {
+        if self.mode != SupportMode::Double || self.landing.is_some() {
+            return Ok(());
+        }
+        let root = self.shared.root;
+        let f = &self.frames[root.index()];
+        let other = f.soles[root.other().index()];
+        self.settle.goals.copy_from_slice(&[
+            Goal::RootPoint {
+                frame: other,
+                offset: Vector3::zeros(),
+                target: self.hold.translation.vector,
+            },
+            Goal::RootOrientation {
+                frame: other,
+                target: self.hold.rotation,
+            },
+        ]);
+        self.frame_bounds
+            .copy_within_reach(&self.shared.bounds, &self.q_start, dt);
+        self.settle
+            .run(&mut self.shared, f.torso, &self.frame_bounds)?;
+        Ok(())
     }
 
     /// The offset achieved (the CoM's ground projection between the sole centres) and the
