@@ -10,7 +10,9 @@
 
 use taskstack::human::HumanFrame;
 use taskstack::imitation::footsteps::FootstepConfig;
+use taskstack::imitation::config::ImitationMethod;
 use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
+use taskstack::imitation::koenemann::KoenemannConfig;
 use taskstack::imitation::metrics::{ImitationMetrics, MetricsRecorder};
 use taskstack::imitation::phase::SupportPhase;
 use taskstack::imitation::shaping::MotionLimits;
@@ -292,6 +294,37 @@ fn overridden_tables_are_solved_and_reported_whole() {
                 .sum();
             assert_eq!(r.task_count, expected, "{}", r.phase);
             assert!(r.task_errors[..r.task_count].iter().all(|e| e.is_finite()));
+        }
+    }
+}
+
+/// Koenemann et al.'s method keeps the same invariants on every bundled clip (limits, velocity
+/// limits, the CoM inside the polygon of the feet on the ground, no slip of a standing foot),
+/// and follows the single-leg stance of `cmu_05_02` (the offset reaches the right foot before
+/// the left lifts, and the left comes back down).
+#[test]
+fn koenemann_keeps_the_invariants_on_every_clip() {
+    let config = ImitatorConfig {
+        method: ImitationMethod::Koenemann(KoenemannConfig::default()),
+        ..ImitatorConfig::default()
+    };
+    for name in [
+        "cmu_02_10_wash_self_standing_arm_gestures.bvh",
+        "cmu_05_02_stand_arm_gestures_turn_single_leg.bvh",
+        "cmu_05_12_slow_dance_tendu_arms_high.bvh",
+        "cmu_07_04_slow_walk.bvh",
+        "cmu_09_12_walk_forward_backward_sideways.bvh",
+        "cmu_131_01_start_walk_stop_maxskel.bvh",
+        "kinect2_labanotation_ges01_wavehand.csv",
+        "kinect2_labanotation_ges02_balancinghands.csv",
+    ] {
+        let (m, _) = run_with(name, config.clone(), HELD_FOOT_TOLERANCE);
+        if name.starts_with("cmu_05_02") {
+            assert!(
+                contains(&m.robot_support_sequence, &["DS", "RS", "DS"]),
+                "{:?}",
+                m.robot_support_sequence
+            );
         }
     }
 }

@@ -27,8 +27,8 @@ use crate::solver::driver::DriverSettings;
 use crate::solver::{JointBounds, Method};
 
 /// How far the held sole may be from its place after a frame (m; its orientation's error in
-/// radians times [`super::goals::NORMAL_WEIGHT`]).
-const HOLD_TOLERANCE: f64 = 1e-6;
+/// radians times [`super::goals::NORMAL_WEIGHT`]: 3.3e-6 rad).
+const HOLD_TOLERANCE: f64 = 1e-7;
 /// Smallest height of a swing sole above the floor while the human's foot is up (m).
 const SWING_CLEARANCE: f64 = 0.01;
 
@@ -244,6 +244,7 @@ impl KoenemannImitator {
         let settle_goals = vec![hold, orientation];
         let settle_settings = DriverSettings {
             tolerance: HOLD_TOLERANCE,
+            stall_tolerance: 0.01 * HOLD_TOLERANCE,
             max_iterations: 10,
             ..leg_settings
         };
