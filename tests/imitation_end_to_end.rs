@@ -9,8 +9,8 @@
 //! `cargo test --release --test imitation_end_to_end -- --nocapture` prints the per-clip metrics.
 
 use taskstack::human::HumanFrame;
-use taskstack::imitation::footsteps::FootstepConfig;
 use taskstack::imitation::config::ImitationMethod;
+use taskstack::imitation::footsteps::FootstepConfig;
 use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
 use taskstack::imitation::koenemann::KoenemannConfig;
 use taskstack::imitation::metrics::{ImitationMetrics, MetricsRecorder};
