@@ -33,7 +33,9 @@ use std::path::Path;
 use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 use taskstack::human::HumanFrame;
 use taskstack::human::Side;
+use taskstack::imitation::config::ImitationMethod;
 use taskstack::imitation::imitator::{Imitator, ImitatorConfig, RobotFrame};
+use taskstack::imitation::koenemann::KoenemannConfig;
 use taskstack::imitation::metrics::{CONTACT_HEIGHT, MetricsRecorder, convex_margin};
 use taskstack::io::clip::Clip;
 use taskstack::robots::{g1, nao};
@@ -307,14 +309,28 @@ fn full_soak_all_clips_ten_passes() {
     check_soak(&load(&ALL), 10);
 }
 
-/// The G1's `Imitator::step` allocates nothing either once warmed up by a first clip (allocations
-/// counted on this thread over the next two clips). The G1's per-frame invariants are checked
-/// clip by clip in `tests/imitation_profiles.rs`: back to back, where the human jumps between
-/// clips, its held foot drifts (see issue 11's closing note).
+/// The G1's `Imitator::step` allocates nothing either once warmed up by a first clip. The G1's
+/// per-frame invariants are checked clip by clip in `tests/imitation_profiles.rs`: back to back,
+/// where the human jumps between clips, its held foot drifts (see issue 11's closing note).
 #[test]
 fn g1_step_does_not_allocate_after_warm_up() {
+    let imitator = Imitator::new(g1::profile(), ImitatorConfig::default()).unwrap();
+    assert_no_allocation_after_warm_up(imitator);
+}
+
+/// Nor does Koenemann et al.'s method (its IK problems, goals and bounds are built in `new`).
+#[test]
+fn koenemann_step_does_not_allocate_after_warm_up() {
+    let config = ImitatorConfig {
+        method: ImitationMethod::Koenemann(KoenemannConfig::default()),
+        ..ImitatorConfig::default()
+    };
+    assert_no_allocation_after_warm_up(Imitator::new(nao::profile(), config).unwrap());
+}
+
+/// Allocations counted on this thread over the short clips after the first (the warm-up).
+fn assert_no_allocation_after_warm_up(mut imitator: Imitator) {
     let clips = load(&SHORT);
-    let mut imitator = Imitator::new(g1::profile(), ImitatorConfig::default()).unwrap();
     let mut next_start = 0.0;
     let mut after_warm_up = 0;
     let mut frames = 0;
