@@ -1,11 +1,14 @@
-//! `Imitator::step` on real clips, for the NAO and the Unitree G1: frames of double support (CMU
-//! 02_10, standing gestures) and of a walk with right and left single supports (CMU 07_04),
-//! streamed from memory in a loop.
+//! `Imitator::step` on real clips, for the NAO and the Unitree G1 and both methods (Poubel's
+//! task tables, Koenemann et al.'s): frames of double support (CMU 02_10, standing gestures)
+//! and of a walk with right and left single supports (CMU 07_04), streamed from memory in a
+//! loop.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
 use taskstack::human::HumanFrame;
+use taskstack::imitation::config::ImitationMethod;
 use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
+use taskstack::imitation::koenemann::KoenemannConfig;
 use taskstack::imitation::phase::SupportPhase;
 use taskstack::io::clip::Clip;
 use taskstack::robots::{BipedProfile, g1, nao};
@@ -20,7 +23,14 @@ type Robot = (&'static str, fn() -> BipedProfile);
 
 fn bench(c: &mut Criterion) {
     let robots: [Robot; 2] = [("nao", nao::profile), ("g1", g1::profile)];
-    for ((label, clip), (robot, profile)) in [
+    let methods = [
+        ("poubel", ImitationMethod::Poubel),
+        (
+            "koenemann",
+            ImitationMethod::Koenemann(KoenemannConfig::default()),
+        ),
+    ];
+    for (((label, clip), (robot, profile)), (method_name, method)) in [
         (
             "double_support_02_10",
             "cmu_02_10_wash_self_standing_arm_gestures.bvh",
@@ -29,10 +39,15 @@ fn bench(c: &mut Criterion) {
     ]
     .into_iter()
     .flat_map(|clip| robots.map(|robot| (clip, robot)))
+    .flat_map(|case| methods.map(|method| (case, method)))
     {
         let frames = frames(clip);
         let duration = frames.last().unwrap().time - frames[0].time + 1.0 / 120.0;
-        let mut imitator = Imitator::new(profile(), ImitatorConfig::default()).unwrap();
+        let config = ImitatorConfig {
+            method,
+            ..ImitatorConfig::default()
+        };
+        let mut imitator = Imitator::new(profile(), config).unwrap();
         // Warm up on the whole clip once, and count the phases the bench will see.
         let mut single = 0;
         for f in &frames {
@@ -40,24 +55,27 @@ fn bench(c: &mut Criterion) {
             single += usize::from(matches!(p, SupportPhase::Right | SupportPhase::Left));
         }
         eprintln!(
-            "{robot} {label}: {} frames, {single} in single support on the first pass",
+            "{robot} {method_name} {label}: {} frames, {single} in single support on the first pass",
             frames.len()
         );
         let mut i = 0;
         let mut lap = 1.0;
-        c.bench_function(&format!("imitator_step/{robot}/{label}"), |b| {
-            b.iter(|| {
-                // Replay the clip with increasing times so the imitator sees a continuous stream.
-                let mut frame = frames[i];
-                frame.time += lap * duration;
-                i += 1;
-                if i == frames.len() {
-                    i = 0;
-                    lap += 1.0;
-                }
-                black_box(imitator.step(&frame).unwrap().q[0])
-            })
-        });
+        c.bench_function(
+            &format!("imitator_step/{robot}/{method_name}/{label}"),
+            |b| {
+                b.iter(|| {
+                    // Replay the clip with increasing times so the imitator sees a continuous stream.
+                    let mut frame = frames[i];
+                    frame.time += lap * duration;
+                    i += 1;
+                    if i == frames.len() {
+                        i = 0;
+                        lap += 1.0;
+                    }
+                    black_box(imitator.step(&frame).unwrap().q[0])
+                })
+            },
+        );
     }
 }
 

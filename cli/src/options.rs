@@ -6,7 +6,7 @@ use anyhow::{Context, Result};
 use clap::Args;
 use taskstack::ImitatorConfig;
 use taskstack::imitation::config::ImitationMethod;
-use taskstack::imitation::koenemann::KoenemannConfig;
+use taskstack::imitation::koenemann::{Calibration, FootRetargeting, KoenemannConfig};
 use taskstack::io::clip::Clip;
 use taskstack::io::skeleton_map::SkeletonMap;
 use taskstack::robots::{BipedProfile, g1, nao};
@@ -58,6 +58,35 @@ pub(crate) struct ImitationOptions {
     /// 2014). Same outputs and metrics for both.
     #[arg(long, value_enum, default_value_t = MethodName::Poubel)]
     pub(crate) method: MethodName,
+    /// `--method koenemann`: the human's reference posture for the limb ratios. `auto`: the
+    /// first frame if it is a T-pose, else an ideal T-pose at the human's limb lengths.
+    #[arg(long, value_enum, default_value_t = CalibrationName::Auto)]
+    pub(crate) calibration: CalibrationName,
+    /// `--method koenemann`: how double support meets the commanded CoM offset.
+    /// `shift-both-feet`: the stance is kept (no foot slides); `move-one-foot`: the paper's rule
+    /// (a loaded foot slides on a real floor).
+    #[arg(long, value_enum, default_value_t = RetargetingName::ShiftBothFeet)]
+    pub(crate) retargeting: RetargetingName,
+}
+
+/// `--calibration` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub(crate) enum CalibrationName {
+    /// The first frame if it is a T-pose, else the ideal T-pose.
+    Auto,
+    /// The first frame with the whole skeleton, whatever its posture.
+    FirstFrame,
+    /// An ideal T-pose at the human's limb lengths.
+    Ideal,
+}
+
+/// `--retargeting` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub(crate) enum RetargetingName {
+    /// Both feet shift together in the torso frame: the stance is kept.
+    ShiftBothFeet,
+    /// One foot moves toward the CoM (Koenemann et al.'s Fig. 5).
+    MoveOneFoot,
 }
 
 /// The imitation methods by name.
@@ -90,7 +119,18 @@ impl ImitationOptions {
     pub(crate) fn imitator_config(&self) -> ImitatorConfig {
         let method = match self.method {
             MethodName::Poubel => ImitationMethod::Poubel,
-            MethodName::Koenemann => ImitationMethod::Koenemann(KoenemannConfig::default()),
+            MethodName::Koenemann => ImitationMethod::Koenemann(KoenemannConfig {
+                calibration: match self.calibration {
+                    CalibrationName::Auto => Calibration::Auto,
+                    CalibrationName::FirstFrame => Calibration::FirstFrame,
+                    CalibrationName::Ideal => Calibration::Ideal,
+                },
+                retargeting: match self.retargeting {
+                    RetargetingName::ShiftBothFeet => FootRetargeting::ShiftBothFeet,
+                    RetargetingName::MoveOneFoot => FootRetargeting::MoveOneFoot,
+                },
+                ..KoenemannConfig::default()
+            }),
         };
         let mut config = ImitatorConfig {
             method,
