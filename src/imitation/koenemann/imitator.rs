@@ -583,16 +583,10 @@ impl KoenemannImitator {
         let com_goal = Goal::RootCom { target: above };
         let ik = match rule {
             FootRetargeting::ShiftBothFeet => {
+                let [point, orientation] = self.hold_goals();
                 self.stance.goals.copy_from_slice(&[
-                    Goal::RootPoint {
-                        frame: f.soles[o],
-                        offset: Vector3::zeros(),
-                        target: self.hold.translation.vector,
-                    },
-                    Goal::RootOrientation {
-                        frame: f.soles[o],
-                        target: self.hold.rotation,
-                    },
+                    point,
+                    orientation,
                     com_goal,
                     centre(r),
                     sole_normal(r),
@@ -613,6 +607,23 @@ impl KoenemannImitator {
         };
         ik.run(&mut self.shared, f.torso, &self.position_bounds)?;
         Ok(())
+    }
+
+    /// The non-root sole at its held placement (root frame): its origin and its orientation.
+    fn hold_goals(&self) -> [Goal; 2] {
+        let root = self.shared.root;
+        let frame = self.frames[root.index()].soles[root.other().index()];
+        [
+            Goal::RootPoint {
+                frame,
+                offset: Vector3::zeros(),
+                target: self.hold.translation.vector,
+            },
+            Goal::RootOrientation {
+                frame,
+                target: self.hold.rotation,
+            },
+        ]
     }
 
     /// The sole centres on the floor (x, y in the root frame, m), `[left, right]`.
@@ -688,20 +699,9 @@ impl KoenemannImitator {
         if self.mode != SupportMode::Double || self.landing.is_some() {
             return Ok(());
         }
-        let root = self.shared.root;
-        let f = &self.frames[root.index()];
-        let other = f.soles[root.other().index()];
-        self.settle.goals.copy_from_slice(&[
-            Goal::RootPoint {
-                frame: other,
-                offset: Vector3::zeros(),
-                target: self.hold.translation.vector,
-            },
-            Goal::RootOrientation {
-                frame: other,
-                target: self.hold.rotation,
-            },
-        ]);
+        let hold = self.hold_goals();
+        self.settle.goals.copy_from_slice(&hold);
+        let f = &self.frames[self.shared.root.index()];
         self.frame_bounds
             .copy_within_reach(&self.shared.bounds, &self.q_start, dt);
         self.settle
@@ -712,15 +712,10 @@ impl KoenemannImitator {
     /// The offset achieved (the CoM's ground projection between the sole centres) and the
     /// landing foot's contact: once it is down, it is held where it landed.
     fn measure(&mut self) {
+        let [left, right] = self.floor_centres().map(|c| Vector3::new(c.x, c.y, 0.0));
         let (data, f) = self.current();
-        let centre = |k: usize| {
-            let sole = data.frame_placement(f.soles[k]);
-            let mut p = sole.transform_point(&self.body.centres[k].into()).coords;
-            p.z = 0.0;
-            p
-        };
         let measured = match self.shared.profile.model(self.shared.root).com(data) {
-            Ok(com) => offset(&Vector3::new(com.x, com.y, 0.0), &centre(0), &centre(1)),
+            Ok(com) => offset(&Vector3::new(com.x, com.y, 0.0), &left, &right),
             Err(_) => None,
         };
         let landed = self.landing.and_then(|swing| {
