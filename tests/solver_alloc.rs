@@ -54,6 +54,15 @@ fn fill(solver: &mut Solver, salt: usize) {
         for (i, t) in l.target_mut().iter_mut().enumerate() {
             *t = 5.0 * entry(i, level, salt + 1);
         }
+        let rows = l.inequality_rows();
+        let (mut jac, lower, upper) = l.inequalities_mut();
+        for i in 0..rows {
+            for j in 0..N {
+                jac[(i, j)] = entry(i + 10 * level + 5, j, salt);
+            }
+            lower[i] = -0.5 + 0.2 * entry(i, level, salt + 2);
+            upper[i] = 0.5 + 0.2 * entry(i, level, salt + 3);
+        }
     }
 }
 
@@ -76,24 +85,33 @@ impl TaskModel for Linear {
     }
 }
 
-/// Both methods in one test: the allocation counter is global, a second test thread would
-/// count into it.
+/// Both methods, and the active-set method with inequality rows, in one test: the allocation
+/// counter is global, a second test thread would count into it.
 #[test]
 fn warmed_up_solves_do_not_allocate() {
-    warmed_up_solves_do_not_allocate_with(Method::Prioritized);
-    warmed_up_solves_do_not_allocate_with(Method::WeightedDls { damping: 0.05 });
-}
-
-fn warmed_up_solves_do_not_allocate_with(method: Method) {
     // The paper's RS stack shape: CoM (2 rows), then hands + free ankle (9 rows).
-    let shape = StackShape::new(N)
+    let equality = StackShape::new(N)
         .with_level("balance", &[("com_xy", 2)])
         .with_level("tracking", &[("l_hand", 3), ("r_hand", 3), ("l_ankle", 3)]);
+    warmed_up_solves_do_not_allocate_with(&equality, Method::Prioritized);
+    warmed_up_solves_do_not_allocate_with(&equality, Method::WeightedDls { damping: 0.05 });
+    // The CoM inside a polygon (6 edges) at the top; hands and ankle, and two distances, below.
+    let inequality = StackShape::new(N)
+        .with_inequality_level("balance", &[("com_in_polygon", 6)])
+        .with_mixed_level(
+            "tracking",
+            &[("l_hand", 3), ("r_hand", 3), ("l_ankle", 3)],
+            &[("distances", 2)],
+        );
+    warmed_up_solves_do_not_allocate_with(&inequality, Method::Prioritized);
+}
+
+fn warmed_up_solves_do_not_allocate_with(shape: &StackShape, method: Method) {
     let settings = Settings {
         method,
         ..Settings::default()
     };
-    let mut solver = Solver::with_settings(&shape, settings).unwrap();
+    let mut solver = Solver::with_settings(shape, settings).unwrap();
     let lower = [-0.3; N];
     let upper = [0.3; N];
     let bounds = JointBounds::with_velocity(&lower, &upper, &[2.0; N]).unwrap();
@@ -110,7 +128,7 @@ fn warmed_up_solves_do_not_allocate_with(method: Method) {
     solver.solve(&q, &bounds, 0.01).unwrap();
 
     let before = ALLOCATIONS.load(Ordering::SeqCst);
-    let mut clamped = 0;
+    let (mut clamped, mut active) = (0, 0);
     for salt in 0..50 {
         fill(&mut solver, salt);
         let stack = solver.stack_mut();
@@ -118,12 +136,9 @@ fn warmed_up_solves_do_not_allocate_with(method: Method) {
         stack.add_gradient(-0.10, &limits, &q).unwrap();
         tracking.set_reference(&reference).unwrap();
         stack.add_gradient(-0.02, &tracking, &q).unwrap();
-        clamped += solver
-            .solve(&q, &bounds, 0.01)
-            .unwrap()
-            .report
-            .clamped_joints()
-            .len();
+        let report = solver.solve(&q, &bounds, 0.01).unwrap().report;
+        clamped += report.clamped_joints().len();
+        active += report.active_inequalities().len();
         solver.solve_unbounded().unwrap();
     }
     driver
@@ -131,6 +146,11 @@ fn warmed_up_solves_do_not_allocate_with(method: Method) {
         .unwrap();
     let after = ALLOCATIONS.load(Ordering::SeqCst);
     assert!(clamped > 0, "the clamping loop was exercised");
+    let inequalities = solver.stack().total_inequality_rows();
+    assert!(
+        inequalities == 0 || active > 0,
+        "inequality rows became active"
+    );
     assert_eq!(
         after - before,
         0,

@@ -202,3 +202,106 @@ fn a_rejected_solve_keeps_the_previous_result() {
     assert!(s.solve_unbounded().is_err());
     assert_eq!(s.velocity(), &before[..]);
 }
+
+fn inequality_solver() -> Solver {
+    let shape = StackShape::new(3)
+        .with_inequality_level("balance", &[("com_in_polygon", 2)])
+        .with_level("tracking", &[("hand", 3)]);
+    Solver::new(&shape).unwrap()
+}
+
+#[test]
+fn bad_inequality_rows_name_level_and_row() {
+    let mut solver = inequality_solver();
+    let mut level = solver.stack_mut().level_mut(0);
+    assert!(matches!(
+        level.set_inequality_row(2, &[1.0, 0.0, 0.0], 0.0, 1.0),
+        Err(SolverError::NoSuchRow {
+            level: 0,
+            row: 2,
+            rows: 2,
+            ..
+        })
+    ));
+    assert!(matches!(
+        level.set_inequality_row(0, &[1.0, 0.0], 0.0, 1.0),
+        Err(SolverError::DimensionMismatch {
+            expected: 3,
+            got: 2,
+            ..
+        })
+    ));
+    // Inverted, NaN and empty (+∞ lower) bounds are refused by the next solve.
+    level
+        .set_inequality_row(1, &[1.0, 0.0, 0.0], 1.0, -1.0)
+        .unwrap();
+    assert_eq!(
+        solver.solve_unbounded().unwrap_err(),
+        SolverError::InvertedBounds {
+            level: 0,
+            name: "balance".into(),
+            row: 1,
+            lower: 1.0,
+            upper: -1.0
+        }
+    );
+    let mut level = solver.stack_mut().level_mut(0);
+    level
+        .set_inequality_row(1, &[1.0, 0.0, 0.0], f64::INFINITY, f64::INFINITY)
+        .unwrap();
+    assert!(matches!(
+        solver.solve_unbounded(),
+        Err(SolverError::InvertedBounds { row: 1, .. })
+    ));
+    let mut level = solver.stack_mut().level_mut(0);
+    level
+        .set_inequality_row(1, &[1.0, 0.0, 0.0], f64::NAN, 1.0)
+        .unwrap();
+    let err = solver.solve_unbounded().unwrap_err();
+    assert!(
+        err.to_string().contains("inequality bounds of level 0"),
+        "{err}"
+    );
+    let mut level = solver.stack_mut().level_mut(0);
+    level
+        .set_inequality_row(1, &[1.0, f64::NAN, 0.0], -1.0, 1.0)
+        .unwrap();
+    let err = solver.solve_unbounded().unwrap_err();
+    assert!(
+        err.to_string()
+            .contains("inequality Jacobian of level 0 (\"balance\") at row 1, column 1"),
+        "{err}"
+    );
+    // Unbounded sides are fine: the default rows (−∞, +∞) and a one-sided row.
+    let mut level = solver.stack_mut().level_mut(0);
+    level
+        .set_inequality_row(1, &[1.0, 0.0, 0.0], f64::NEG_INFINITY, 1.0)
+        .unwrap();
+    assert!(solver.solve_unbounded().is_ok());
+    assert!(matches!(
+        solver.stack_mut().inequality_task_mut("hand"),
+        Err(SolverError::NoSuchTask(_))
+    ));
+}
+
+#[test]
+fn scaling_and_weighted_dls_are_refused_with_inequality_rows() {
+    let shape = StackShape::new(3).with_inequality_level("balance", &[("com", 2)]);
+    let scale = Settings {
+        scale_to_fit: true,
+        ..Settings::default()
+    };
+    assert!(matches!(
+        Solver::with_settings(&shape, scale),
+        Err(SolverError::InvalidParameter {
+            name: "scale_to_fit",
+            ..
+        })
+    ));
+    let mut solver = inequality_solver();
+    assert!(solver.set_settings(scale).is_err());
+    assert!(
+        !solver.settings().scale_to_fit,
+        "the previous settings are kept"
+    );
+}

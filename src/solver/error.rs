@@ -7,8 +7,8 @@ use thiserror::Error;
 #[derive(Debug, Clone, PartialEq, Error)]
 #[non_exhaustive]
 pub enum SolverError {
-    /// The stack has no equality level.
-    #[error("the task stack has no equality level")]
+    /// The stack has no level.
+    #[error("the task stack has no level")]
     EmptyStack,
     /// The stack has no joint (degree of freedom).
     #[error("the task stack has no degree of freedom (dof = 0)")]
@@ -70,6 +70,23 @@ pub enum SolverError {
         /// Lower limit (rad or m).
         lower: f64,
         /// Upper limit (rad or m).
+        upper: f64,
+    },
+    /// An inequality row whose bounds admit no value: `lower > upper`, `lower = +∞` or
+    /// `upper = −∞`.
+    #[error(
+        "inequality row {row} of level {level} ({name:?}): bounds [{lower}, {upper}] are empty"
+    )]
+    InvertedBounds {
+        /// Level index.
+        level: usize,
+        /// Level name.
+        name: String,
+        /// Row within the level's inequality rows.
+        row: usize,
+        /// Lower bound (task velocity units).
+        lower: f64,
+        /// Upper bound (task velocity units).
         upper: f64,
     },
     /// A parameter outside its valid range (a negative velocity limit, a non-positive time step, …).

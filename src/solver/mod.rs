@@ -18,6 +18,13 @@
 //! solve fills a [`SolveReport`]: per level the residual, the rank used and whether it was met; the
 //! clamped joints; the clamping iterations. See [`prioritized`] for how it is computed.
 //!
+//! A level may also hold **inequality rows** `l_j ≤ C_j q̇ ≤ u_j` beside its equality rows
+//! ([`StackShape::with_inequality_level`], [`StackShape::with_mixed_level`]): the stack is then
+//! solved lexicographically by an active-set method on the same null-space machinery, with the
+//! joint intervals as inequalities above every level (see [`prioritized::active_set`]); the
+//! report lists the active rows ([`SolveReport::active_inequalities`]) and the level that gave
+//! way ([`SolveReport::first_infeasible_level`]).
+//!
 //! [`Solver`] owns the stack and a workspace sized once for `(n, rows per level)`; solving
 //! allocates nothing. [`driver`] iterates the velocity solve to reach position targets.
 //!
@@ -51,6 +58,8 @@
 //! | Entry point | Bad input | What happens | Test |
 //! |---|---|---|---|
 //! | [`StackShape`] → [`Solver::new`], [`Solver::with_settings`] | `dof = 0`; no level; a level with 0 rows | `NoDegreesOfFreedom`; `EmptyStack`; `EmptyLevel { level, name }` (the shape itself is plain data, checked when a solver is built) | `solver_errors`, `empty_stack_and_zero_dof_are_rejected` |
+//! | [`Solver::with_settings`], [`Solver::set_settings`] | `scale_to_fit` or weighted DLS with inequality rows (or `limits_by_active_set`) | `InvalidParameter { name: "scale_to_fit" }` / `"method (weighted DLS damping)"`; `set_settings` keeps the previous settings | `solver_errors`, `scaling_and_weighted_dls_are_refused_with_inequality_rows` |
+//! | [`LevelMut::set_inequality_row`], [`LevelMut::inequalities_mut`], [`TaskStack::inequality_task_mut`] | row ≥ rows; wrong length; unknown task; NaN in the Jacobian or a bound; `lower > upper`, `lower = +∞`, `upper = −∞` | `NoSuchRow`; `DimensionMismatch`; `NoSuchTask`; refused by the next solve: `NonFinite` naming level, row (and column), `InvertedBounds { level, name, row, lower, upper }`. Infinite bounds on one side mean "no bound" | `solver_errors`, `bad_inequality_rows_name_level_and_row` |
 //! | [`Solver::with_settings`], [`Solver::set_settings`] ([`Settings`]) | a NaN, infinite or negative field; `rank_tolerance = 0` | `InvalidParameter { name }` naming the field; `set_settings` keeps the previous settings | `solver_errors`, `bad_q_dt_limits_and_settings_are_rejected`; `hardening_entry_points`, `settings_out_of_range_are_refused_by_name_at_construction_and_on_update` |
 //! | [`TaskStack::try_level_mut`], [`TaskStack::task_mut`] | a level index or task name the stack lacks | `NoSuchLevel`; `NoSuchTask` ([`TaskStack::level_mut`] panics by contract, like slice indexing) | `solver_errors`, `wrong_sizes_are_rejected` |
 //! | [`LevelMut::set_row`] | row ≥ rows; wrong length | `NoSuchRow`; `DimensionMismatch` | `solver_errors`, `wrong_sizes_are_rejected` |
@@ -86,5 +95,5 @@ pub use bounds::JointBounds;
 pub use error::SolverError;
 pub use gradient::{GradientFunction, JointLimitAvoidance, JointTracking};
 pub use prioritized::{Method, Settings, Solver, limit_criterion_gradient, limit_weight};
-pub use report::{LevelReport, Solution, SolveReport};
-pub use stack::{LevelMut, LevelSpec, StackShape, TaskSpec, TaskStack};
+pub use report::{ActiveInequality, Bound, LevelReport, Solution, SolveReport};
+pub use stack::{InequalityRowsMut, LevelMut, LevelSpec, StackShape, TaskSpec, TaskStack};

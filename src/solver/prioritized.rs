@@ -40,10 +40,13 @@ use super::bounds::JointBounds;
 use super::householder::{
     apply_reflector, dot, norm, qr_col_pivoting, qr_with_rhs, solve_upper, solve_upper_transposed,
 };
-use super::report::{Solution, SolveReport};
+use super::report::{ActiveInequality, Bound, Solution, SolveReport};
 use super::stack::{StackShape, TaskStack, check_finite_slice, check_len};
 
+pub mod active_set;
 mod weighted_dls;
+
+use active_set::ActiveSetWorkspace;
 
 pub use weighted_dls::{limit_criterion_gradient, limit_weight};
 
@@ -107,6 +110,13 @@ pub struct Settings {
     pub scale_to_fit: bool,
     /// Strict priorities (default) or weighted damped least squares.
     pub method: Method,
+    /// Handle the joint intervals as inequality rows above every level, by the active-set
+    /// method (see [`active_set`]), instead of the clamping loop: a joint held at a bound is
+    /// released again when the levels would rather move it inward, so the result is the
+    /// lexicographic optimum under the joint intervals. Always the case for a stack with
+    /// inequality rows; this switch asks for it on equality-only stacks too. Default off.
+    /// Not available with [`Settings::scale_to_fit`] or [`Method::WeightedDls`].
+    pub limits_by_active_set: bool,
 }
 
 impl Default for Settings {
@@ -118,12 +128,31 @@ impl Default for Settings {
             feasibility_tolerance: 1e-8,
             scale_to_fit: false,
             method: Method::Prioritized,
+            limits_by_active_set: false,
         }
     }
 }
 
 impl Settings {
-    fn validate(&self) -> Result<(), SolverError> {
+    /// Checks the fields; `inequalities`: whether the stack has inequality rows.
+    fn validate(&self, inequalities: bool) -> Result<(), SolverError> {
+        if inequalities || self.limits_by_active_set {
+            let reason = "not available with inequality rows or limits_by_active_set";
+            if self.scale_to_fit {
+                return Err(SolverError::InvalidParameter {
+                    name: "scale_to_fit",
+                    value: 1.0,
+                    reason,
+                });
+            }
+            if let Method::WeightedDls { damping } = self.method {
+                return Err(SolverError::InvalidParameter {
+                    name: "method (weighted DLS damping)",
+                    value: damping,
+                    reason,
+                });
+            }
+        }
         let check = |name, value: f64, positive: bool| {
             let ok = value.is_finite() && if positive { value > 0.0 } else { value >= 0.0 };
             if ok {
@@ -158,6 +187,60 @@ struct LevelFactor {
     dim: usize,
     /// Rank used, `k_j`.
     rank: usize,
+    /// Rows used: the level's equality rows and its active inequality rows.
+    rows: usize,
+}
+
+/// A row a pass uses: an equality row (stacked index), or an active inequality row held at one of
+/// its bounds.
+#[derive(Debug, Clone, Copy)]
+enum UsedRow {
+    Equality(usize),
+    Inequality(usize, Bound),
+}
+
+/// The Jacobian row and the desired velocity of a used row.
+fn used_row(stack: &TaskStack, row: UsedRow, scale: f64) -> (&[f64], f64) {
+    match row {
+        UsedRow::Equality(r) => (stack.row(r), scale * stack.stacked_target()[r]),
+        UsedRow::Inequality(r, bound) => {
+            let (lower, upper) = stack.inequality_bounds(r);
+            let value = match bound {
+                Bound::Lower => lower,
+                Bound::Upper => upper,
+            };
+            (stack.inequality_row(r), value)
+        }
+    }
+}
+
+/// Applies the reflectors of `factors` (levels `0..factors.len()`, level j's stored at
+/// `n · seg_start[j]` in `qr`) to `coords` (free-joint coordinates): afterwards
+/// `coords[o_j..o_j + k_j]` is `U_jᵀ v` for each level's range basis `U_j = Z_{j−1} Q_j[:, ..k_j]`.
+/// Returns the offset where the remaining null-space coordinates start.
+fn apply_chain(
+    qr: &[f64],
+    n: usize,
+    tau: &[f64],
+    factors: &[LevelFactor],
+    seg_start: &[usize],
+    coords: &mut [f64],
+) -> usize {
+    let mut offset = 0;
+    for (j, f) in factors.iter().enumerate() {
+        let start = seg_start[j];
+        let factor = &qr[n * start..];
+        let cur = &mut coords[offset..offset + f.dim];
+        for l in 0..f.rank {
+            apply_reflector(
+                &factor[l * f.dim + l..(l + 1) * f.dim],
+                tau[start + l],
+                &mut cur[l..],
+            );
+        }
+        offset += f.rank;
+    }
+    offset
 }
 
 /// A prioritized task-stack solver: the stack, its workspace, and the last result.
@@ -169,7 +252,15 @@ pub struct Solver {
     settings: Settings,
     // Workspace, sized for (n, level rows).
     factors: Vec<LevelFactor>,
-    /// `A_jᵀ` per level, column-major with leading dimension `r_{j−1}`, at offset `n · start_j`;
+    /// First buffer row of each level (its equality rows plus all its inequality rows), and the
+    /// total.
+    seg_start: Vec<usize>,
+    /// The rows each level uses in the current pass, at `seg_start`.
+    used: Vec<UsedRow>,
+    /// Per inequality row: the bound it is held at, or `None` while inactive.
+    inequality_state: Vec<Option<Bound>>,
+    active_set: ActiveSetWorkspace,
+    /// `A_jᵀ` per level, column-major with leading dimension `r_{j−1}`, at offset `n · seg_j`;
     /// after factorization, `R_j` and the reflectors.
     qr: Vec<f64>,
     tau: Vec<f64>,
@@ -214,19 +305,35 @@ impl Solver {
 
     /// A solver for stacks of this shape with the given settings.
     pub fn with_settings(shape: &StackShape, settings: Settings) -> Result<Self, SolverError> {
-        settings.validate()?;
+        settings.validate(shape.has_inequalities())?;
         let stack = TaskStack::new(shape)?;
         let n = stack.dof();
         let total = stack.total_rows();
+        let inequalities = stack.total_inequality_rows();
         let levels = stack.level_count();
-        let m_max = shape.level_rows().max().unwrap_or(0);
+        // Each level's buffers hold its equality rows and every inequality row it could activate.
+        let capacities: Vec<usize> = shape
+            .level_rows()
+            .zip(shape.level_inequality_rows())
+            .map(|(m, p)| m + p)
+            .collect();
+        let mut seg_start = vec![0];
+        for c in &capacities {
+            seg_start.push(seg_start[seg_start.len() - 1] + c);
+        }
+        let capacity = seg_start[levels];
+        let m_max = capacities.iter().copied().max().unwrap_or(0);
         Ok(Self {
             factors: vec![LevelFactor::default(); levels],
-            qr: vec![0.0; n * total],
-            tau: vec![0.0; total],
-            perm: vec![0; total],
-            rhs: vec![0.0; total],
-            coeff: vec![0.0; total],
+            seg_start,
+            used: vec![UsedRow::Equality(0); capacity],
+            inequality_state: vec![None; inequalities],
+            active_set: ActiveSetWorkspace::new(n, capacity, inequalities, m_max),
+            qr: vec![0.0; n * capacity],
+            tau: vec![0.0; capacity],
+            perm: vec![0; capacity],
+            rhs: vec![0.0; capacity],
+            coeff: vec![0.0; capacity],
             ls_matrix: vec![0.0; 2 * m_max * m_max],
             ls_rhs: vec![0.0; 2 * m_max],
             coords: vec![0.0; n],
@@ -245,7 +352,7 @@ impl Solver {
             gram: vec![0.0; total * total],
             inverse_weight: vec![1.0; n],
             previous_criterion: vec![0.0; n],
-            report: SolveReport::with_capacity(levels, n),
+            report: SolveReport::with_capacity(levels, n, inequalities),
             stack,
             settings,
         })
@@ -268,7 +375,7 @@ impl Solver {
 
     /// Replaces the numerical settings.
     pub fn set_settings(&mut self, settings: Settings) -> Result<(), SolverError> {
-        settings.validate()?;
+        settings.validate(self.stack.shape().has_inequalities())?;
         self.settings = settings;
         Ok(())
     }
@@ -308,12 +415,21 @@ impl Solver {
         }
         self.stack.check_finite()?;
         bounds.step_interval(q, dt, &mut self.step_lo, &mut self.step_hi);
+        if self.uses_active_set() {
+            self.solve_active_set();
+            self.finish_report();
+            return Ok(Solution {
+                velocity: &self.velocity,
+                report: &self.report,
+            });
+        }
         self.step_vmax.copy_from_slice(bounds.velocity());
         self.clamped.fill(false);
         self.fixed_velocity.fill(0.0);
         self.report.clamped.clear();
         self.report.clamping_iterations = 0;
         self.scales.fill(1.0);
+        self.inequality_state.fill(None);
         if let Method::WeightedDls { .. } = self.settings.method {
             self.update_limit_weights(q, bounds);
         }
@@ -355,12 +471,23 @@ impl Solver {
     /// uses unit weights).
     pub fn solve_unbounded(&mut self) -> Result<Solution<'_>, SolverError> {
         self.stack.check_finite()?;
+        if self.uses_active_set() {
+            self.step_lo.fill(f64::NEG_INFINITY);
+            self.step_hi.fill(f64::INFINITY);
+            self.solve_active_set();
+            self.finish_report();
+            return Ok(Solution {
+                velocity: &self.velocity,
+                report: &self.report,
+            });
+        }
         self.inverse_weight.fill(1.0);
         self.clamped.fill(false);
         self.fixed_velocity.fill(0.0);
         self.report.clamped.clear();
         self.report.clamping_iterations = 1;
         self.scales.fill(1.0);
+        self.inequality_state.fill(None);
         self.pass();
         self.finish_report();
         Ok(Solution {
@@ -465,59 +592,80 @@ impl Solver {
         self.free.extend((0..n).filter(|&i| !self.clamped[i]));
         let mut dim = self.free.len();
         for j in 0..self.stack.level_count() {
-            self.project_level_rows(j, dim);
-            let rank = self.factor_and_solve_level(j, dim);
-            self.factors[j] = LevelFactor { dim, rank };
+            let rows = self.project_level_rows(j, dim);
+            let rank = self.factor_and_solve_level(j, dim, rows);
+            self.factors[j] = LevelFactor { dim, rank, rows };
             dim -= rank;
         }
         self.assemble_velocity();
     }
 
-    /// Writes `A_jᵀ = Z_{j−1}ᵀ J_jᵀ` into level j's QR buffer and the right-hand side
-    /// `b_j = ẋ_j − J_j q̇_{j−1}` into `rhs`.
-    fn project_level_rows(&mut self, j: usize, dim: usize) {
+    /// Lists the rows level `j` uses in this pass (its equality rows, then its active inequality
+    /// rows), writes `A_jᵀ = Z_{j−1}ᵀ J_jᵀ` into level j's QR buffer and the right-hand side
+    /// `b_j = ẋ_j − J_j q̇_{j−1}` into `rhs`. Returns the number of rows.
+    fn project_level_rows(&mut self, j: usize, dim: usize) -> usize {
         let n = self.stack.dof();
-        let start = self.stack.level_start(j);
-        let rows = self.stack.level_start(j + 1) - start;
-        let (head, tail) = self.qr.split_at_mut(n * start);
+        let seg = self.seg_start[j];
+        let rows = self.list_used_rows(j);
+        let (head, tail) = self.qr.split_at_mut(n * seg);
         self.row_scale = 0.0;
         for t in 0..rows {
-            let row = self.stack.row(start + t);
+            let (row, target) = used_row(&self.stack, self.used[seg + t], self.scales[j]);
             self.row_scale = self.row_scale.max(norm(row));
-            let mut b = self.scales[j] * self.stack.stacked_target()[start + t]
-                - dot(row, &self.fixed_velocity);
+            let mut b = target - dot(row, &self.fixed_velocity);
             for (c, &i) in self.coords.iter_mut().zip(&self.free) {
                 *c = row[i];
             }
-            let mut offset = 0;
+            let offset = apply_chain(
+                head,
+                n,
+                &self.tau,
+                &self.factors[..j],
+                &self.seg_start,
+                &mut self.coords,
+            );
+            let mut level_offset = 0;
             for (i, f) in self.factors[..j].iter().enumerate() {
-                let level_start = self.stack.level_start(i);
-                let factor = &head[n * level_start..];
-                let cur = &mut self.coords[offset..offset + f.dim];
-                for l in 0..f.rank {
-                    apply_reflector(
-                        &factor[l * f.dim + l..(l + 1) * f.dim],
-                        self.tau[level_start + l],
-                        &mut cur[l..],
-                    );
-                }
+                let level_seg = self.seg_start[i];
                 b -= dot(
-                    &cur[..f.rank],
-                    &self.coeff[level_start..level_start + f.rank],
+                    &self.coords[level_offset..level_offset + f.rank],
+                    &self.coeff[level_seg..level_seg + f.rank],
                 );
-                offset += f.rank;
+                level_offset += f.rank;
             }
             tail[t * dim..(t + 1) * dim].copy_from_slice(&self.coords[offset..offset + dim]);
-            self.rhs[start + t] = b;
+            self.rhs[seg + t] = b;
         }
+        rows
     }
 
-    /// Factorizes level j's projected rows and stores its least-squares coefficients `w_j`.
-    /// Returns the rank used.
-    fn factor_and_solve_level(&mut self, j: usize, dim: usize) -> usize {
+    /// Fills `used[seg_start[j]..]` with level j's equality rows, then its active inequality rows.
+    fn list_used_rows(&mut self, j: usize) -> usize {
+        let seg = self.seg_start[j];
+        let (eq_start, eq_end) = (self.stack.level_start(j), self.stack.level_start(j + 1));
+        let (in_start, in_end) = (
+            self.stack.inequality_start(j),
+            self.stack.inequality_start(j + 1),
+        );
+        let mut t = seg;
+        for r in eq_start..eq_end {
+            self.used[t] = UsedRow::Equality(r);
+            t += 1;
+        }
+        for r in in_start..in_end {
+            if let Some(side) = self.inequality_state[r] {
+                self.used[t] = UsedRow::Inequality(r, side);
+                t += 1;
+            }
+        }
+        t - seg
+    }
+
+    /// Factorizes level j's `rows` projected rows and stores its least-squares coefficients
+    /// `w_j`. Returns the rank used.
+    fn factor_and_solve_level(&mut self, j: usize, dim: usize, rows: usize) -> usize {
         let n = self.stack.dof();
-        let start = self.stack.level_start(j);
-        let rows = self.stack.level_start(j + 1) - start;
+        let start = self.seg_start[j];
         let a = &mut self.qr[n * start..n * start + dim * rows];
         let tau = &mut self.tau[start..start + rows];
         let perm = &mut self.perm[start..start + rows];
@@ -580,25 +728,18 @@ impl Solver {
         for (c, &i) in self.coords.iter_mut().zip(&self.free) {
             *c = self.scales[levels] * gradient[i];
         }
-        let mut offset = 0;
-        for j in 0..levels {
-            let f = self.factors[j];
-            let start = self.stack.level_start(j);
-            let factor = &self.qr[n * start..];
-            let cur = &mut self.coords[offset..offset + f.dim];
-            for l in 0..f.rank {
-                apply_reflector(
-                    &factor[l * f.dim + l..(l + 1) * f.dim],
-                    self.tau[start + l],
-                    &mut cur[l..],
-                );
-            }
-            offset += f.rank;
-        }
+        let mut offset = apply_chain(
+            &self.qr,
+            n,
+            &self.tau,
+            &self.factors,
+            &self.seg_start,
+            &mut self.coords,
+        );
         // Fold back: at level j the vector is [w_j; (deeper part)] in r_{j−1} coordinates.
         for j in (0..levels).rev() {
             let f = self.factors[j];
-            let start = self.stack.level_start(j);
+            let start = self.seg_start[j];
             offset -= f.rank;
             let factor = &self.qr[n * start..];
             let cur = &mut self.coords[offset..offset + f.dim];
@@ -617,10 +758,18 @@ impl Solver {
         }
     }
 
-    /// Residuals and feasibility of every level for the final velocity.
+    /// Whether joint intervals and inequality rows are handled by the active-set method.
+    fn uses_active_set(&self) -> bool {
+        self.settings.limits_by_active_set || self.stack.total_inequality_rows() > 0
+    }
+
+    /// Residuals, violations and feasibility of every level for the final velocity, and the
+    /// active inequality rows.
     fn finish_report(&mut self) {
         self.report.gradient_scale = self.scales[self.scales.len() - 1];
+        self.report.active.clear();
         for j in 0..self.stack.level_count() {
+            let (violation, bound_scale) = self.level_violation(j);
             let start = self.stack.level_start(j);
             let end = self.stack.level_start(j + 1);
             let targets = &self.stack.stacked_target()[start..end];
@@ -631,10 +780,42 @@ impl Solver {
             }
             let residual = norm(r);
             let level = &mut self.report.levels[j];
-            level.residual = residual;
-            level.feasible =
-                residual <= self.settings.feasibility_tolerance * (1.0 + norm(targets));
+            level.residual = norm(&[residual, violation]);
+            level.violation = violation;
+            level.feasible = level.residual
+                <= self.settings.feasibility_tolerance * (1.0 + norm(targets) + bound_scale);
             level.scale = self.scales[j];
         }
+    }
+
+    /// `‖v_j‖` of level j's inequality rows for the final velocity, and the norm of the bounds
+    /// they violate (for the relative tolerance); lists the level's active rows in the report.
+    fn level_violation(&mut self, j: usize) -> (f64, f64) {
+        let (first, last) = (
+            self.stack.inequality_start(j),
+            self.stack.inequality_start(j + 1),
+        );
+        let (mut violation, mut bounds) = (0.0_f64, 0.0_f64);
+        for r in first..last {
+            let value = dot(self.stack.inequality_row(r), &self.velocity);
+            let (lower, upper) = self.stack.inequality_bounds(r);
+            let (v, b) = if value > upper {
+                (value - upper, upper)
+            } else if value < lower {
+                (lower - value, lower)
+            } else {
+                (0.0, 0.0)
+            };
+            violation = norm(&[violation, v]);
+            bounds = norm(&[bounds, b]);
+            if let Some(bound) = self.inequality_state[r] {
+                self.report.active.push(ActiveInequality {
+                    level: j,
+                    row: r - first,
+                    bound,
+                });
+            }
+        }
+        (violation, bounds)
     }
 }

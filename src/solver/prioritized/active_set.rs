@@ -1,0 +1,404 @@
+//! Inequality rows at any level, and joint intervals above every level, by a primal active-set
+//! method on the prioritized null-space solve (Kanoun, Lamiraux & Wieber 2011; Escande, Mansard &
+//! Wieber 2014).
+//!
+//! # Problem
+//!
+//! Level `j` has equality rows `J_j q̇ = ẋ_j` and inequality rows `l_j ≤ C_j q̇ ≤ u_j`; above every
+//! level, each joint's interval for this step `lo ≤ q̇ ≤ hi` (position limits over `Δt` and
+//! velocity limits, see [`JointBounds`](crate::solver::JointBounds)); below every level, the
+//! gradient term `q̇ = g` (`g = 0` without an optimization task: the minimum-norm solution). The
+//! solve is lexicographic: the joint intervals hold; level 1 minimizes
+//! `‖J_1 q̇ − ẋ_1‖² + ‖v_1(q̇)‖²`, with `v_j = max(0, C_j q̇ − u_j, l_j − C_j q̇)` the violations,
+//! among the joint-feasible `q̇`; level 2 does the same among the minimizers of level 1; and so on;
+//! last, `‖q̇ − g‖²` picks the one minimizer. A level's inequalities are thus met whenever the
+//! levels above leave room, and otherwise violated by the least-squares amount, without costing a
+//! higher level anything. Inequality rows of a level that gave way stay bounds for the levels
+//! below at the violated value.
+//!
+//! # Method
+//!
+//! An **active set** holds the inequality rows and joints currently held at a bound. With it fixed,
+//! the problem is an equality hierarchy — each active row an equality row of its own level at its
+//! bound, each active joint clamped — solved exactly by the null-space recursion of
+//! [`prioritized`](super). The iterate `x` starts at `0` with the joints outside their interval
+//! clamped to it and the rows it violates active; from then on every inactive row and free joint
+//! holds at `x`. Each step:
+//!
+//! 1. `x* =` the hierarchy's solution for the active set.
+//! 2. If moving from `x` to `x*` would take an inactive row or a free joint past a bound, move to
+//!    the first such bound and activate it (primal feasibility is kept).
+//! 3. Otherwise `x = x*`, and the **lexicographic multipliers** decide whether an active bound may
+//!    go. For level `j` (and last the gradient level), `−∇_j = −J_jᵀ (J_j x − ẋ_j)` (active rows
+//!    included) is written as `Σ_{p<j} J_pᵀ ν_p + Σ_clamped ν_i e_i` by back-substitution through
+//!    the factorization: `U_pᵀ r = R_p Π_pᵀ ν_p` for the range basis `U_p` of level `p`, deepest
+//!    level first, subtracting `J_pᵀ ν_p` as it goes; what remains on a clamped joint is its
+//!    multiplier. A row held at its upper bound is wanted there at level `j` if `ν > 0`, at its
+//!    lower bound if `ν < 0` (a clamped joint likewise). A row's own level speaks first: its
+//!    residual `C q̇ − u` is its multiplier there. Levels are read top-down; the first level that
+//!    has a bound it does not want, among bounds no higher level decided on, releases the most
+//!    unwanted one.
+//!
+//! The objective decreases lexicographically at every step, so no active set comes back and the
+//! method ends; an iteration cap (`4 (n + p) + 8` prioritized solves, `p` the inequality rows)
+//! guards against rounding-induced cycles, and the report says whether it was reached. The
+//! iterate keeps every joint interval at every step, so even a capped solve never violates a
+//! limit.
+
+use super::super::householder::{dot, norm, solve_upper};
+use super::{Bound, Solver, UsedRow, apply_chain, used_row};
+
+/// A multiplier is taken as zero below this fraction of its level's gradient norm (plus one).
+const MULTIPLIER_TOLERANCE: f64 = 1e-9;
+
+/// Scratch of the active-set method, sized at construction.
+#[derive(Debug, Clone)]
+pub(crate) struct ActiveSetWorkspace {
+    /// The iterate `x` (n).
+    point: Vec<f64>,
+    /// `x* − x` (n).
+    direction: Vec<f64>,
+    /// `−∇_j` minus the rows' parts found so far (n).
+    residual: Vec<f64>,
+    /// `ν` per used row, at the level's buffer offset.
+    multipliers: Vec<f64>,
+    /// Back-substitution scratch (largest level).
+    mu: Vec<f64>,
+    /// Bounds whose fate a higher level already decided.
+    decided_rows: Vec<bool>,
+    decided_joints: Vec<bool>,
+}
+
+impl ActiveSetWorkspace {
+    pub(crate) fn new(dof: usize, capacity: usize, inequalities: usize, level_max: usize) -> Self {
+        Self {
+            point: vec![0.0; dof],
+            direction: vec![0.0; dof],
+            residual: vec![0.0; dof],
+            multipliers: vec![0.0; capacity],
+            mu: vec![0.0; level_max],
+            decided_rows: vec![false; inequalities],
+            decided_joints: vec![false; dof],
+        }
+    }
+}
+
+/// A bound that enters or leaves the active set: a joint's interval, or an inequality row.
+#[derive(Debug, Clone, Copy)]
+enum Constraint {
+    Joint(usize, Bound),
+    Row(usize, Bound),
+}
+
+/// The most unwanted bound found so far at one level, and how unwanted (a negative pull).
+type Worst = Option<(f64, Constraint)>;
+
+/// Records a bound's pull (how much a level wants it held: > 0 wanted, < 0 not): a clear answer
+/// decides its fate; an unwanted one is a release candidate.
+fn judge(pull: f64, tolerance: f64, bound: Constraint, decided: &mut bool, worst: &mut Worst) {
+    if pull > tolerance {
+        *decided = true;
+    } else if pull < -tolerance {
+        *decided = true;
+        if worst.is_none_or(|(p, _)| pull < p) {
+            *worst = Some((pull, bound));
+        }
+    }
+}
+
+impl Solver {
+    /// Solves with the joint intervals in `step_lo`/`step_hi` (±∞ for none) and the inequality
+    /// rows by the active-set method; writes `velocity` and the report's joint and iteration
+    /// entries.
+    pub(super) fn solve_active_set(&mut self) {
+        let n = self.stack.dof();
+        let rows = self.stack.total_inequality_rows();
+        self.scales.fill(1.0);
+        self.start_active_set();
+        let cap = 4 * (n + rows) + 8;
+        let (mut iterations, mut converged) = (0, false);
+        while iterations < cap {
+            iterations += 1;
+            self.prioritized_pass();
+            let ws = &mut self.active_set;
+            for i in 0..n {
+                ws.direction[i] = self.velocity[i] - ws.point[i];
+            }
+            if let Some((tau, blocking)) = self.first_blocking() {
+                let ws = &mut self.active_set;
+                for i in 0..n {
+                    ws.point[i] += tau * ws.direction[i];
+                }
+                self.activate(blocking);
+                continue;
+            }
+            self.active_set.point.copy_from_slice(&self.velocity);
+            match self.release_candidate() {
+                Some(bound) => self.release(bound),
+                None => {
+                    converged = true;
+                    break;
+                }
+            }
+        }
+        self.velocity.copy_from_slice(&self.active_set.point);
+        self.report.clamped.clear();
+        self.report
+            .clamped
+            .extend((0..n).filter(|&i| self.clamped[i]));
+        self.report.clamping_iterations = 0;
+        self.report.active_set_iterations = iterations;
+        self.report.converged = converged;
+    }
+
+    /// `x = 0`, with the joints whose interval excludes 0 clamped to it and the rows `x` violates
+    /// active.
+    fn start_active_set(&mut self) {
+        self.clamped.fill(false);
+        self.fixed_velocity.fill(0.0);
+        self.inequality_state.fill(None);
+        let ws = &mut self.active_set;
+        ws.point.fill(0.0);
+        for i in 0..self.stack.dof() {
+            let (lo, hi) = (self.step_lo[i], self.step_hi[i]);
+            let v = if lo > 0.0 {
+                lo
+            } else if hi < 0.0 {
+                hi
+            } else {
+                continue;
+            };
+            self.clamped[i] = true;
+            self.fixed_velocity[i] = v;
+            ws.point[i] = v;
+        }
+        for r in 0..self.stack.total_inequality_rows() {
+            let value = dot(self.stack.inequality_row(r), &ws.point);
+            let (lower, upper) = self.stack.inequality_bounds(r);
+            self.inequality_state[r] = if value > upper {
+                Some(Bound::Upper)
+            } else if value < lower {
+                Some(Bound::Lower)
+            } else {
+                None
+            };
+        }
+    }
+
+    /// The first bound the step `x → x + direction` crosses, with the step fraction `τ < 1` that
+    /// reaches it. Joint intervals are exact; a row crosses only if the full step would violate it
+    /// by more than the feasibility tolerance. A row released from one bound while its level's
+    /// least-squares fit had taken it past the other is violated at `x` already: it blocks at
+    /// `τ = 0`, which moves it to the other bound.
+    fn first_blocking(&self) -> Option<(f64, Constraint)> {
+        let ws = &self.active_set;
+        let mut best: Option<(f64, Constraint)> = None;
+        let mut consider = |tau: f64, c: Constraint| {
+            let tau = tau.max(0.0);
+            if tau < best.map_or(1.0, |(t, _)| t) {
+                best = Some((tau, c));
+            }
+        };
+        for &i in &self.free {
+            let (x, d) = (ws.point[i], ws.direction[i]);
+            if x + d > self.step_hi[i] {
+                consider(
+                    (self.step_hi[i] - x) / d,
+                    Constraint::Joint(i, Bound::Upper),
+                );
+            } else if x + d < self.step_lo[i] {
+                consider(
+                    (self.step_lo[i] - x) / d,
+                    Constraint::Joint(i, Bound::Lower),
+                );
+            }
+        }
+        let tolerance = self.settings.feasibility_tolerance;
+        for r in 0..self.stack.total_inequality_rows() {
+            if self.inequality_state[r].is_some() {
+                continue;
+            }
+            let row = self.stack.inequality_row(r);
+            let (value, change) = (dot(row, &ws.point), dot(row, &ws.direction));
+            let (lower, upper) = self.stack.inequality_bounds(r);
+            if value > upper + tolerance * (1.0 + upper.abs()) {
+                consider(0.0, Constraint::Row(r, Bound::Upper));
+            } else if value < lower - tolerance * (1.0 + lower.abs()) {
+                consider(0.0, Constraint::Row(r, Bound::Lower));
+            } else if value + change > upper + tolerance * (1.0 + upper.abs()) {
+                consider((upper - value) / change, Constraint::Row(r, Bound::Upper));
+            } else if value + change < lower - tolerance * (1.0 + lower.abs()) {
+                consider((lower - value) / change, Constraint::Row(r, Bound::Lower));
+            }
+        }
+        best
+    }
+
+    fn activate(&mut self, c: Constraint) {
+        match c {
+            Constraint::Joint(i, bound) => {
+                self.clamped[i] = true;
+                self.fixed_velocity[i] = match bound {
+                    Bound::Lower => self.step_lo[i],
+                    Bound::Upper => self.step_hi[i],
+                };
+            }
+            Constraint::Row(r, bound) => self.inequality_state[r] = Some(bound),
+        }
+    }
+
+    fn release(&mut self, c: Constraint) {
+        match c {
+            Constraint::Joint(i, _) => {
+                self.clamped[i] = false;
+                self.fixed_velocity[i] = 0.0;
+            }
+            Constraint::Row(r, _) => self.inequality_state[r] = None,
+        }
+    }
+
+    /// The bound to release at `x = x*`, if any (step 3 of the method in the module docs).
+    fn release_candidate(&mut self) -> Option<Constraint> {
+        let levels = self.stack.level_count();
+        self.active_set.decided_rows.fill(false);
+        self.active_set.decided_joints.fill(false);
+        for j in 0..=levels {
+            let mut worst: Worst = None;
+            if j < levels {
+                self.judge_own_rows(j, &mut worst);
+            }
+            self.load_negative_gradient(j);
+            let tolerance = MULTIPLIER_TOLERANCE * (1.0 + norm(&self.active_set.residual));
+            for p in (0..j).rev() {
+                self.back_substitute(p);
+            }
+            self.judge_multipliers(j, tolerance, &mut worst);
+            if let Some((_, c)) = worst {
+                return Some(c);
+            }
+        }
+        None
+    }
+
+    /// Level j's active rows at their own level: the residual beyond the bound is the multiplier
+    /// of the row's slack.
+    fn judge_own_rows(&mut self, j: usize, worst: &mut Worst) {
+        let seg = self.seg_start[j];
+        let tolerance = self.settings.feasibility_tolerance;
+        for t in 0..self.factors[j].rows {
+            let UsedRow::Inequality(r, bound) = self.used[seg + t] else {
+                continue;
+            };
+            let (row, value) = used_row(&self.stack, self.used[seg + t], 1.0);
+            let reached = dot(row, &self.active_set.point);
+            let pull = match bound {
+                Bound::Upper => reached - value,
+                Bound::Lower => value - reached,
+            };
+            let decided = &mut self.active_set.decided_rows[r];
+            judge(
+                pull,
+                tolerance * (1.0 + value.abs()),
+                Constraint::Row(r, bound),
+                decided,
+                worst,
+            );
+        }
+    }
+
+    /// `−∇_j` at `x` into `residual`: level j's used rows, or for `j = levels` the gradient level
+    /// `g − x`.
+    fn load_negative_gradient(&mut self, j: usize) {
+        let levels = self.stack.level_count();
+        let ws = &mut self.active_set;
+        if j == levels {
+            let g = self.stack.gradient();
+            for i in 0..ws.point.len() {
+                ws.residual[i] = self.scales[levels] * g[i] - ws.point[i];
+            }
+            return;
+        }
+        ws.residual.fill(0.0);
+        let seg = self.seg_start[j];
+        for t in 0..self.factors[j].rows {
+            let (row, target) = used_row(&self.stack, self.used[seg + t], self.scales[j]);
+            let error = dot(row, &ws.point) - target;
+            for (r, a) in ws.residual.iter_mut().zip(row) {
+                *r -= error * a;
+            }
+        }
+    }
+
+    /// Finds level p's multipliers `ν_p` from `U_pᵀ r = R_p Π_pᵀ ν_p` (rows beyond the rank get
+    /// 0) and subtracts `J_pᵀ ν_p` from `r`.
+    fn back_substitute(&mut self, p: usize) {
+        let n = self.stack.dof();
+        let f = self.factors[p];
+        let seg = self.seg_start[p];
+        let ws = &mut self.active_set;
+        for (c, &i) in self.coords.iter_mut().zip(&self.free) {
+            *c = ws.residual[i];
+        }
+        let end = apply_chain(
+            &self.qr,
+            n,
+            &self.tau,
+            &self.factors[..=p],
+            &self.seg_start,
+            &mut self.coords,
+        );
+        let mu = &mut ws.mu[..f.rank];
+        mu.copy_from_slice(&self.coords[end - f.rank..end]);
+        solve_upper(&self.qr[n * seg..], f.dim, f.rank, mu);
+        let nu = &mut ws.multipliers[seg..seg + f.rows];
+        nu.fill(0.0);
+        for (c, &m) in mu.iter().enumerate() {
+            nu[self.perm[seg + c]] = m;
+        }
+        for t in 0..f.rows {
+            let weight = ws.multipliers[seg + t];
+            if weight != 0.0 {
+                let (row, _) = used_row(&self.stack, self.used[seg + t], 1.0);
+                for (r, a) in ws.residual.iter_mut().zip(row) {
+                    *r -= weight * a;
+                }
+            }
+        }
+    }
+
+    /// Judges, at level j, the active rows of the levels above and the clamped joints by their
+    /// multipliers.
+    fn judge_multipliers(&mut self, j: usize, tolerance: f64, worst: &mut Worst) {
+        let ws = &mut self.active_set;
+        for p in 0..j {
+            let seg = self.seg_start[p];
+            for t in 0..self.factors[p].rows {
+                let UsedRow::Inequality(r, bound) = self.used[seg + t] else {
+                    continue;
+                };
+                if ws.decided_rows[r] {
+                    continue;
+                }
+                let nu = ws.multipliers[seg + t];
+                let pull = if bound == Bound::Upper { nu } else { -nu };
+                let c = Constraint::Row(r, bound);
+                judge(pull, tolerance, c, &mut ws.decided_rows[r], worst);
+            }
+        }
+        for i in 0..self.stack.dof() {
+            // A zero-width interval pins the joint whatever the levels want.
+            if !self.clamped[i] || ws.decided_joints[i] || self.step_lo[i] >= self.step_hi[i] {
+                continue;
+            }
+            let nu = ws.residual[i];
+            let bound = if self.fixed_velocity[i] == self.step_hi[i] {
+                Bound::Upper
+            } else {
+                Bound::Lower
+            };
+            let pull = if bound == Bound::Upper { nu } else { -nu };
+            let c = Constraint::Joint(i, bound);
+            judge(pull, tolerance, c, &mut ws.decided_joints[i], worst);
+        }
+    }
+}

@@ -1,0 +1,432 @@
+//! The hierarchy with inequality rows against an independent reference: the lexicographic QP
+//! solved level by level with a dense interior-point solver (clarabel), on small random problems.
+//!
+//! Reference (Kanoun, Lamiraux & Wieber 2011): level k minimizes `½‖w_E‖² + ½‖w_I‖²` over
+//! `(q̇, w)` subject to `J_k q̇ − w_E = ẋ_k`, `l_k ≤ C_k q̇ − w_I ≤ u_k`, the joint interval, and
+//! every higher level's optimal set (see [`reference`]). Last, `½‖q̇ − g‖²` under all of them
+//! picks the unique answer.
+
+use clarabel::algebra::CscMatrix;
+use clarabel::solver::{
+    DefaultSettingsBuilder, DefaultSolver, IPSolver, NonnegativeConeT, SolverStatus, ZeroConeT,
+};
+use proptest::prelude::*;
+use taskstack::solver::{Bound, JointBounds, Settings, Solver, StackShape};
+
+/// One level of a random problem: equality rows `(row, target)` and inequality rows
+/// `(row, lower, upper)`.
+#[derive(Debug, Clone, Default)]
+struct Level {
+    equalities: Vec<(Vec<f64>, f64)>,
+    inequalities: Vec<(Vec<f64>, f64, f64)>,
+}
+
+#[derive(Debug, Clone)]
+struct Problem {
+    n: usize,
+    levels: Vec<Level>,
+    /// Joint interval of the step (q = 0, Δt = 1): `lo ≤ q̇ ≤ hi`.
+    lo: Vec<f64>,
+    hi: Vec<f64>,
+    gradient: Vec<f64>,
+}
+
+/// SplitMix64: the problems come from a seed, so a failing case is reproducible.
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * (self.next() >> 11) as f64 / (1u64 << 53) as f64
+    }
+    fn below(&mut self, k: usize) -> usize {
+        (self.next() % k as u64) as usize
+    }
+    fn chance(&mut self, p: f64) -> bool {
+        self.uniform(0.0, 1.0) < p
+    }
+}
+
+fn random_problem(seed: u64, bounded_joints: bool) -> Problem {
+    let mut rng = Rng(seed);
+    let n = 3 + rng.below(5);
+    let level_count = 1 + rng.below(3);
+    let row = |rng: &mut Rng| (0..n).map(|_| rng.uniform(-1.0, 1.0)).collect::<Vec<_>>();
+    let levels = (0..level_count)
+        .map(|_| {
+            let mut level = Level::default();
+            let (m, p) = loop {
+                let (m, p) = (rng.below(3), rng.below(4));
+                if m + p > 0 {
+                    break (m, p);
+                }
+            };
+            for _ in 0..m {
+                let r = row(&mut rng);
+                level.equalities.push((r, rng.uniform(-1.0, 1.0)));
+            }
+            for _ in 0..p {
+                let r = row(&mut rng);
+                let centre = rng.uniform(-1.0, 1.0);
+                let lower = if rng.chance(0.3) {
+                    f64::NEG_INFINITY
+                } else {
+                    centre - rng.uniform(0.0, 0.8)
+                };
+                let upper = if rng.chance(0.3) {
+                    f64::INFINITY
+                } else {
+                    centre + rng.uniform(0.0, 0.8)
+                };
+                level.inequalities.push((r, lower, upper));
+            }
+            level
+        })
+        .collect();
+    let (mut lo, mut hi) = (vec![f64::NEG_INFINITY; n], vec![f64::INFINITY; n]);
+    if bounded_joints {
+        for i in 0..n {
+            if rng.chance(0.7) {
+                lo[i] = -rng.uniform(0.05, 1.0);
+                hi[i] = rng.uniform(0.05, 1.0);
+            }
+        }
+    }
+    let gradient = if rng.chance(0.5) {
+        row(&mut rng)
+    } else {
+        vec![0.0; n]
+    };
+    Problem {
+        n,
+        levels,
+        lo,
+        hi,
+        gradient,
+    }
+}
+
+fn shape(problem: &Problem, levels: usize) -> StackShape {
+    let names: Vec<String> = (0..levels).map(|j| format!("level {j}")).collect();
+    let mut shape = StackShape::new(problem.n);
+    for (j, level) in problem.levels[..levels].iter().enumerate() {
+        let eq: Vec<(&str, usize)> = if level.equalities.is_empty() {
+            vec![]
+        } else {
+            vec![(names[j].as_str(), level.equalities.len())]
+        };
+        let ineq_name = format!("{} inequalities", names[j]);
+        let ineq: Vec<(&str, usize)> = if level.inequalities.is_empty() {
+            vec![]
+        } else {
+            vec![(ineq_name.as_str(), level.inequalities.len())]
+        };
+        shape = shape.with_mixed_level(&names[j], &eq, &ineq);
+    }
+    shape
+}
+
+/// Solves the first `levels` levels of `problem` with our solver (no damping: the reference is
+/// the exact lexicographic optimum).
+fn solve(problem: &Problem, levels: usize) -> (Vec<f64>, Solver) {
+    let settings = Settings {
+        damping_threshold: 0.0,
+        limits_by_active_set: true,
+        ..Settings::default()
+    };
+    let mut solver = Solver::with_settings(&shape(problem, levels), settings).unwrap();
+    for (j, level) in problem.levels[..levels].iter().enumerate() {
+        let mut l = solver.stack_mut().level_mut(j);
+        for (t, (row, target)) in level.equalities.iter().enumerate() {
+            l.set_row(t, row, *target).unwrap();
+        }
+        for (t, (row, lower, upper)) in level.inequalities.iter().enumerate() {
+            l.set_inequality_row(t, row, *lower, *upper).unwrap();
+        }
+    }
+    solver
+        .stack_mut()
+        .gradient_mut()
+        .copy_from_slice(&problem.gradient);
+    let bounds = JointBounds::new(&problem.lo, &problem.hi).unwrap();
+    let velocity = solver
+        .solve(&vec![0.0; problem.n], &bounds, 1.0)
+        .unwrap()
+        .velocity
+        .to_vec();
+    (velocity, solver)
+}
+
+/// Level `j`'s cost `½‖J q̇ − ẋ‖² + ½‖v(q̇)‖²`.
+fn level_cost(level: &Level, v: &[f64]) -> f64 {
+    let dot = |a: &[f64]| a.iter().zip(v).map(|(x, y)| x * y).sum::<f64>();
+    let eq: f64 = level
+        .equalities
+        .iter()
+        .map(|(r, t)| (dot(r) - t).powi(2))
+        .sum();
+    let ineq: f64 = level
+        .inequalities
+        .iter()
+        .map(|(r, l, u)| {
+            let c = dot(r);
+            (c - u).max(l - c).max(0.0).powi(2)
+        })
+        .sum();
+    0.5 * (eq + ineq)
+}
+
+/// Dense rows → CSC (`rows × cols`).
+fn csc(rows: &[Vec<f64>], cols: usize) -> CscMatrix<f64> {
+    let (mut colptr, mut rowval, mut nzval) = (vec![0], vec![], vec![]);
+    for c in 0..cols {
+        for (r, row) in rows.iter().enumerate() {
+            if row[c] != 0.0 {
+                rowval.push(r);
+                nzval.push(row[c]);
+            }
+        }
+        colptr.push(rowval.len());
+    }
+    CscMatrix::new(rows.len(), cols, colptr, rowval, nzval)
+}
+
+/// A row violated by no more than this at the reference's optimum is one it met.
+const MET: f64 = 1e-7;
+
+/// The reference: level by level with clarabel; returns `q̇`.
+///
+/// A higher level's result is kept as constraints on the levels below it: its equality rows, and
+/// the inequality rows it could not meet, at the values `J q̇*` it reached (the fitted values of a
+/// least-squares problem are unique, so these equalities describe its optimal set exactly and are
+/// consistent by construction); the inequality rows it met, as the inequalities themselves.
+fn reference(problem: &Problem) -> Option<Vec<f64>> {
+    let n = problem.n;
+    // Rows `a q̇ = b` and `a q̇ ≤ b` that every later level keeps.
+    let mut fixed: Vec<(Vec<f64>, f64)> = vec![];
+    let mut kept: Vec<(Vec<f64>, f64)> = vec![];
+    for i in 0..n {
+        let mut e = vec![0.0; n];
+        e[i] = 1.0;
+        if problem.hi[i].is_finite() {
+            kept.push((e.clone(), problem.hi[i]));
+        }
+        if problem.lo[i].is_finite() {
+            kept.push((e.iter().map(|v| -v).collect(), -problem.lo[i]));
+        }
+    }
+    let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
+    for level in &problem.levels {
+        let (m, p) = (level.equalities.len(), level.inequalities.len());
+        let vars = n + m + p;
+        let pad = |row: &[f64], slack: Option<(usize, f64)>| {
+            let mut z = row.to_vec();
+            z.resize(vars, 0.0);
+            if let Some((s, sign)) = slack {
+                z[n + s] = sign;
+            }
+            z
+        };
+        let (mut a, mut b) = (vec![], vec![]);
+        for (t, (row, target)) in level.equalities.iter().enumerate() {
+            a.push(pad(row, Some((t, -1.0))));
+            b.push(*target);
+        }
+        for (row, value) in &fixed {
+            a.push(pad(row, None));
+            b.push(*value);
+        }
+        let equalities = a.len();
+        for (row, bound) in &kept {
+            a.push(pad(row, None));
+            b.push(*bound);
+        }
+        for (t, (row, lower, upper)) in level.inequalities.iter().enumerate() {
+            if upper.is_finite() {
+                a.push(pad(row, Some((m + t, -1.0))));
+                b.push(*upper);
+            }
+            if lower.is_finite() {
+                let neg: Vec<f64> = row.iter().map(|v| -v).collect();
+                a.push(pad(&neg, Some((m + t, 1.0))));
+                b.push(-lower);
+            }
+        }
+        let mut hessian = vec![vec![0.0; vars]; vars];
+        for s in n..vars {
+            hessian[s][s] = 1.0;
+        }
+        let z = qp(&hessian, &vec![0.0; vars], &a, &b, equalities)?;
+        let x = &z[..n];
+        for (row, _) in &level.equalities {
+            fixed.push((row.clone(), dot(row, x)));
+        }
+        for (row, lower, upper) in &level.inequalities {
+            let value = dot(row, x);
+            if value > upper + MET || value < lower - MET {
+                fixed.push((row.clone(), dot(row, x)));
+                continue;
+            }
+            if upper.is_finite() {
+                kept.push((row.clone(), *upper));
+            }
+            if lower.is_finite() {
+                kept.push((row.iter().map(|v| -v).collect(), -lower));
+            }
+        }
+    }
+    let identity: Vec<Vec<f64>> = (0..n)
+        .map(|i| (0..n).map(|k| if i == k { 1.0 } else { 0.0 }).collect())
+        .collect();
+    let q: Vec<f64> = problem.gradient.iter().map(|g| -g).collect();
+    let equalities = fixed.len();
+    let (a, b): (Vec<_>, Vec<_>) = fixed.into_iter().chain(kept).unzip();
+    qp(&identity, &q, &a, &b, equalities)
+}
+
+/// `min ½ zᵀ H z + qᵀ z` s.t. the first `equalities` rows of `a z = b`, the rest `a z ≤ b`; `None`
+/// when the interior-point solver does not report a solution (a degenerate optimal set, one case
+/// in a few hundred: the case is then skipped).
+fn qp(
+    hessian: &[Vec<f64>],
+    q: &[f64],
+    a: &[Vec<f64>],
+    b: &[f64],
+    equalities: usize,
+) -> Option<Vec<f64>> {
+    let vars = q.len();
+    let upper: Vec<Vec<f64>> = hessian
+        .iter()
+        .enumerate()
+        .map(|(i, row)| {
+            row.iter()
+                .enumerate()
+                .map(|(k, &v)| if k >= i { v } else { 0.0 })
+                .collect()
+        })
+        .collect();
+    let cones = [
+        ZeroConeT(equalities),
+        NonnegativeConeT(a.len() - equalities),
+    ];
+    let settings = DefaultSettingsBuilder::default()
+        .verbose(false)
+        .tol_gap_abs(1e-10)
+        .tol_gap_rel(1e-10)
+        .tol_feas(1e-10)
+        .max_iter(500)
+        .build()
+        .unwrap();
+    let mut solver =
+        DefaultSolver::new(&csc(&upper, vars), q, &csc(a, vars), b, &cones, settings).unwrap();
+    solver.solve();
+    matches!(solver.solution.status, SolverStatus::Solved).then(|| solver.solution.x.clone())
+}
+
+fn norm(v: &[f64]) -> f64 {
+    v.iter().map(|x| x * x).sum::<f64>().sqrt()
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(500))]
+
+    /// The result equals the reference lexicographic QP.
+    #[test]
+    fn equals_the_level_by_level_reference_qp(seed in any::<u64>(), bounded in any::<bool>()) {
+        let problem = random_problem(seed, bounded);
+        let (ours, solver) = solve(&problem, problem.levels.len());
+        prop_assert!(solver.report().converged());
+        let expected = reference(&problem);
+        prop_assume!(expected.is_some(), "the reference QP found no solution");
+        let expected = expected.unwrap();
+        let error = norm(&ours.iter().zip(&expected).map(|(a, b)| a - b).collect::<Vec<_>>());
+        prop_assert!(
+            error <= 1e-5 * (1.0 + norm(&expected)),
+            "ours {ours:?}\nreference {expected:?}\n{problem:?}\n{:?}", solver.report()
+        );
+    }
+
+    /// Adding lower levels costs no higher level anything, equality or inequality; every joint
+    /// stays in its interval.
+    #[test]
+    fn lower_levels_never_disturb_higher_ones(seed in any::<u64>()) {
+        let problem = random_problem(seed, true);
+        let (full, _) = solve(&problem, problem.levels.len());
+        for (i, v) in full.iter().enumerate() {
+            prop_assert!(problem.lo[i] <= *v && *v <= problem.hi[i], "joint {i}: {v}");
+        }
+        for k in 1..problem.levels.len() {
+            let (truncated, _) = solve(&problem, k);
+            for level in &problem.levels[..k] {
+                let (with, without) = (level_cost(level, &full), level_cost(level, &truncated));
+                prop_assert!(
+                    (with - without).abs() <= 1e-8 * (1.0 + without),
+                    "levels below {k} changed a higher level's cost from {without} to {with}"
+                );
+            }
+        }
+    }
+
+    /// A top level that the joint intervals allow (inequalities whose box contains 0) is met
+    /// exactly, and the report lists its active rows, each held at its bound.
+    #[test]
+    fn a_feasible_top_level_is_met_and_active_rows_hold_their_bound(seed in any::<u64>()) {
+        let mut problem = random_problem(seed, true);
+        let top = &mut problem.levels[0];
+        top.equalities.clear();
+        for (_, lower, upper) in &mut top.inequalities {
+            *lower = lower.min(-0.01);
+            *upper = upper.max(0.01);
+        }
+        if top.inequalities.is_empty() {
+            top.inequalities.push((vec![1.0; problem.n], -0.01, 0.01));
+        }
+        let (v, solver) = solve(&problem, problem.levels.len());
+        let report = solver.report();
+        prop_assert!(report.levels()[0].feasible, "{report:?}");
+        prop_assert!(level_cost(&problem.levels[0], &v) <= 1e-16);
+        for active in report.active_inequalities() {
+            if !report.levels()[active.level].feasible {
+                continue;
+            }
+            let (row, lower, upper) = &problem.levels[active.level].inequalities[active.row];
+            let value: f64 = row.iter().zip(&v).map(|(a, b)| a * b).sum();
+            let bound = if active.bound == Bound::Upper { upper } else { lower };
+            prop_assert!((value - bound).abs() <= 1e-8 * (1.0 + bound.abs()), "{value} vs {bound}");
+        }
+    }
+}
+
+/// A hand-made case: one joint pair, `q̇0 + q̇1 ≤ 1` at the top, `q̇0 = 2, q̇1 = 2` below. The
+/// answer by hand: the lower level is met as well as the bound allows, `(0.5, 0.5)`, and the
+/// bound is active.
+#[test]
+fn a_bound_above_a_conflicting_level_by_hand() {
+    let shape = StackShape::new(2)
+        .with_inequality_level("limit", &[("sum", 1)])
+        .with_level("target", &[("both", 2)]);
+    let mut solver = Solver::new(&shape).unwrap();
+    solver
+        .stack_mut()
+        .level_mut(0)
+        .set_inequality_row(0, &[1.0, 1.0], f64::NEG_INFINITY, 1.0)
+        .unwrap();
+    let mut target = solver.stack_mut().level_mut(1);
+    target.set_row(0, &[1.0, 0.0], 2.0).unwrap();
+    target.set_row(1, &[0.0, 1.0], 2.0).unwrap();
+    let solution = solver.solve_unbounded().unwrap();
+    assert!(
+        (solution.velocity[0] - 0.5).abs() < 1e-12 && (solution.velocity[1] - 0.5).abs() < 1e-12
+    );
+    let report = solution.report;
+    assert_eq!(report.active_inequalities().len(), 1);
+    assert_eq!(report.active_inequalities()[0].bound, Bound::Upper);
+    assert!(report.levels()[0].feasible && !report.levels()[1].feasible);
+    assert_eq!(report.first_infeasible_level(), Some(1));
+}
