@@ -4,7 +4,9 @@
 //! the current `q`, sets `ẋ_j = K e_j` (each task's error first clipped to a largest norm, so that
 //! a far target is approached in steps the linearization can be trusted over), solves the stack (with the clamping loop, so every iterate
 //! is within the joint limits) and integrates `q ← q + q̇ Δt`. With `K Δt = 1` (the default) an
-//! iteration is a Gauss–Newton step. It stops when every task's error norm is within tolerance,
+//! iteration is a Gauss–Newton step. Inequality rows get their position-level room the same way:
+//! `K (l − c(q)) ≤ C q̇ ≤ K (u − c(q))`, a violated side clipped to the largest task error. It
+//! stops when every task's error norm and every inequality row's violation is within tolerance,
 //! when no task error changed by more than the stall tolerance in the last iteration, or at the
 //! iteration cap — and says which.
 
@@ -21,8 +23,10 @@ pub trait TaskModel {
     type Error: From<SolverError>;
 
     /// For configuration `q`, writes every level's Jacobian and, in place of its desired velocity,
-    /// its task **error** `x* − x(q)` (task units) into `stack`; and the gradient term
-    /// `Σ κ_k ∇f_k(q)` (or clears it).
+    /// its task **error** `x* − x(q)` (task units) into `stack`; in place of the bounds of its
+    /// inequality rows, the change of the row's value the step may make, `l − c(q) ≤ C δq ≤
+    /// u − c(q)` (task units; ±∞ for no bound); and the gradient term `Σ κ_k ∇f_k(q)` (or
+    /// clears it).
     fn evaluate(&mut self, q: &[f64], stack: &mut TaskStack) -> Result<(), Self::Error>;
 
     /// Largest error norm task `task` (stack order, from 0) may ask for in one iteration, in
@@ -203,7 +207,9 @@ impl PositionDriver {
             solver.stack().check_finite()?;
             self.measure_errors(solver.stack());
             let errors = &self.report.task_errors;
-            if errors.iter().all(|&e| e <= s.tolerance) {
+            if errors.iter().all(|&e| e <= s.tolerance)
+                && inequality_violation(solver.stack()) <= s.tolerance
+            {
                 break StopReason::Converged;
             }
             if iterations > 0
@@ -219,6 +225,7 @@ impl PositionDriver {
             }
             self.previous.copy_from_slice(errors);
             self.set_velocities(model, solver.stack_mut());
+            self.set_bounds(solver.stack_mut());
             solver.solve(q, &self.step_bounds, s.dt)?;
             for (qi, v) in q.iter_mut().zip(solver.velocity()) {
                 *qi += v * s.dt;
@@ -262,10 +269,35 @@ impl PositionDriver {
         }
     }
 
+    /// `K (l − c(q)) ≤ C q̇ ≤ K (u − c(q))`, a violated side (`l − c > 0` or `u − c < 0`) clipped
+    /// to `max_task_error` first.
+    fn set_bounds(&self, stack: &mut TaskStack) {
+        let (gain, limit) = (self.settings.gain, self.settings.max_task_error);
+        for level in 0..stack.level_count() {
+            let mut l = stack.level_mut(level);
+            let (_, lower, upper) = l.inequalities_mut();
+            for (lo, hi) in lower.iter_mut().zip(upper.iter_mut()) {
+                *lo = gain * lo.min(limit);
+                *hi = gain * hi.max(-limit);
+            }
+        }
+    }
+
     fn measure_errors(&mut self, stack: &TaskStack) {
         let errors = stack.stacked_target();
         for (t, e) in self.report.task_errors.iter_mut().enumerate() {
             *e = norm(&errors[self.task_start[t]..self.task_start[t + 1]]);
         }
     }
+}
+
+/// The largest position-level violation of an inequality row: `max(0, l − c(q), c(q) − u)`, with
+/// the model's bounds written relative to the current value (task units).
+fn inequality_violation(stack: &TaskStack) -> f64 {
+    (0..stack.level_count())
+        .flat_map(|j| {
+            let (lower, upper) = stack.bounds(j);
+            lower.iter().zip(upper).map(|(l, u)| l.max(-u).max(0.0))
+        })
+        .fold(0.0, f64::max)
 }

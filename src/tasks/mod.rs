@@ -1,7 +1,11 @@
 //! Ready-made tasks for the solver, built from a [`Model`] by frame name: a frame's position
 //! ([`PositionTask`]), orientation ([`OrientationTask`]) or both ([`PoseTask`]), the centre of
-//! mass ([`ComTask`]) and a joint posture ([`PostureTask`]); and [`TaskSet`], which stacks them in
-//! priority levels and drives the solver with them ([`TaskModel`](crate::solver::driver::TaskModel)).
+//! mass ([`ComTask`]), a joint posture ([`PostureTask`]) and a contact normal
+//! ([`ContactNormalTask`], Di Fava et al. eq. 11); inequality tasks ([`InequalityTask`]): the
+//! CoM inside a support polygon ([`ComPolygonTask`]), capsule–capsule and capsule–plane
+//! distances above a margin ([`CapsuleDistanceTask`], [`PlaneDistanceTask`]); and [`TaskSet`],
+//! which stacks them in priority levels and drives the solver with them
+//! ([`TaskModel`](crate::solver::driver::TaskModel)).
 //!
 //! Every task writes, for the configuration whose forward kinematics a [`ModelData`] holds, its
 //! Jacobian `J` (rows × nv) and its error `e = x* − x(q)` in task units (metres, radians). The
@@ -32,6 +36,10 @@
 //! ```
 
 mod com;
+mod com_polygon;
+mod contact_normal;
+mod distance;
+mod inequality;
 mod orientation;
 mod pose;
 mod position;
@@ -48,6 +56,10 @@ use crate::model::{Model, ModelData, ModelError};
 use crate::solver::{JointBounds, SolverError};
 
 pub use com::{ComTask, com_rows};
+pub use com_polygon::ComPolygonTask;
+pub use contact_normal::ContactNormalTask;
+pub use distance::{Capsule, CapsuleDistanceTask, PlaneDistanceTask, closest_segment_parameters};
+pub use inequality::InequalityTask;
 pub use orientation::{OrientationTask, orientation_rows};
 pub use pose::PoseTask;
 pub use position::{FramePoint, PositionTask, point_rows};
@@ -78,6 +90,22 @@ pub enum TaskError {
         expected: usize,
         /// Given length.
         got: usize,
+    },
+    /// A support polygon that is not convex and counter-clockwise, or a negative margin.
+    #[error(
+        "task `{task}`: the polygon must be convex, counter-clockwise seen from above, with a margin >= 0"
+    )]
+    InvalidPolygon {
+        /// The task's name.
+        task: String,
+    },
+    /// A geometric parameter out of range (a negative radius or margin, a zero normal).
+    #[error("task `{task}`: {reason}")]
+    InvalidGeometry {
+        /// The task's name.
+        task: String,
+        /// What is wrong.
+        reason: &'static str,
     },
     /// [`TaskSet::task_mut`] found no task of that name and type.
     #[error("no task `{0}` of the requested type")]

@@ -4,7 +4,15 @@ use crate::model::{Model, ModelData};
 use crate::solver::driver::TaskModel;
 use crate::solver::{JointTracking, StackShape, TaskStack};
 
-use super::{Task, TaskError, finite_target};
+use super::{InequalityTask, Task, TaskError, finite_target};
+
+/// One level of a [`TaskSet`]: its name, equality tasks and inequality tasks.
+#[derive(Debug)]
+struct Level {
+    name: String,
+    tasks: Vec<Box<dyn Task>>,
+    inequalities: Vec<Box<dyn InequalityTask>>,
+}
 
 /// Tasks in strict priority levels (first level highest) on one model, plus an optional posture
 /// gradient in the null space of all of them; a [`TaskModel`] for the
@@ -14,7 +22,7 @@ use super::{Task, TaskError, finite_target};
 pub struct TaskSet<'m> {
     model: &'m Model,
     data: ModelData,
-    levels: Vec<(String, Vec<Box<dyn Task>>)>,
+    levels: Vec<Level>,
     posture: Option<(f64, JointTracking)>,
 }
 
@@ -29,9 +37,28 @@ impl<'m> TaskSet<'m> {
         }
     }
 
-    /// Adds a level below the existing ones.
-    pub fn level(mut self, name: &str, tasks: Vec<Box<dyn Task>>) -> Self {
-        self.levels.push((name.to_owned(), tasks));
+    /// Adds a level of equality tasks below the existing ones.
+    pub fn level(self, name: &str, tasks: Vec<Box<dyn Task>>) -> Self {
+        self.mixed_level(name, tasks, Vec::new())
+    }
+
+    /// Adds a level of inequality tasks below the existing ones.
+    pub fn inequality_level(self, name: &str, tasks: Vec<Box<dyn InequalityTask>>) -> Self {
+        self.mixed_level(name, Vec::new(), tasks)
+    }
+
+    /// Adds a level with both kinds of task, solved together at this priority.
+    pub fn mixed_level(
+        mut self,
+        name: &str,
+        tasks: Vec<Box<dyn Task>>,
+        inequalities: Vec<Box<dyn InequalityTask>>,
+    ) -> Self {
+        self.levels.push(Level {
+            name: name.to_owned(),
+            tasks,
+            inequalities,
+        });
         self
     }
 
@@ -60,10 +87,15 @@ impl<'m> TaskSet<'m> {
     pub fn shape(&self) -> StackShape {
         self.levels
             .iter()
-            .fold(StackShape::new(self.model.nv()), |shape, (name, tasks)| {
+            .fold(StackShape::new(self.model.nv()), |shape, level| {
                 let specs: Vec<(&str, usize)> =
-                    tasks.iter().map(|t| (t.name(), t.rows())).collect();
-                shape.with_level(name, &specs)
+                    level.tasks.iter().map(|t| (t.name(), t.rows())).collect();
+                let inequalities: Vec<(&str, usize)> = level
+                    .inequalities
+                    .iter()
+                    .map(|t| (t.name(), t.rows()))
+                    .collect();
+                shape.with_mixed_level(&level.name, &specs, &inequalities)
             })
     }
 
@@ -74,7 +106,20 @@ impl<'m> TaskSet<'m> {
     pub fn task_mut<T: Task>(&mut self, name: &str) -> Result<&mut T, TaskError> {
         self.levels
             .iter_mut()
-            .flat_map(|(_, tasks)| tasks.iter_mut())
+            .flat_map(|level| level.tasks.iter_mut())
+            .filter(|t| t.name() == name)
+            .find_map(|t| t.as_any_mut().downcast_mut::<T>())
+            .ok_or_else(|| TaskError::UnknownTask(name.to_owned()))
+    }
+
+    /// The inequality task named `name` as its concrete type (e.g. to move a support polygon).
+    ///
+    /// # Errors
+    /// [`TaskError::UnknownTask`] when no inequality task has that name and type.
+    pub fn inequality_mut<T: InequalityTask>(&mut self, name: &str) -> Result<&mut T, TaskError> {
+        self.levels
+            .iter_mut()
+            .flat_map(|level| level.inequalities.iter_mut())
             .filter(|t| t.name() == name)
             .find_map(|t| t.as_any_mut().downcast_mut::<T>())
             .ok_or_else(|| TaskError::UnknownTask(name.to_owned()))
@@ -91,21 +136,35 @@ impl TaskModel for TaskSet<'_> {
 
     fn evaluate(&mut self, q: &[f64], stack: &mut TaskStack) -> Result<(), TaskError> {
         self.model.forward_kinematics(&mut self.data, q)?;
-        for (l, (_, tasks)) in self.levels.iter().enumerate() {
+        for (l, spec) in self.levels.iter().enumerate() {
             let mut level = stack.try_level_mut(l)?;
-            let rows: usize = tasks.iter().map(|t| t.rows()).sum();
-            if level.rows() != rows {
+            let rows: usize = spec.tasks.iter().map(|t| t.rows()).sum();
+            let inequality_rows: usize = spec.inequalities.iter().map(|t| t.rows()).sum();
+            if level.rows() != rows || level.inequality_rows() != inequality_rows {
                 return Err(TaskError::WrongLength {
                     task: format!("rows of level {l}"),
-                    expected: rows,
-                    got: level.rows(),
+                    expected: rows + inequality_rows,
+                    got: level.rows() + level.inequality_rows(),
                 });
             }
             let mut row = 0;
-            for task in tasks {
+            for task in &spec.tasks {
                 let rows = task.rows();
                 let (jacobian, target) = level.rows_mut(row, rows);
                 task.write(self.model, &self.data, q, jacobian, target)?;
+                row += rows;
+            }
+            let (mut jacobian, lower, upper) = level.inequalities_mut();
+            let mut row = 0;
+            for task in &spec.inequalities {
+                let rows = task.rows();
+                task.write(
+                    self.model,
+                    &self.data,
+                    jacobian.as_mut().subrows_mut(row, rows),
+                    &mut lower[row..row + rows],
+                    &mut upper[row..row + rows],
+                )?;
                 row += rows;
             }
         }

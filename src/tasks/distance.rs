@@ -1,0 +1,335 @@
+//! Distances between bodies, kept above a margin: capsule to capsule (self-collision) and capsule
+//! to plane (the floor, a table top).
+//!
+//! A [`Capsule`] is a segment `[a, b]` fixed in a frame, swept by a sphere of radius `r`. The
+//! distance of two capsules is `d = ‖p₁ − p₂‖ − r₁ − r₂`, with `p₁`, `p₂` the closest points of
+//! the two segments (Ericson, *Real-Time Collision Detection*, §5.1.9); its Jacobian is
+//! `nᵀ (J_{p₁} − J_{p₂})`, `n = (p₁ − p₂)/‖p₁ − p₂‖`, the closest points held fixed in their
+//! frames (the derivative of a minimum distance, where the closest points are unique). The
+//! distance of a capsule to the plane through `o` with unit normal `ν` is
+//! `d = ν ᵀ (p − o) − r`, `p` the segment end nearer the plane (its midpoint when both are as
+//! near), Jacobian `νᵀ J_p`. Each task is one row `margin − d ≤ C δq ≤ +∞`.
+
+use std::any::Any;
+use std::cell::RefCell;
+
+use faer::{Mat, MatMut};
+use nalgebra::Vector3;
+
+use super::inequality::InequalityTask;
+use super::{TaskError, finite_target};
+use crate::model::{FrameId, Model, ModelData, ModelError};
+
+/// A segment `[a, b]` fixed in a frame (m, in the frame's axes), swept by a sphere of `radius`
+/// (m). A sphere is a capsule with `a = b`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Capsule {
+    /// The frame the capsule moves with.
+    pub frame: FrameId,
+    /// Segment ends, in the frame's axes (m).
+    pub a: Vector3<f64>,
+    /// See `a`.
+    pub b: Vector3<f64>,
+    /// Radius (m, ≥ 0).
+    pub radius: f64,
+}
+
+impl Capsule {
+    /// A capsule on the named frame.
+    ///
+    /// # Errors
+    /// [`TaskError::Model`] for an unknown frame, [`TaskError::NonFiniteTarget`] for a NaN or
+    /// infinite end or radius, [`TaskError::InvalidGeometry`] for a negative radius.
+    pub fn new(
+        model: &Model,
+        frame: &str,
+        a: Vector3<f64>,
+        b: Vector3<f64>,
+        radius: f64,
+    ) -> Result<Self, TaskError> {
+        let frame = model.frame_id(frame)?;
+        finite_target("capsule", a.as_slice())?;
+        finite_target("capsule", b.as_slice())?;
+        finite_target("capsule", &[radius])?;
+        if radius < 0.0 {
+            return Err(TaskError::InvalidGeometry {
+                task: "capsule".to_owned(),
+                reason: "negative radius",
+            });
+        }
+        Ok(Self {
+            frame,
+            a,
+            b,
+            radius,
+        })
+    }
+
+    /// The segment's ends in the base frame (m).
+    fn ends(&self, model: &Model, data: &ModelData) -> Result<[Vector3<f64>; 2], ModelError> {
+        Ok([
+            model.point_position(data, self.frame, &self.a)?,
+            model.point_position(data, self.frame, &self.b)?,
+        ])
+    }
+
+    /// The point at parameter `s ∈ [0, 1]` of the segment, in the frame's axes.
+    fn local(&self, s: f64) -> Vector3<f64> {
+        self.a + (self.b - self.a) * s
+    }
+}
+
+/// Parameters `(s, t) ∈ [0, 1]²` of the closest points `p₁ + s d₁`, `p₂ + t d₂` of two segments
+/// (Ericson §5.1.9, with its degenerate cases: points, parallel segments).
+pub fn closest_segment_parameters(
+    p1: &Vector3<f64>,
+    q1: &Vector3<f64>,
+    p2: &Vector3<f64>,
+    q2: &Vector3<f64>,
+) -> (f64, f64) {
+    const EPS: f64 = 1e-12;
+    let (d1, d2, r) = (q1 - p1, q2 - p2, p1 - p2);
+    let (a, e, f) = (d1.dot(&d1), d2.dot(&d2), d2.dot(&r));
+    if a <= EPS && e <= EPS {
+        return (0.0, 0.0);
+    }
+    if a <= EPS {
+        return (0.0, (f / e).clamp(0.0, 1.0));
+    }
+    let c = d1.dot(&r);
+    if e <= EPS {
+        return ((-c / a).clamp(0.0, 1.0), 0.0);
+    }
+    let b = d1.dot(&d2);
+    let denom = a * e - b * b;
+    let mut s = if denom > EPS * a * e {
+        ((b * f - c * e) / denom).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let mut t = (b * s + f) / e;
+    if t < 0.0 {
+        t = 0.0;
+        s = (-c / a).clamp(0.0, 1.0);
+    } else if t > 1.0 {
+        t = 1.0;
+        s = ((b - c) / a).clamp(0.0, 1.0);
+    }
+    (s, t)
+}
+
+fn check_margin(task: &str, margin: f64) -> Result<(), TaskError> {
+    finite_target(task, &[margin])?;
+    if margin < 0.0 {
+        return Err(TaskError::InvalidGeometry {
+            task: task.to_owned(),
+            reason: "negative margin",
+        });
+    }
+    Ok(())
+}
+
+/// Two capsules kept at least `margin` apart (m): one row, `margin − d ≤ C δq`.
+#[derive(Debug, Clone)]
+pub struct CapsuleDistanceTask {
+    name: String,
+    first: Capsule,
+    second: Capsule,
+    margin: f64,
+    /// Point-Jacobian scratch (3 × nv each), so that writing does not allocate.
+    scratch: RefCell<(Mat<f64>, Mat<f64>)>,
+}
+
+impl CapsuleDistanceTask {
+    /// Keeps `first` and `second` at least `margin` (m, ≥ 0) apart; named `name`.
+    ///
+    /// # Errors
+    /// [`TaskError::NonFiniteTarget`], [`TaskError::InvalidGeometry`] for a bad margin.
+    pub fn new(
+        model: &Model,
+        name: &str,
+        first: Capsule,
+        second: Capsule,
+        margin: f64,
+    ) -> Result<Self, TaskError> {
+        check_margin(name, margin)?;
+        let nv = model.nv();
+        Ok(Self {
+            name: name.to_owned(),
+            first,
+            second,
+            margin,
+            scratch: RefCell::new((Mat::zeros(3, nv), Mat::zeros(3, nv))),
+        })
+    }
+
+    /// The signed distance `d` (m; < 0 when the capsules overlap), the closest points in the
+    /// base frame, and their parameters on the segments.
+    pub fn distance(&self, model: &Model, data: &ModelData) -> Result<f64, ModelError> {
+        Ok(self.closest(model, data)?.0)
+    }
+
+    #[allow(clippy::type_complexity)]
+    fn closest(
+        &self,
+        model: &Model,
+        data: &ModelData,
+    ) -> Result<(f64, Vector3<f64>, (f64, f64)), ModelError> {
+        let [p1, q1] = self.first.ends(model, data)?;
+        let [p2, q2] = self.second.ends(model, data)?;
+        let (s, t) = closest_segment_parameters(&p1, &q1, &p2, &q2);
+        let gap = (p1 + (q1 - p1) * s) - (p2 + (q2 - p2) * t);
+        let length = gap.norm();
+        // Touching axes: any direction is a subgradient; the one between the segments' middles
+        // pushes them apart.
+        let normal = if length > 1e-12 {
+            gap / length
+        } else {
+            let between = (p1 + q1 - p2 - q2) * 0.5;
+            if between.norm() > 1e-12 {
+                between.normalize()
+            } else {
+                Vector3::z()
+            }
+        };
+        let d = length - self.first.radius - self.second.radius;
+        Ok((d, normal, (s, t)))
+    }
+}
+
+impl InequalityTask for CapsuleDistanceTask {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn rows(&self) -> usize {
+        1
+    }
+
+    fn write(
+        &self,
+        model: &Model,
+        data: &ModelData,
+        mut jacobian: MatMut<'_, f64>,
+        lower: &mut [f64],
+        upper: &mut [f64],
+    ) -> Result<(), ModelError> {
+        let (d, n, (s, t)) = self.closest(model, data)?;
+        let mut scratch = self.scratch.borrow_mut();
+        let (j1, j2) = &mut *scratch;
+        model.point_jacobian(data, self.first.frame, &self.first.local(s), j1.as_mut())?;
+        model.point_jacobian(data, self.second.frame, &self.second.local(t), j2.as_mut())?;
+        for col in 0..jacobian.ncols() {
+            jacobian[(0, col)] = (0..3).map(|r| n[r] * (j1[(r, col)] - j2[(r, col)])).sum();
+        }
+        lower[0] = self.margin - d;
+        upper[0] = f64::INFINITY;
+        Ok(())
+    }
+
+    fn as_any_mut(&mut self) -> &mut dyn Any {
+        self
+    }
+}
+
+/// A capsule kept at least `margin` above a plane (m): the plane through `point` with unit
+/// `normal` (base frame), unbounded. One row, `margin − d ≤ C δq`.
+#[derive(Debug, Clone)]
+pub struct PlaneDistanceTask {
+    name: String,
+    capsule: Capsule,
+    point: Vector3<f64>,
+    normal: Vector3<f64>,
+    margin: f64,
+    scratch: RefCell<Mat<f64>>,
+}
+
+impl PlaneDistanceTask {
+    /// Keeps `capsule` at least `margin` (m) on the `normal` side of the plane through `point`;
+    /// named `name`. `normal` is normalized.
+    ///
+    /// # Errors
+    /// [`TaskError::NonFiniteTarget`]; [`TaskError::InvalidGeometry`] for a zero normal or a
+    /// negative margin.
+    pub fn new(
+        model: &Model,
+        name: &str,
+        capsule: Capsule,
+        point: Vector3<f64>,
+        normal: Vector3<f64>,
+        margin: f64,
+    ) -> Result<Self, TaskError> {
+        check_margin(name, margin)?;
+        finite_target(name, point.as_slice())?;
+        finite_target(name, normal.as_slice())?;
+        if normal.norm() < 1e-12 {
+            return Err(TaskError::InvalidGeometry {
+                task: name.to_owned(),
+                reason: "zero plane normal",
+            });
+        }
+        Ok(Self {
+            name: name.to_owned(),
+            capsule,
+            point,
+            normal: normal.normalize(),
+            margin,
+            scratch: RefCell::new(Mat::zeros(3, model.nv())),
+        })
+    }
+
+    /// The signed distance `d` (m) and the segment parameter of the nearest point.
+    pub fn distance(&self, model: &Model, data: &ModelData) -> Result<f64, ModelError> {
+        Ok(self.nearest(model, data)?.0)
+    }
+
+    fn nearest(&self, model: &Model, data: &ModelData) -> Result<(f64, f64), ModelError> {
+        let [a, b] = self.capsule.ends(model, data)?;
+        let (ha, hb) = (
+            self.normal.dot(&(a - self.point)),
+            self.normal.dot(&(b - self.point)),
+        );
+        let s = if (ha - hb).abs() <= 1e-12 {
+            0.5
+        } else if ha < hb {
+            0.0
+        } else {
+            1.0
+        };
+        Ok((ha.min(hb) - self.capsule.radius, s))
+    }
+}
+
+impl InequalityTask for PlaneDistanceTask {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn rows(&self) -> usize {
+        1
+    }
+
+    fn write(
+        &self,
+        model: &Model,
+        data: &ModelData,
+        mut jacobian: MatMut<'_, f64>,
+        lower: &mut [f64],
+        upper: &mut [f64],
+    ) -> Result<(), ModelError> {
+        let (d, s) = self.nearest(model, data)?;
+        let mut j = self.scratch.borrow_mut();
+        let offset = self.capsule.local(s);
+        model.point_jacobian(data, self.capsule.frame, &offset, j.as_mut())?;
+        for col in 0..jacobian.ncols() {
+            jacobian[(0, col)] = (0..3).map(|r| self.normal[r] * j[(r, col)]).sum();
+        }
+        lower[0] = self.margin - d;
+        upper[0] = f64::INFINITY;
+        Ok(())
+    }
+
+    fn as_any_mut(&mut self) -> &mut dyn Any {
+        self
+    }
+}

@@ -1,0 +1,283 @@
+//! Inequality tasks and the contact-normal task: Jacobians against central finite differences of
+//! the quantity they bound, distances against hand calculations, and the CoM-in-polygon task
+//! holding in a driven solve where the equality stack without it lets the CoM out.
+
+use nalgebra::Vector3;
+use taskstack::model::{Model, ModelData};
+use taskstack::robots::nao;
+use taskstack::solver::Solver;
+use taskstack::solver::driver::{DriverSettings, PositionDriver};
+use taskstack::tasks::{
+    Capsule, CapsuleDistanceTask, ComPolygonTask, ContactNormalTask, InequalityTask,
+    PlaneDistanceTask, PositionTask, Task, TaskError, TaskSet, closest_segment_parameters,
+    joint_bounds,
+};
+
+/// A bent, asymmetric NAO configuration (no joint at a symmetric zero).
+fn bent(model: &Model) -> Vec<f64> {
+    (0..model.nv())
+        .map(|i| 0.3 * ((i as f64) * 1.7).sin())
+        .collect()
+}
+
+fn data_at(model: &Model, q: &[f64]) -> ModelData {
+    let mut data = model.new_data();
+    model.forward_kinematics(&mut data, q).unwrap();
+    data
+}
+
+/// Central differences of `value(q)` against the first Jacobian row `jacobian`.
+fn check_gradient(model: &Model, q: &[f64], jacobian: &[f64], value: impl Fn(&ModelData) -> f64) {
+    let h = 1e-6;
+    for k in 0..model.nv() {
+        let (mut plus, mut minus) = (q.to_vec(), q.to_vec());
+        plus[k] += h;
+        minus[k] -= h;
+        let fd = (value(&data_at(model, &plus)) - value(&data_at(model, &minus))) / (2.0 * h);
+        assert!(
+            (fd - jacobian[k]).abs() < 1e-6,
+            "variable {k}: finite difference {fd}, Jacobian {}",
+            jacobian[k]
+        );
+    }
+}
+
+fn inequality_row(task: &dyn InequalityTask, model: &Model, data: &ModelData) -> (Vec<f64>, f64) {
+    let mut jacobian = faer::Mat::zeros(task.rows(), model.nv());
+    let (mut lower, mut upper) = (vec![0.0; task.rows()], vec![0.0; task.rows()]);
+    task.write(model, data, jacobian.as_mut(), &mut lower, &mut upper)
+        .unwrap();
+    let row = (0..model.nv()).map(|k| jacobian[(0, k)]).collect();
+    (row, lower[0])
+}
+
+fn forearm(model: &Model, side: &str) -> Capsule {
+    Capsule::new(
+        model,
+        &format!("{side}_elbow"),
+        Vector3::zeros(),
+        Vector3::new(0.1, 0.0, 0.0),
+        0.025,
+    )
+    .unwrap()
+}
+
+#[test]
+fn capsule_distance_jacobian_matches_finite_differences() {
+    let model = nao::rfoot();
+    let q = bent(&model);
+    let torso = Capsule::new(
+        &model,
+        "torso",
+        Vector3::new(0.0, 0.0, -0.05),
+        Vector3::new(0.0, 0.0, 0.1),
+        0.06,
+    )
+    .unwrap();
+    for second in [torso, forearm(&model, "r")] {
+        let task =
+            CapsuleDistanceTask::new(&model, "arm", forearm(&model, "l"), second, 0.01).unwrap();
+        let (row, lower) = inequality_row(&task, &model, &data_at(&model, &q));
+        let d = task.distance(&model, &data_at(&model, &q)).unwrap();
+        assert!((lower - (0.01 - d)).abs() < 1e-15, "room = margin − d");
+        check_gradient(&model, &q, &row, |data| {
+            task.distance(&model, data).unwrap()
+        });
+    }
+}
+
+#[test]
+fn plane_distance_and_contact_normal_jacobians_match_finite_differences() {
+    let model = nao::rfoot();
+    let q = bent(&model);
+    // A table top 0.3 m above the right sole, tilted a little.
+    let normal = Vector3::new(0.1, 0.0, 1.0);
+    let table = PlaneDistanceTask::new(
+        &model,
+        "l_hand_table",
+        forearm(&model, "l"),
+        Vector3::new(0.0, 0.0, 0.3),
+        normal,
+        0.0,
+    )
+    .unwrap();
+    let (row, _) = inequality_row(&table, &model, &data_at(&model, &q));
+    check_gradient(&model, &q, &row, |data| {
+        table.distance(&model, data).unwrap()
+    });
+
+    let palm =
+        ContactNormalTask::new(&model, "l_hand", Vector3::new(0.0, 0.0, -1.0), -normal).unwrap();
+    let data = data_at(&model, &q);
+    let mut jacobian = faer::Mat::zeros(1, model.nv());
+    let mut error = [0.0];
+    palm.write(&model, &data, &q, jacobian.as_mut(), &mut error)
+        .unwrap();
+    let phi = palm.alignment(&model, &data).unwrap();
+    assert!((error[0] - (1.0 - phi)).abs() < 1e-15);
+    let row: Vec<f64> = (0..model.nv()).map(|k| jacobian[(0, k)]).collect();
+    check_gradient(&model, &q, &row, |data| {
+        palm.alignment(&model, data).unwrap()
+    });
+}
+
+#[test]
+fn com_polygon_rows_match_finite_differences_and_spare_rows_are_open() {
+    let model = nao::rfoot();
+    let q = bent(&model);
+    let square = [[-0.04, -0.03], [0.06, -0.03], [0.06, 0.03], [-0.04, 0.03]];
+    let task = ComPolygonTask::new(&model, 6, &square, 0.005).unwrap();
+    let data = data_at(&model, &q);
+    let mut jacobian = faer::Mat::zeros(6, model.nv());
+    let (mut lower, mut upper) = ([0.0; 6], [0.0; 6]);
+    task.write(&model, &data, jacobian.as_mut(), &mut lower, &mut upper)
+        .unwrap();
+    let c = model.com(&data).unwrap();
+    // Edge 1 runs from (0.06, −0.03) to (0.06, 0.03): outward normal +x, offset 0.06. By hand:
+    // room = 0.06 − 0.005 − c_x.
+    assert!((upper[1] - (0.055 - c[0])).abs() < 1e-15);
+    let row: Vec<f64> = (0..model.nv()).map(|k| jacobian[(1, k)]).collect();
+    check_gradient(&model, &q, &row, |data| model.com(data).unwrap()[0]);
+    // Edge 2 (top, from (0.06, 0.03) to (−0.04, 0.03)): normal +y.
+    let row: Vec<f64> = (0..model.nv()).map(|k| jacobian[(2, k)]).collect();
+    check_gradient(&model, &q, &row, |data| model.com(data).unwrap()[1]);
+    for spare in 4..6 {
+        assert_eq!(
+            (lower[spare], upper[spare]),
+            (f64::NEG_INFINITY, f64::INFINITY)
+        );
+        assert!((0..model.nv()).all(|k| jacobian[(spare, k)] == 0.0));
+    }
+    assert!(lower[..4].iter().all(|l| *l == f64::NEG_INFINITY));
+}
+
+#[test]
+fn bad_polygons_and_geometry_are_refused() {
+    let model = nao::rfoot();
+    let square = [[-0.04, -0.03], [0.06, -0.03], [0.06, 0.03], [-0.04, 0.03]];
+    let clockwise: Vec<[f64; 2]> = square.iter().rev().copied().collect();
+    assert!(matches!(
+        ComPolygonTask::new(&model, 4, &clockwise, 0.0),
+        Err(TaskError::InvalidPolygon { .. })
+    ));
+    assert!(matches!(
+        ComPolygonTask::new(&model, 4, &square, -0.01),
+        Err(TaskError::InvalidPolygon { .. })
+    ));
+    assert!(matches!(
+        ComPolygonTask::new(&model, 3, &square, 0.0),
+        Err(TaskError::WrongLength { .. })
+    ));
+    let mut task = ComPolygonTask::new(&model, 4, &square, 0.0).unwrap();
+    assert!(
+        task.set_polygon(&[[0.0, 0.0], [f64::NAN, 0.0], [0.0, 1.0]], 0.0)
+            .is_err()
+    );
+    assert_eq!(
+        task.vertices(),
+        &square,
+        "a refused polygon leaves the task as it was"
+    );
+    assert!(matches!(
+        Capsule::new(&model, "l_hand", Vector3::zeros(), Vector3::zeros(), -1.0),
+        Err(TaskError::InvalidGeometry { .. })
+    ));
+    assert!(
+        Capsule::new(
+            &model,
+            "no_such_frame",
+            Vector3::zeros(),
+            Vector3::zeros(),
+            0.1
+        )
+        .is_err()
+    );
+    assert!(matches!(
+        PlaneDistanceTask::new(
+            &model,
+            "floor",
+            forearm(&model, "l"),
+            Vector3::zeros(),
+            Vector3::zeros(),
+            0.0
+        ),
+        Err(TaskError::InvalidGeometry { .. })
+    ));
+}
+
+#[test]
+fn closest_segment_points_by_hand() {
+    // Crossed segments one unit apart: the closest points are both middles.
+    let (s, t) = closest_segment_parameters(
+        &Vector3::new(-1.0, 0.0, 0.0),
+        &Vector3::new(1.0, 0.0, 0.0),
+        &Vector3::new(0.0, -1.0, 1.0),
+        &Vector3::new(0.0, 1.0, 1.0),
+    );
+    assert!((s - 0.5).abs() < 1e-15 && (t - 0.5).abs() < 1e-15);
+    // A point beyond the end of a segment: the end, t = 1.
+    let (s, t) = closest_segment_parameters(
+        &Vector3::new(3.0, 0.0, 0.0),
+        &Vector3::new(3.0, 0.0, 0.0),
+        &Vector3::new(0.0, 0.0, 0.0),
+        &Vector3::new(1.0, 0.0, 0.0),
+    );
+    assert_eq!((s, t), (0.0, 1.0));
+    // Parallel segments overlapping on [0.5, 1]: some pair at distance 0.3 (any s on the overlap).
+    let (p1, q1) = (Vector3::new(0.0, 0.0, 0.0), Vector3::new(1.0, 0.0, 0.0));
+    let (p2, q2) = (Vector3::new(0.5, 0.3, 0.0), Vector3::new(1.5, 0.3, 0.0));
+    let (s, t) = closest_segment_parameters(&p1, &q1, &p2, &q2);
+    let gap = (p1 + (q1 - p1) * s) - (p2 + (q2 - p2) * t);
+    assert!((gap.norm() - 0.3).abs() < 1e-15, "{gap}");
+}
+
+/// The right hand sent far forward: with the CoM kept inside a rectangle under the right sole
+/// (shrunk by 1 cm) at the top, the CoM stays inside; without that level the hand drags it out.
+#[test]
+fn com_polygon_level_keeps_the_com_inside_while_a_hand_reaches() {
+    let model = nao::rfoot();
+    let square = [[-0.03, -0.02], [0.05, -0.02], [0.05, 0.02], [-0.03, 0.02]];
+    let margin = 0.01;
+    let far = Vector3::new(0.4, -0.1, 0.25);
+    let run = |with_polygon: bool| {
+        let hand: Box<dyn Task> = Box::new(PositionTask::new(&model, "r_hand", far).unwrap());
+        let mut set = if with_polygon {
+            let polygon = ComPolygonTask::new(&model, 4, &square, margin).unwrap();
+            TaskSet::new(&model)
+                .inequality_level("balance", vec![Box::new(polygon)])
+                .level("reach", vec![hand])
+        } else {
+            TaskSet::new(&model).level("reach", vec![hand])
+        };
+        let mut solver = Solver::new(&set.shape()).unwrap();
+        let settings = DriverSettings {
+            max_iterations: 200,
+            ..DriverSettings::default()
+        };
+        let mut driver = PositionDriver::new(&solver, settings).unwrap();
+        let mut q = nao::profile().stand.clone();
+        driver
+            .run(
+                &mut solver,
+                &mut set,
+                &mut q,
+                &joint_bounds(&model).unwrap(),
+            )
+            .unwrap();
+        let c = model.com(&data_at(&model, &q)).unwrap();
+        (c, solver.report().active_inequalities().len())
+    };
+    let (free, _) = run(false);
+    assert!(
+        free[0] > 0.05 - margin + 0.005,
+        "without the level the CoM leaves: {free}"
+    );
+    let (held, active) = run(true);
+    assert!(
+        held[0] <= 0.05 - margin + 1e-4,
+        "CoM x {} past the shrunk edge",
+        held[0]
+    );
+    assert!(held[1].abs() <= 0.02 - margin + 1e-4 && held[0] >= -0.03 + margin - 1e-4);
+    assert!(active > 0, "the front edge is active");
+}
