@@ -1,8 +1,10 @@
 //! The whole `solve` frame on the NAO benchmark problems (`tests/data/bench/problem_*.json`):
 //! targets set + all driver iterations + stop test, warm-started from the previous frame, cycling
 //! through the file's frames. Same code as the `solve` example (`taskstack::problem`). Each
-//! problem twice: by the strict hierarchy (as the files ask) and by weighted damped least
-//! squares (λ = 1e-3, `solve_frame_dls/…`), to compare the two solver methods.
+//! problem three times: by the strict hierarchy (as the files ask), by weighted damped least
+//! squares (λ = 1e-3, `solve_frame_dls/…`), to compare the two solver methods, and with the CoM
+//! task replaced by an inequality level: its ground projection inside the support polygon shrunk
+//! by 1 cm (`solve_frame_com_polygon/…`), solved by the active-set method.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
@@ -25,7 +27,13 @@ fn bench(c: &mut Criterion) {
         let strict = Problem::from_json(&text).expect("valid problem file");
         let mut dls = strict.clone();
         dls.method = Method::WeightedDls { damping: 1e-3 };
-        for (label, problem) in [("solve_frame", strict), ("solve_frame_dls", dls)] {
+        let mut polygon = strict.clone();
+        polygon.com_polygon_margin = Some(0.01);
+        for (label, problem) in [
+            ("solve_frame", strict),
+            ("solve_frame_dls", dls),
+            ("solve_frame_com_polygon", polygon),
+        ] {
             bench_problem(c, &format!("{label}/{name}"), &problem);
         }
     }

@@ -1,12 +1,16 @@
 //! Prioritized solve on the paper's stack shapes (n = 23): RS (CoM 2 rows, then hands + free
 //! ankle 9 rows, two gradient tasks) and DS (2 rows, then 11 rows), with and without an active
 //! clamp, against a naive nalgebra implementation of eq. 4–6 (explicit n × n projectors, SVD
-//! pseudo-inverses) measured in the same run.
+//! pseudo-inverses) measured in the same run. Then the RS stack under a top level of 0, 10 or 30
+//! inequality rows (`solve_inequalities/…`, the active-set method; the id says how many rows
+//! ended active and how many prioritized solves it took).
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use nalgebra::{DMatrix, DVector};
 use std::hint::black_box;
-use taskstack::solver::{JointBounds, JointLimitAvoidance, JointTracking, Solver, StackShape};
+use taskstack::solver::{
+    JointBounds, JointLimitAvoidance, JointTracking, Settings, Solver, StackShape,
+};
 
 const N: usize = 23;
 
@@ -144,5 +148,79 @@ fn bench(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, bench);
+/// The RS stack (CoM 2 rows, then 9 rows, two gradient tasks) below a level of `rows`
+/// inequality rows `|c_i q̇| ≤ b_i`: every third row bounded at half the value it has in the
+/// solution without them (so it must become active), the others loosely.
+fn bench_inequalities(c: &mut Criterion) {
+    let bounds = JointBounds::new(&[-2.0; N], &[2.0; N]).unwrap();
+    let q = vec![0.1; N];
+    let limits = JointLimitAvoidance::new(&bounds);
+    let tracking = JointTracking::new(&[0.2; N]).unwrap();
+    let case = Case::new("RS", &[2, 9]);
+    let mut group = c.benchmark_group("solve_inequalities");
+    for rows in [0, 10, 30] {
+        let names = [("com_xy", 2)];
+        let hands = [("hands_ankle", 9)];
+        let shape = StackShape::new(N)
+            .with_mixed_level("limits", &[], &[("rows", rows)])
+            .with_level("balance", &names)
+            .with_level("tracking", &hands);
+        let shape = if rows == 0 { case.shape() } else { shape };
+        let settings = Settings {
+            limits_by_active_set: true,
+            ..Settings::default()
+        };
+        let mut solver = Solver::with_settings(&shape, settings).unwrap();
+        let mut row_bounds = vec![f64::INFINITY; rows];
+        let fill = |solver: &mut Solver, row_bounds: &[f64]| {
+            let stack = solver.stack_mut();
+            let offset = if rows == 0 { 0 } else { 1 };
+            for (l, (jac, target)) in case.levels.iter().enumerate() {
+                let mut level = stack.level_mut(l + offset);
+                let mut view = level.jacobian_mut();
+                for i in 0..jac.nrows() {
+                    for j in 0..N {
+                        view[(i, j)] = jac[(i, j)];
+                    }
+                }
+                level.target_mut().copy_from_slice(target.as_slice());
+            }
+            if rows > 0 {
+                let mut level = stack.level_mut(0);
+                let (mut jac, lower, upper) = level.inequalities_mut();
+                for i in 0..rows {
+                    for j in 0..N {
+                        jac[(i, j)] = entry(i, j, 1234);
+                    }
+                    (lower[i], upper[i]) = (-row_bounds[i], row_bounds[i]);
+                }
+            }
+            stack.clear_gradient();
+            stack.add_gradient(-0.10, &limits, &q).unwrap();
+            stack.add_gradient(-0.02, &tracking, &q).unwrap();
+        };
+        fill(&mut solver, &row_bounds);
+        let free = solver.solve(&q, &bounds, 0.01).unwrap().velocity.to_vec();
+        for (i, b) in row_bounds.iter_mut().enumerate() {
+            let value: f64 = (0..N).map(|j| entry(i, j, 1234) * free[j]).sum();
+            *b = if i % 3 == 0 { 0.5 } else { 10.0 } * value.abs() + 1e-6;
+        }
+        fill(&mut solver, &row_bounds);
+        let report = solver.solve(&q, &bounds, 0.01).unwrap().report;
+        let (active, iterations) = (
+            report.active_inequalities().len(),
+            report.active_set_iterations(),
+        );
+        let id = format!("{rows}_rows_{active}_active_{iterations}_solves");
+        group.bench_function(id, |b| {
+            b.iter(|| {
+                fill(&mut solver, &row_bounds);
+                black_box(solver.solve(&q, &bounds, 0.01).unwrap().velocity[0])
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench, bench_inequalities);
 criterion_main!(benches);

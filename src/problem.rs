@@ -24,15 +24,16 @@
 
 use std::time::Instant;
 
-use nalgebra::Vector3;
+use nalgebra::{Point3, Vector3};
 use serde_json::Value;
 use thiserror::Error;
 
+use crate::human::Side;
 use crate::model::{Axis, Model, ModelError};
 use crate::robots::nao;
 use crate::solver::driver::{DriverSettings, PositionDriver, StopReason};
 use crate::solver::{JointBounds, Method, Settings, Solver, SolverError};
-use crate::tasks::{self, ComTask, PositionTask, TaskError, TaskSet};
+use crate::tasks::{self, ComPolygonTask, ComTask, PositionTask, TaskError, TaskSet, convex_hull};
 
 /// The schema this module reads.
 pub const SCHEMA: &str = "nao-prioritized-ik-benchmark/1";
@@ -116,6 +117,11 @@ pub struct Problem {
     /// How each iteration's stack is solved: strict priorities (default, what the files ask
     /// for) or weighted damped least squares, to compare the two.
     pub method: Method,
+    /// Solve the CoM task as an inequality instead (`None`, what the files ask for, by default):
+    /// its ground projection inside the support polygon shrunk by this margin (m), at the CoM
+    /// task's level. The support polygon is the convex hull of the outlines of the soles on the
+    /// ground (within 1 mm) at `q_init`.
+    pub com_polygon_margin: Option<f64>,
     tasks: Vec<ProblemTask>,
     /// Name of each level, highest priority first.
     pub level_names: Vec<String>,
@@ -236,6 +242,7 @@ impl Problem {
             frames,
             settings,
             method: Method::Prioritized,
+            com_polygon_margin: None,
             tasks,
             level_names,
             model,
@@ -413,6 +420,34 @@ fn ready_made(model: &Model, task: &ProblemTask) -> Result<Box<dyn tasks::Task>,
     Ok(Box::new(point))
 }
 
+/// The CoM kept inside the convex hull of the outlines of the soles on the ground at the
+/// problem's start posture, shrunk by `margin` (m).
+fn support_polygon_task(problem: &Problem, margin: f64) -> Result<ComPolygonTask, ProblemError> {
+    let model = &problem.model;
+    let mut data = model.new_data();
+    model.forward_kinematics(&mut data, &problem.q_init)?;
+    let mut corners = Vec::new();
+    for side in [Side::Left, Side::Right] {
+        let sole = model.frame_id(nao::sole(side))?;
+        let placement = model.placement_in_world(&data, &Default::default(), sole)?;
+        if placement.translation.vector.z.abs() > 1e-3 {
+            continue;
+        }
+        for [x, y] in nao::sole_outline(side) {
+            let p = placement.transform_point(&Point3::new(x, y, 0.0));
+            corners.push([p.x, p.y]);
+        }
+    }
+    let mut hull = Vec::new();
+    convex_hull(&mut corners, &mut hull);
+    Ok(ComPolygonTask::new(
+        model,
+        hull.len().max(3),
+        &hull,
+        margin,
+    )?)
+}
+
 impl<'p> Runner<'p> {
     /// The task set, solver and driver of `problem`.
     ///
@@ -423,13 +458,23 @@ impl<'p> Runner<'p> {
         let model = &problem.model;
         let mut set = TaskSet::new(model);
         for (level, name) in problem.level_names.iter().enumerate() {
-            let tasks = problem
-                .tasks
-                .iter()
-                .filter(|t| t.level == level)
+            let in_level = problem.tasks.iter().filter(|t| t.level == level);
+            let (polygon, points): (Vec<&ProblemTask>, Vec<&ProblemTask>) =
+                in_level.partition(|t| {
+                    matches!(t.target, Target::Com(_)) && problem.com_polygon_margin.is_some()
+                });
+            let tasks = points
+                .into_iter()
                 .map(|t| ready_made(model, t))
                 .collect::<Result<_, _>>()?;
-            set = set.level(name, tasks);
+            let inequalities: Vec<Box<dyn tasks::InequalityTask>> = match polygon.is_empty() {
+                true => Vec::new(),
+                false => vec![Box::new(support_polygon_task(
+                    problem,
+                    problem.com_polygon_margin.unwrap_or(0.0),
+                )?)],
+            };
+            set = set.mixed_level(name, tasks, inequalities);
         }
         let set = set.posture_gradient(POSTURE_GAIN, &problem.q_ref)?;
         let settings = Settings {

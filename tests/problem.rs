@@ -83,3 +83,55 @@ fn a_frame_past_the_count_is_refused() {
     assert!(runner.solve_frame(problem.frames, &mut q).is_err());
     assert!(runner.solve_frame(0, &mut q).is_ok());
 }
+
+/// With the CoM task as an inequality (inside the support polygon shrunk by 1 cm), every frame of
+/// the RS and DS files converges: the point tasks within 1e-4 m, and the CoM at least
+/// 1 cm − 1e-4 m inside the hull of the soles on the ground.
+#[test]
+fn com_polygon_variant_converges_with_the_com_inside() {
+    use nalgebra::{Point3, Vector2};
+    use taskstack::human::Side;
+    use taskstack::imitation::metrics::convex_margin;
+    use taskstack::robots::nao;
+    use taskstack::solver::driver::StopReason;
+    let model = nao::rfoot();
+    for name in ["problem_rs", "problem_ds"] {
+        let path = format!(
+            "{}/tests/data/bench/{name}.json",
+            env!("CARGO_MANIFEST_DIR")
+        );
+        let mut problem = Problem::from_json(&std::fs::read_to_string(path).unwrap()).unwrap();
+        problem.com_polygon_margin = Some(0.01);
+        let mut data = model.new_data();
+        model
+            .forward_kinematics(&mut data, &problem.q_init)
+            .unwrap();
+        let mut corners = Vec::new();
+        for side in [Side::Left, Side::Right] {
+            let sole = model.frame_id(nao::sole(side)).unwrap();
+            let placement = model
+                .placement_in_world(&data, &Default::default(), sole)
+                .unwrap();
+            if placement.translation.vector.z.abs() < 1e-3 {
+                for [x, y] in nao::sole_outline(side) {
+                    let p = placement.transform_point(&Point3::new(x, y, 0.0));
+                    corners.push(Vector2::new(p.x, p.y));
+                }
+            }
+        }
+        assert_eq!(corners.len(), if name == "problem_rs" { 4 } else { 8 });
+        let mut runner = Runner::new(&problem).unwrap();
+        let mut q = problem.q_init.clone();
+        for frame in 0..problem.frames {
+            let result = runner.solve_frame(frame, &mut q).unwrap();
+            assert_eq!(result.stop, StopReason::Converged, "{name} frame {frame}");
+            model.forward_kinematics(&mut data, &q).unwrap();
+            let com = model.com(&data).unwrap();
+            let margin = convex_margin(&corners, com.xy());
+            assert!(
+                margin >= 0.01 - 1e-4,
+                "{name} frame {frame}: CoM {margin} m inside"
+            );
+        }
+    }
+}

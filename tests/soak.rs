@@ -170,7 +170,7 @@ fn check_frame(
             n += 4;
         }
     }
-    let margin = convex_margin(&mut points[..n], r.com.xy());
+    let margin = convex_margin(&points[..n], r.com.xy());
     assert!(
         margin > 0.0,
         "{at}: CoM margin {margin} m ({n} sole corners on the ground)"

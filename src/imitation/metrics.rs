@@ -26,6 +26,7 @@ use super::phase::SupportPhase;
 use super::support::HumanSupport;
 use super::travel::{HandTrace, Stance, StepCounter, Travel, TravelRecorder, robot_stance};
 use crate::solver::JointBounds;
+use crate::tasks::convex_hull;
 
 /// A foot is on the ground when its outline points are at most this high (m).
 pub const CONTACT_HEIGHT: f64 = 1e-3;
@@ -337,35 +338,17 @@ fn standing_feet(phase: SupportPhase) -> [bool; 2] {
 }
 
 /// Signed distance of `p` to the boundary of the convex hull of `points` (positive inside).
-/// `points` is reordered.
-pub fn convex_margin(points: &mut [Vector2<f64>], p: Vector2<f64>) -> f64 {
-    // Andrew's monotone chain, lower then upper hull, counter-clockwise.
-    points.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
-    let cross = |o: Vector2<f64>, a: Vector2<f64>, b: Vector2<f64>| (a - o).perp(&(b - o));
-    let mut hull = vec![Vector2::zeros(); 2 * points.len() + 1];
-    let mut k = 0;
-    for &pt in points.iter() {
-        while k >= 2 && cross(hull[k - 2], hull[k - 1], pt) <= 0.0 {
-            k -= 1;
-        }
-        hull[k] = pt;
-        k += 1;
-    }
-    let lower = k + 1;
-    for &pt in points.iter().rev().skip(1) {
-        while k >= lower && cross(hull[k - 2], hull[k - 1], pt) <= 0.0 {
-            k -= 1;
-        }
-        hull[k] = pt;
-        k += 1;
-    }
-    let n = k.saturating_sub(1);
+pub fn convex_margin(points: &[Vector2<f64>], p: Vector2<f64>) -> f64 {
+    let mut corners: Vec<[f64; 2]> = points.iter().map(|v| [v.x, v.y]).collect();
+    let mut hull = Vec::with_capacity(corners.len());
+    convex_hull(&mut corners, &mut hull);
+    let n = hull.len();
     if n < 3 {
         return f64::NEG_INFINITY;
     }
     (0..n)
         .map(|i| {
-            let (a, b) = (hull[i], hull[(i + 1) % n]);
+            let (a, b) = (Vector2::from(hull[i]), Vector2::from(hull[(i + 1) % n]));
             let edge = b - a;
             edge.perp(&(p - a)) / edge.norm()
         })
@@ -508,7 +491,7 @@ impl MetricsRecorder {
                     .extend(outline.iter().map(|c| corner(c).xy().coords));
             }
         }
-        let margin = convex_margin(&mut self.points, frame.com.xy());
+        let margin = convex_margin(&self.points, frame.com.xy());
         self.min_margin = self.min_margin.min(margin);
         if margin < 0.0 {
             self.outside += 1;

@@ -146,3 +146,30 @@ impl InequalityTask for ComPolygonTask {
         self
     }
 }
+
+/// The convex hull of `points` (m), counter-clockwise seen from above without repeated or
+/// collinear vertices (Andrew's monotone chain), written into `hull`; `points` is reordered.
+/// Fewer than three vertices when the points are all on a line.
+pub fn convex_hull(points: &mut [[f64; 2]], hull: &mut Vec<[f64; 2]>) {
+    points.sort_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])));
+    let turns_left = |hull: &[[f64; 2]], p: [f64; 2]| {
+        let (o, a) = (hull[hull.len() - 2], hull[hull.len() - 1]);
+        (a[0] - o[0]) * (p[1] - o[1]) - (a[1] - o[1]) * (p[0] - o[0]) > 0.0
+    };
+    hull.clear();
+    for &p in points.iter() {
+        while hull.len() >= 2 && !turns_left(hull, p) {
+            hull.pop();
+        }
+        hull.push(p);
+    }
+    let lower = hull.len() + 1;
+    for &p in points.iter().rev().skip(1) {
+        while hull.len() >= lower && !turns_left(hull, p) {
+            hull.pop();
+        }
+        hull.push(p);
+    }
+    // The last point pushed is the first vertex again.
+    hull.pop();
+}
