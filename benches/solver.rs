@@ -48,16 +48,18 @@ impl Case {
         StackShape::from_level_rows(N, &rows)
     }
 
+    /// Writes the case's levels into the solver's levels `first..`, and the two gradient tasks.
     fn fill(
         &self,
         solver: &mut Solver,
+        first: usize,
         q: &[f64],
         limits: &JointLimitAvoidance,
         tracking: &JointTracking,
     ) {
         let stack = solver.stack_mut();
         for (l, (jac, target)) in self.levels.iter().enumerate() {
-            let mut level = stack.level_mut(l);
+            let mut level = stack.level_mut(first + l);
             let mut view = level.jacobian_mut();
             for i in 0..jac.nrows() {
                 for j in 0..N {
@@ -111,7 +113,7 @@ fn bench(c: &mut Criterion) {
 
     for case in [Case::new("RS", &[2, 9]), Case::new("DS", &[2, 11])] {
         let mut solver = Solver::new(&case.shape()).unwrap();
-        case.fill(&mut solver, &q_mid, &limits, &tracking);
+        case.fill(&mut solver, 0, &q_mid, &limits, &tracking);
         let clamped = solver
             .solve(&q_mid, &clamp_bounds, dt)
             .unwrap()
@@ -130,13 +132,13 @@ fn bench(c: &mut Criterion) {
         let mut group = c.benchmark_group(format!("solve_{}", case.name));
         group.bench_function("taskstack_no_clamp", |b| {
             b.iter(|| {
-                case.fill(&mut solver, black_box(&q_mid), &limits, &tracking);
+                case.fill(&mut solver, 0, black_box(&q_mid), &limits, &tracking);
                 black_box(solver.solve(&q_mid, &free_bounds, dt).unwrap().velocity[0])
             })
         });
         group.bench_function(format!("taskstack_clamp_{clamped}_joints"), |b| {
             b.iter(|| {
-                case.fill(&mut solver, black_box(&q_mid), &limits, &tracking);
+                case.fill(&mut solver, 0, black_box(&q_mid), &limits, &tracking);
                 black_box(solver.solve(&q_mid, &clamp_bounds, dt).unwrap().velocity[0])
             })
         });
@@ -159,13 +161,13 @@ fn bench_inequalities(c: &mut Criterion) {
     let case = Case::new("RS", &[2, 9]);
     let mut group = c.benchmark_group("solve_inequalities");
     for rows in [0, 10, 30] {
-        let names = [("com_xy", 2)];
-        let hands = [("hands_ankle", 9)];
-        let shape = StackShape::new(N)
-            .with_mixed_level("limits", &[], &[("rows", rows)])
-            .with_level("balance", &names)
-            .with_level("tracking", &hands);
-        let shape = if rows == 0 { case.shape() } else { shape };
+        let shape = match rows {
+            0 => case.shape(),
+            _ => StackShape::new(N)
+                .with_inequality_level("limits", &[("rows", rows)])
+                .with_level("balance", &[("com_xy", 2)])
+                .with_level("tracking", &[("hands_ankle", 9)]),
+        };
         let settings = Settings {
             limits_by_active_set: true,
             ..Settings::default()
@@ -173,20 +175,9 @@ fn bench_inequalities(c: &mut Criterion) {
         let mut solver = Solver::with_settings(&shape, settings).unwrap();
         let mut row_bounds = vec![f64::INFINITY; rows];
         let fill = |solver: &mut Solver, row_bounds: &[f64]| {
-            let stack = solver.stack_mut();
-            let offset = if rows == 0 { 0 } else { 1 };
-            for (l, (jac, target)) in case.levels.iter().enumerate() {
-                let mut level = stack.level_mut(l + offset);
-                let mut view = level.jacobian_mut();
-                for i in 0..jac.nrows() {
-                    for j in 0..N {
-                        view[(i, j)] = jac[(i, j)];
-                    }
-                }
-                level.target_mut().copy_from_slice(target.as_slice());
-            }
+            case.fill(solver, usize::from(rows > 0), &q, &limits, &tracking);
             if rows > 0 {
-                let mut level = stack.level_mut(0);
+                let mut level = solver.stack_mut().level_mut(0);
                 let (mut jac, lower, upper) = level.inequalities_mut();
                 for i in 0..rows {
                     for j in 0..N {
@@ -195,9 +186,6 @@ fn bench_inequalities(c: &mut Criterion) {
                     (lower[i], upper[i]) = (-row_bounds[i], row_bounds[i]);
                 }
             }
-            stack.clear_gradient();
-            stack.add_gradient(-0.10, &limits, &q).unwrap();
-            stack.add_gradient(-0.02, &tracking, &q).unwrap();
         };
         fill(&mut solver, &row_bounds);
         let free = solver.solve(&q, &bounds, 0.01).unwrap().velocity.to_vec();

@@ -458,22 +458,21 @@ impl<'p> Runner<'p> {
         let model = &problem.model;
         let mut set = TaskSet::new(model);
         for (level, name) in problem.level_names.iter().enumerate() {
-            let in_level = problem.tasks.iter().filter(|t| t.level == level);
-            let (polygon, points): (Vec<&ProblemTask>, Vec<&ProblemTask>) =
-                in_level.partition(|t| {
-                    matches!(t.target, Target::Com(_)) && problem.com_polygon_margin.is_some()
-                });
-            let tasks = points
-                .into_iter()
+            let in_level = || problem.tasks.iter().filter(move |t| t.level == level);
+            // With a polygon margin, the CoM task becomes the polygon inequality.
+            let as_polygon = |t: &&ProblemTask| {
+                matches!(t.target, Target::Com(_)) && problem.com_polygon_margin.is_some()
+            };
+            let tasks = in_level()
+                .filter(|t| !as_polygon(t))
                 .map(|t| ready_made(model, t))
                 .collect::<Result<_, _>>()?;
-            let inequalities: Vec<Box<dyn tasks::InequalityTask>> = match polygon.is_empty() {
-                true => Vec::new(),
-                false => vec![Box::new(support_polygon_task(
-                    problem,
-                    problem.com_polygon_margin.unwrap_or(0.0),
-                )?)],
-            };
+            let mut inequalities: Vec<Box<dyn tasks::InequalityTask>> = Vec::new();
+            if let Some(margin) = problem.com_polygon_margin
+                && in_level().any(|t| as_polygon(&t))
+            {
+                inequalities.push(Box::new(support_polygon_task(problem, margin)?));
+            }
             set = set.mixed_level(name, tasks, inequalities);
         }
         let set = set.posture_gradient(POSTURE_GAIN, &problem.q_ref)?;

@@ -41,7 +41,7 @@ use super::householder::{
     apply_reflector, dot, norm, qr_col_pivoting, qr_with_rhs, solve_upper, solve_upper_transposed,
 };
 use super::report::{ActiveInequality, Bound, Solution, SolveReport};
-use super::stack::{StackShape, TaskStack, check_finite_slice, check_len};
+use super::stack::{StackShape, TaskStack, check_finite_slice, check_len, prefix_sums};
 
 pub mod active_set;
 mod weighted_dls;
@@ -317,12 +317,9 @@ impl Solver {
             .zip(shape.level_inequality_rows())
             .map(|(m, p)| m + p)
             .collect();
-        let mut seg_start = vec![0];
-        for c in &capacities {
-            seg_start.push(seg_start[seg_start.len() - 1] + c);
-        }
-        let capacity = seg_start[levels];
         let m_max = capacities.iter().copied().max().unwrap_or(0);
+        let seg_start = prefix_sums(capacities.into_iter());
+        let capacity = seg_start[levels];
         Ok(Self {
             factors: vec![LevelFactor::default(); levels],
             seg_start,
@@ -429,7 +426,6 @@ impl Solver {
         self.report.clamped.clear();
         self.report.clamping_iterations = 0;
         self.scales.fill(1.0);
-        self.inequality_state.fill(None);
         if let Method::WeightedDls { .. } = self.settings.method {
             self.update_limit_weights(q, bounds);
         }
@@ -487,7 +483,6 @@ impl Solver {
         self.report.clamped.clear();
         self.report.clamping_iterations = 1;
         self.scales.fill(1.0);
-        self.inequality_state.fill(None);
         self.pass();
         self.finish_report();
         Ok(Solution {

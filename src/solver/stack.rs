@@ -190,7 +190,8 @@ pub struct TaskStack {
     gradient: Vec<f64>,
 }
 
-fn prefix_sums(counts: impl Iterator<Item = usize>) -> Vec<usize> {
+/// `[0, c₀, c₀ + c₁, …]`: the first index of each block of `counts` rows, and the total.
+pub(crate) fn prefix_sums(counts: impl Iterator<Item = usize>) -> Vec<usize> {
     let mut starts = vec![0];
     for c in counts {
         starts.push(starts.last().copied().unwrap_or(0) + c);

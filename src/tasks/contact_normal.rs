@@ -7,7 +7,7 @@ use std::cell::RefCell;
 use faer::{Mat, MatMut};
 use nalgebra::Vector3;
 
-use super::{Task, TaskError, finite_target};
+use super::{Task, TaskError, combine_rows, finite_target};
 use crate::model::{FrameId, Model, ModelData, ModelError};
 
 /// The one-dimensional task `φ = ⟨ν_k, ν_env⟩ → 1` (eq. 11): the unit normal `ν_k` of a link's
@@ -92,9 +92,7 @@ impl Task for ContactNormalTask {
         let axis = nu.cross(&self.surface_normal);
         let mut j = self.scratch.borrow_mut();
         model.orientation_jacobian(data, self.frame, j.as_mut())?;
-        for col in 0..jacobian.ncols() {
-            jacobian[(0, col)] = (0..3).map(|r| axis[r] * j[(r, col)]).sum();
-        }
+        combine_rows(&axis, j.as_ref(), jacobian.as_mut());
         error[0] = 1.0 - nu.dot(&self.surface_normal);
         Ok(())
     }

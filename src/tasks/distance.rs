@@ -17,7 +17,7 @@ use faer::{Mat, MatMut};
 use nalgebra::Vector3;
 
 use super::inequality::InequalityTask;
-use super::{TaskError, finite_target};
+use super::{TaskError, combine_rows, finite_target};
 use crate::model::{FrameId, Model, ModelData, ModelError};
 
 /// A segment `[a, b]` fixed in a frame (m, in the frame's axes), swept by a sphere of `radius`
@@ -118,6 +118,23 @@ pub fn closest_segment_parameters(
     (s, t)
 }
 
+/// The closest approach of two capsules.
+struct Closest {
+    /// Signed distance (m; < 0 when they overlap).
+    distance: f64,
+    /// Unit direction from the second capsule's closest point to the first's.
+    normal: Vector3<f64>,
+    /// Parameters of the closest points on the first and second segments.
+    s: f64,
+    t: f64,
+}
+
+/// The distance row of a task: `margin − d ≤ C δq ≤ +∞`.
+fn write_room(margin: f64, distance: f64, lower: &mut [f64], upper: &mut [f64]) {
+    lower[0] = margin - distance;
+    upper[0] = f64::INFINITY;
+}
+
 fn check_margin(task: &str, margin: f64) -> Result<(), TaskError> {
     finite_target(task, &[margin])?;
     if margin < 0.0 {
@@ -163,18 +180,13 @@ impl CapsuleDistanceTask {
         })
     }
 
-    /// The signed distance `d` (m; < 0 when the capsules overlap), the closest points in the
-    /// base frame, and their parameters on the segments.
+    /// The signed distance `d` (m; < 0 when the capsules overlap) at the forward kinematics in
+    /// `data`.
     pub fn distance(&self, model: &Model, data: &ModelData) -> Result<f64, ModelError> {
-        Ok(self.closest(model, data)?.0)
+        Ok(self.closest(model, data)?.distance)
     }
 
-    #[allow(clippy::type_complexity)]
-    fn closest(
-        &self,
-        model: &Model,
-        data: &ModelData,
-    ) -> Result<(f64, Vector3<f64>, (f64, f64)), ModelError> {
+    fn closest(&self, model: &Model, data: &ModelData) -> Result<Closest, ModelError> {
         let [p1, q1] = self.first.ends(model, data)?;
         let [p2, q2] = self.second.ends(model, data)?;
         let (s, t) = closest_segment_parameters(&p1, &q1, &p2, &q2);
@@ -192,8 +204,12 @@ impl CapsuleDistanceTask {
                 Vector3::z()
             }
         };
-        let d = length - self.first.radius - self.second.radius;
-        Ok((d, normal, (s, t)))
+        Ok(Closest {
+            distance: length - self.first.radius - self.second.radius,
+            normal,
+            s,
+            t,
+        })
     }
 }
 
@@ -214,16 +230,15 @@ impl InequalityTask for CapsuleDistanceTask {
         lower: &mut [f64],
         upper: &mut [f64],
     ) -> Result<(), ModelError> {
-        let (d, n, (s, t)) = self.closest(model, data)?;
+        let closest = self.closest(model, data)?;
         let mut scratch = self.scratch.borrow_mut();
         let (j1, j2) = &mut *scratch;
-        model.point_jacobian(data, self.first.frame, &self.first.local(s), j1.as_mut())?;
-        model.point_jacobian(data, self.second.frame, &self.second.local(t), j2.as_mut())?;
-        for col in 0..jacobian.ncols() {
-            jacobian[(0, col)] = (0..3).map(|r| n[r] * (j1[(r, col)] - j2[(r, col)])).sum();
-        }
-        lower[0] = self.margin - d;
-        upper[0] = f64::INFINITY;
+        let (first, second) = (self.first.local(closest.s), self.second.local(closest.t));
+        model.point_jacobian(data, self.first.frame, &first, j1.as_mut())?;
+        model.point_jacobian(data, self.second.frame, &second, j2.as_mut())?;
+        *j1 -= &*j2;
+        combine_rows(&closest.normal, j1.as_ref(), jacobian.as_mut());
+        write_room(self.margin, closest.distance, lower, upper);
         Ok(())
     }
 
@@ -278,11 +293,13 @@ impl PlaneDistanceTask {
         })
     }
 
-    /// The signed distance `d` (m) and the segment parameter of the nearest point.
+    /// The signed distance `d` (m; < 0 when the capsule cuts the plane) at the forward
+    /// kinematics in `data`.
     pub fn distance(&self, model: &Model, data: &ModelData) -> Result<f64, ModelError> {
         Ok(self.nearest(model, data)?.0)
     }
 
+    /// The signed distance and the segment parameter of the point nearest the plane.
     fn nearest(&self, model: &Model, data: &ModelData) -> Result<(f64, f64), ModelError> {
         let [a, b] = self.capsule.ends(model, data)?;
         let (ha, hb) = (
@@ -321,11 +338,8 @@ impl InequalityTask for PlaneDistanceTask {
         let mut j = self.scratch.borrow_mut();
         let offset = self.capsule.local(s);
         model.point_jacobian(data, self.capsule.frame, &offset, j.as_mut())?;
-        for col in 0..jacobian.ncols() {
-            jacobian[(0, col)] = (0..3).map(|r| self.normal[r] * j[(r, col)]).sum();
-        }
-        lower[0] = self.margin - d;
-        upper[0] = f64::INFINITY;
+        combine_rows(&self.normal, j.as_ref(), jacobian.as_mut());
+        write_room(self.margin, d, lower, upper);
         Ok(())
     }
 

@@ -49,7 +49,8 @@ mod set;
 use std::any::Any;
 use std::fmt::Debug;
 
-use faer::MatMut;
+use faer::{MatMut, MatRef};
+use nalgebra::Vector3;
 use thiserror::Error;
 
 use crate::model::{Model, ModelData, ModelError};
@@ -136,6 +137,14 @@ pub trait Task: Debug + Any {
 
     /// `self` as [`Any`], so that [`TaskSet::task_mut`] can hand back the concrete type.
     fn as_any_mut(&mut self) -> &mut dyn Any;
+}
+
+/// Writes `wᵀ J` into the one-row view `out`, for a 3 × nv Jacobian `j` (a direction times a
+/// point or orientation Jacobian: a distance's or an alignment's rate).
+pub(crate) fn combine_rows(weights: &Vector3<f64>, j: MatRef<'_, f64>, mut out: MatMut<'_, f64>) {
+    for col in 0..out.ncols() {
+        out[(0, col)] = (0..3).map(|r| weights[r] * j[(r, col)]).sum();
+    }
 }
 
 /// The model's joint position and velocity limits as solver bounds (radians or metres, and per

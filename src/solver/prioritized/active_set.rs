@@ -93,6 +93,15 @@ enum Constraint {
 /// The most unwanted bound found so far at one level, and how unwanted (a negative pull).
 type Worst = Option<(f64, Constraint)>;
 
+/// How much a row or joint held at `bound` is wanted there, from the signed amount `toward_upper`
+/// by which something pushes it toward its upper side (a residual or a multiplier).
+fn pull(bound: Bound, toward_upper: f64) -> f64 {
+    match bound {
+        Bound::Upper => toward_upper,
+        Bound::Lower => -toward_upper,
+    }
+}
+
 /// Records a bound's pull (how much a level wants it held: > 0 wanted, < 0 not): a clear answer
 /// decides its fate; an unwanted one is a release candidate.
 fn judge(pull: f64, tolerance: f64, bound: Constraint, decided: &mut bool, worst: &mut Worst) {
@@ -213,7 +222,7 @@ impl Solver {
                 );
             }
         }
-        let tolerance = self.settings.feasibility_tolerance;
+        let slack = |bound: f64| self.settings.feasibility_tolerance * (1.0 + bound.abs());
         for r in 0..self.stack.total_inequality_rows() {
             if self.inequality_state[r].is_some() {
                 continue;
@@ -221,13 +230,14 @@ impl Solver {
             let row = self.stack.inequality_row(r);
             let (value, change) = (dot(row, &ws.point), dot(row, &ws.direction));
             let (lower, upper) = self.stack.inequality_bounds(r);
-            if value > upper + tolerance * (1.0 + upper.abs()) {
+            let (above, below) = (upper + slack(upper), lower - slack(lower));
+            if value > above {
                 consider(0.0, Constraint::Row(r, Bound::Upper));
-            } else if value < lower - tolerance * (1.0 + lower.abs()) {
+            } else if value < below {
                 consider(0.0, Constraint::Row(r, Bound::Lower));
-            } else if value + change > upper + tolerance * (1.0 + upper.abs()) {
+            } else if value + change > above {
                 consider((upper - value) / change, Constraint::Row(r, Bound::Upper));
-            } else if value + change < lower - tolerance * (1.0 + lower.abs()) {
+            } else if value + change < below {
                 consider((lower - value) / change, Constraint::Row(r, Bound::Lower));
             }
         }
@@ -291,13 +301,9 @@ impl Solver {
             };
             let (row, value) = used_row(&self.stack, self.used[seg + t], 1.0);
             let reached = dot(row, &self.active_set.point);
-            let pull = match bound {
-                Bound::Upper => reached - value,
-                Bound::Lower => value - reached,
-            };
             let decided = &mut self.active_set.decided_rows[r];
             judge(
-                pull,
+                pull(bound, reached - value),
                 tolerance * (1.0 + value.abs()),
                 Constraint::Row(r, bound),
                 decided,
@@ -379,10 +385,9 @@ impl Solver {
                 if ws.decided_rows[r] {
                     continue;
                 }
-                let nu = ws.multipliers[seg + t];
-                let pull = if bound == Bound::Upper { nu } else { -nu };
+                let wanted = pull(bound, ws.multipliers[seg + t]);
                 let c = Constraint::Row(r, bound);
-                judge(pull, tolerance, c, &mut ws.decided_rows[r], worst);
+                judge(wanted, tolerance, c, &mut ws.decided_rows[r], worst);
             }
         }
         for i in 0..self.stack.dof() {
@@ -390,15 +395,14 @@ impl Solver {
             if !self.clamped[i] || ws.decided_joints[i] || self.step_lo[i] >= self.step_hi[i] {
                 continue;
             }
-            let nu = ws.residual[i];
             let bound = if self.fixed_velocity[i] == self.step_hi[i] {
                 Bound::Upper
             } else {
                 Bound::Lower
             };
-            let pull = if bound == Bound::Upper { nu } else { -nu };
+            let wanted = pull(bound, ws.residual[i]);
             let c = Constraint::Joint(i, bound);
-            judge(pull, tolerance, c, &mut ws.decided_joints[i], worst);
+            judge(wanted, tolerance, c, &mut ws.decided_joints[i], worst);
         }
     }
 }
