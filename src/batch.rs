@@ -519,6 +519,12 @@ pub fn metrics_value(m: &ImitationMetrics, clip: &Path) -> Value {
         "max_held_foot_slip_m": m.max_held_foot_slip,
         "max_held_foot_turn_rad": m.max_held_foot_turn,
         "solve_time_us": spread(&m.solve_time_us),
+        "self_clearance": m.self_clearance.as_ref().map(|c| json!({
+            "min_distance_m": c.min_distance,
+            "closest": c.closest,
+            "margin_m": c.margin,
+            "frames_below_margin": c.frames_below_margin,
+        })),
         "tracking_error_clip": effector_map(&m.effectors_clip),
         "tracking_error_clip_lag_removed": effector_map(&m.hands_clip_lag_removed),
         "hand_lag_s": m.hand_lag_s,

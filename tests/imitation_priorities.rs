@@ -2,7 +2,9 @@
 //! (the executable tables the imitator uses and the contact-first variant of Table I),
 //! at random configurations within the limits and random task velocities, the residual of each
 //! level is the same (to 1e-9 relative) whether or not the levels below it and the gradient tasks
-//! are present. Jacobians come from the DH NAO rooted at the table's sole.
+//! are present. Jacobians come from the DH NAO rooted at the table's sole. The executable tables'
+//! self-collision level is kept with its bounds open (±∞, never active): the bounds' own tests
+//! are `solver_inequalities`.
 
 use nalgebra::Vector3;
 use proptest::prelude::*;
@@ -20,6 +22,10 @@ fn model(foot: Side) -> Model {
     }
 }
 
+fn borrowed(named: &[(String, usize)]) -> Vec<(&str, usize)> {
+    named.iter().map(|(n, r)| (n.as_str(), *r)).collect()
+}
+
 /// A solver for the first `levels` levels of `table`, filled at `q` with desired velocities
 /// from `targets` (one per row, in stack order) and, if given, a gradient term.
 fn filled(
@@ -34,9 +40,11 @@ fn filled(
     let shape = full.levels()[..levels]
         .iter()
         .fold(StackShape::new(model.nv()), |s, l| {
-            let tasks: Vec<(&str, usize)> =
-                l.tasks.iter().map(|t| (t.name.as_str(), t.rows)).collect();
-            s.with_level(&l.name, &tasks)
+            let named = |specs: &[taskstack::solver::TaskSpec]| -> Vec<(String, usize)> {
+                specs.iter().map(|t| (t.name.clone(), t.rows)).collect()
+            };
+            let (tasks, inequalities) = (named(&l.tasks), named(&l.inequalities));
+            s.with_mixed_level(&l.name, &borrowed(&tasks), &borrowed(&inequalities))
         });
     let mut solver = Solver::new(&shape).unwrap();
     let mut data = model.new_data();

@@ -281,3 +281,45 @@ fn com_polygon_level_keeps_the_com_inside_while_a_hand_reaches() {
     assert!(held[1].abs() <= 0.02 - margin + 1e-4 && held[0] >= -0.03 + margin - 1e-4);
     assert!(active > 0, "the front edge is active");
 }
+
+/// A stack of one distance inequality alone, started 2 cm inside the margin: the driver keeps
+/// iterating while the violation shrinks (no equality error to watch) and ends with the bodies
+/// at the margin, a few iterations later.
+#[test]
+fn an_inequality_only_stack_is_driven_out_of_violation() {
+    let model = nao::rfoot();
+    let mut q = nao::profile().stand.clone();
+    let r_elbow_roll = model.variable_index("RElbowRoll").unwrap();
+    let r_shoulder_roll = model.variable_index("RShoulderRoll").unwrap();
+    q[r_elbow_roll] = 1.5;
+    q[r_shoulder_roll] = 0.3;
+    let torso = Capsule::new(
+        &model,
+        "torso",
+        Vector3::new(0.0, 0.0, -0.045),
+        Vector3::new(0.0, 0.0, 0.06),
+        0.055,
+    )
+    .unwrap();
+    let margin = 0.01;
+    let forearm = forearm(&model, "r");
+    let task = CapsuleDistanceTask::new(&model, "apart", forearm, torso, margin).unwrap();
+    let start = task.distance(&model, &data_at(&model, &q)).unwrap();
+    assert!(start < margin - 0.015, "starts inside the margin: {start}");
+    let mut set = TaskSet::new(&model).inequality_level("apart", vec![Box::new(task)]);
+    let mut solver = Solver::new(&set.shape()).unwrap();
+    let mut driver = PositionDriver::new(&solver, DriverSettings::default()).unwrap();
+    let report = driver
+        .run(
+            &mut solver,
+            &mut set,
+            &mut q,
+            &joint_bounds(&model).unwrap(),
+        )
+        .unwrap()
+        .clone();
+    let task: &mut CapsuleDistanceTask = set.inequality_mut("apart").unwrap();
+    let end = task.distance(&model, &data_at(&model, &q)).unwrap();
+    assert!(report.iterations > 1, "{report:?}");
+    assert!(end >= margin - 1e-4, "ends {end} m apart, {report:?}");
+}

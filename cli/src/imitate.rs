@@ -145,6 +145,17 @@ fn print_summary(
         m.max_held_foot_slip * 1000.0,
         m.max_held_foot_turn.to_degrees()
     );
+    if let Some(c) = &m.self_clearance {
+        let _ = writeln!(
+            text,
+            "self-collision: bodies at least {:.1} mm apart ({} and {}; margin {:.0} mm, {} frames closer)",
+            c.min_distance * 1000.0,
+            c.closest[0],
+            c.closest[1],
+            c.margin * 1000.0,
+            c.frames_below_margin
+        );
+    }
     let t = &m.travel;
     let _ = writeln!(
         text,

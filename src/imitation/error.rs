@@ -10,6 +10,7 @@ use super::tables::TableError;
 use crate::model::ModelError;
 use crate::robots::ProfileError;
 use crate::solver::SolverError;
+use crate::tasks::TaskError;
 
 /// Errors of the imitator.
 #[derive(Debug, Error)]
@@ -30,6 +31,9 @@ pub enum ImitationError {
     /// A task table is invalid.
     #[error(transparent)]
     Table(#[from] TableError),
+    /// A table's constraint could not be built (e.g. a body's geometry).
+    #[error(transparent)]
+    Task(#[from] TaskError),
     /// Invalid phase-machine configuration.
     #[error(transparent)]
     Phase(#[from] PhaseError),

@@ -15,12 +15,15 @@
 //! * **Locomotion and timing** ([`super::travel`]): travel of the scaled human and of the robot,
 //!   steps of both, catch-up time after the clip, the hands' lag; tracking errors over the clip's
 //!   own frames apart from the hold that follows it ([`MetricsRecorder::mark_clip_end`]).
+//! * **Self-collision clearance** ([`super::clearance`]): the smallest distance of the
+//!   profile's paired bodies over the run (m), and the frames closer than the margin.
 //! * **Support changes and transitions**: changes of the human's support and of the robot's
 //!   continuous phase (DS, RS, LS); the time from leaving one continuous phase to reaching the
 //!   next (s). **Solve time** per frame (µs).
 
 use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 
+use super::clearance::{ClearanceMeter, SelfClearance};
 use super::imitator::{Imitator, RobotFrame};
 use super::phase::SupportPhase;
 use super::support::HumanSupport;
@@ -249,6 +252,8 @@ pub struct ImitationMetrics {
     /// Seconds after the clip's end until the robot stood where the scaled human stands, or
     /// `None` if it never did (or the clip's end was not marked).
     pub catch_up_s: Option<f64>,
+    /// How close the paired bodies came; `None` when the profile has no self-collision pairs.
+    pub self_clearance: Option<SelfClearance>,
 }
 
 /// Accumulates [`ImitationMetrics`] frame by frame.
@@ -288,6 +293,7 @@ pub struct MetricsRecorder {
     single_clip: Vec<Series>,
     double_clip: Vec<Series>,
     hands: HandTrace,
+    clearance: Option<ClearanceMeter>,
     travel: TravelRecorder,
     human_steps: StepCounter,
     robot_steps: StepCounter,
@@ -404,6 +410,8 @@ impl MetricsRecorder {
             single_clip: vec![Series::default(); EFFECTORS.len()],
             double_clip: vec![Series::default(); EFFECTORS.len()],
             hands: HandTrace::default(),
+            // The imitator validated its profile, so its pairs resolve.
+            clearance: ClearanceMeter::new(profile).ok().flatten(),
             travel: TravelRecorder::default(),
             human_steps: StepCounter::default(),
             robot_steps: StepCounter::default(),
@@ -427,6 +435,10 @@ impl MetricsRecorder {
         }
         self.record_balance(frame);
         self.record_limits(frame);
+        if let Some(meter) = &mut self.clearance {
+            // The frame's q has the model's length: the imitator wrote it.
+            meter.record(&frame.q).ok();
+        }
         let standing = standing_feet(frame.phase);
         self.record_slip(frame, standing);
 
@@ -630,6 +642,7 @@ impl MetricsRecorder {
             robot_steps: self.robot_steps.steps(),
             queued_steps_at_end: self.pending,
             catch_up_s: self.travel.catch_up(),
+            self_clearance: self.clearance.as_ref().and_then(ClearanceMeter::clearance),
         }
     }
 }

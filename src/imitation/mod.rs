@@ -11,6 +11,7 @@
 //! [`imitator::Imitator`] runs the whole pipeline frame by frame; [`crate::batch`] runs it over
 //! many clips in parallel.
 
+pub mod clearance;
 pub mod config;
 pub mod error;
 pub mod footsteps;

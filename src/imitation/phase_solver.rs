@@ -9,7 +9,8 @@ use nalgebra::{Rotation3, Vector2, Vector3};
 use super::error::ImitationError;
 use super::footsteps::GroundPose;
 use super::tables::{
-    Axes, ComGoal, Gradient, GradientKind, OrientationTarget, PointTarget, Task, TaskTable,
+    Axes, ComGoal, Constraint, Gradient, GradientKind, OrientationTarget, PointTarget, Task,
+    TaskTable,
 };
 use crate::human::HumanJoint;
 use crate::model::{Axis, FrameId, Model, ModelData};
@@ -18,7 +19,9 @@ use crate::solver::driver::{DriverReport, DriverSettings, PositionDriver, TaskMo
 use crate::solver::{
     JointBounds, JointLimitAvoidance, JointTracking, Settings, SolveReport, Solver, TaskStack,
 };
-use crate::tasks::{FramePoint, com_rows, orientation_rows, point_rows};
+use crate::tasks::{
+    CapsuleDistanceTask, FramePoint, InequalityTask, com_rows, orientation_rows, point_rows,
+};
 
 /// A task of a table, resolved against a model: frame, axes, where its rows are.
 #[derive(Debug, Clone)]
@@ -39,6 +42,15 @@ struct ResolvedTask {
     held: Vector3<f64>,
     /// Held heading (yaw of the frame's x axis when the step began), rad, root frame.
     held_yaw: f64,
+}
+
+/// A constraint of a table, resolved against a model: its rows and where they are.
+#[derive(Debug, Clone)]
+struct ResolvedConstraint {
+    rows: CapsuleDistanceTask,
+    level: usize,
+    /// First row among the level's inequality rows.
+    row: usize,
 }
 
 /// What the tasks of a phase aim at in one frame, in the model root's frame.
@@ -68,6 +80,7 @@ pub(super) struct Criteria<'a> {
 pub(super) struct PhaseSolver {
     pub(super) table: TaskTable,
     tasks: Vec<ResolvedTask>,
+    constraints: Vec<ResolvedConstraint>,
     solver: Solver,
     driver: PositionDriver,
     other_ankle: FrameId,
@@ -144,12 +157,14 @@ impl PhaseSolver {
                 row += task.rows();
             }
         }
+        let constraints = resolve_constraints(table, profile, model)?;
         let solver = Solver::with_settings(&table.shape(model.nv()), settings)?;
         let driver = PositionDriver::new(&solver, DriverSettings::default())?;
         let other = profile.foot(table.model_root.other());
         Ok(Self {
             table: table.clone(),
             tasks,
+            constraints,
             solver,
             driver,
             other_ankle: model.frame_id(&other.ankle)?,
@@ -251,6 +266,7 @@ impl PhaseSolver {
             model,
             data,
             tasks: &self.tasks,
+            constraints: &self.constraints,
             targets,
             orientation_rows: &mut self.orientation_rows,
             gradients: &self.table.gradients,
@@ -260,11 +276,40 @@ impl PhaseSolver {
     }
 }
 
+/// The table's constraints as inequality tasks on `model`, the bodies from the profile's
+/// self-collision model.
+fn resolve_constraints(
+    table: &TaskTable,
+    profile: &BipedProfile,
+    model: &Model,
+) -> Result<Vec<ResolvedConstraint>, ImitationError> {
+    let bodies = &profile.self_collision;
+    let mut out = Vec::new();
+    for (level, l) in table.levels.iter().enumerate() {
+        let mut row = 0;
+        for constraint in &l.constraints {
+            let Constraint::Distance {
+                first,
+                second,
+                margin,
+            } = constraint;
+            let [first, second] =
+                [first, second].map(|name| bodies.body(name)?.capsule(model, &profile.stand));
+            let rows =
+                CapsuleDistanceTask::new(model, &constraint.name(), first?, second?, *margin)?;
+            out.push(ResolvedConstraint { rows, level, row });
+            row += constraint.rows();
+        }
+    }
+    Ok(out)
+}
+
 /// The `TaskModel` of one phase at one frame.
 struct PhaseTasks<'a> {
     model: &'a Model,
     data: &'a mut ModelData,
     tasks: &'a [ResolvedTask],
+    constraints: &'a [ResolvedConstraint],
     targets: FrameTargets<'a>,
     orientation_rows: &'a mut Mat<f64>,
     gradients: &'a [Gradient],
@@ -326,6 +371,18 @@ impl TaskModel for PhaseTasks<'_> {
             let mut level = stack.level_mut(task.level);
             let (jacobian, target) = level.rows_mut(task.row, task.rows);
             self.write(task, jacobian, target)?;
+        }
+        for c in self.constraints {
+            let mut level = stack.level_mut(c.level);
+            let (mut jacobian, lower, upper) = level.inequalities_mut();
+            let rows = c.row..c.row + c.rows.rows();
+            c.rows.write(
+                self.model,
+                self.data,
+                jacobian.as_mut().subrows_mut(c.row, c.rows.rows()),
+                &mut lower[rows.clone()],
+                &mut upper[rows],
+            )?;
         }
         stack.clear_gradient();
         for g in self.gradients {

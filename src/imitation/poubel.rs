@@ -95,15 +95,21 @@ fn phase_solvers(
     q: &[f64],
     solver: Settings,
 ) -> Result<Vec<PhaseSolver>, ImitationError> {
-    // Scale to fit: when the velocity limits bind, the whole step slows down uniformly instead
-    // of the clamping loop pinning joints the balance level needs.
-    let settings = Settings {
-        scale_to_fit: true,
-        ..solver
-    };
     SupportPhase::ALL
         .iter()
-        .map(|&phase| PhaseSolver::new(tables.table(phase), profile, q, settings))
+        .map(|&phase| {
+            let table = tables.table(phase);
+            // Scale to fit: when the velocity limits bind, the whole step slows down uniformly
+            // instead of the clamping loop pinning joints the balance level needs. A table with
+            // inequalities has the joint intervals as the top inequalities of the active set
+            // instead, which never pins a joint a level needs either.
+            let inequalities = table.levels.iter().any(|l| !l.constraints.is_empty());
+            let settings = Settings {
+                scale_to_fit: !inequalities,
+                ..solver
+            };
+            PhaseSolver::new(table, profile, q, settings)
+        })
         .collect()
 }
 

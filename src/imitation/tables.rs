@@ -277,13 +277,63 @@ impl Task {
     }
 }
 
-/// An equality level: tasks of equal priority, stacked in order.
+/// An inequality of a level: a row kept within bounds instead of driven to a target.
 #[derive(Clone, Debug, PartialEq)]
+pub enum Constraint {
+    /// Two bodies of the profile's self-collision model
+    /// ([`BipedProfile::self_collision`](crate::robots::BipedProfile::self_collision), by name)
+    /// kept at least `margin` apart (m), 1 row.
+    Distance {
+        /// The first body's name, e.g. `"l_forearm"`.
+        first: String,
+        /// The second body's name, e.g. `"torso"`.
+        second: String,
+        /// Smallest surface-to-surface distance (m, ≥ 0).
+        margin: f64,
+    },
+}
+
+impl Constraint {
+    /// The constraint's name in the stack: `"d(l_forearm,torso)"`.
+    pub fn name(&self) -> String {
+        match self {
+            Constraint::Distance { first, second, .. } => format!("d({first},{second})"),
+        }
+    }
+
+    /// Number of rows.
+    pub fn rows(&self) -> usize {
+        1
+    }
+}
+
+/// A level: tasks of equal priority, stacked in order, and the inequalities solved at the same
+/// priority.
+#[derive(Clone, Debug, PartialEq, Default)]
 pub struct Level {
     /// Level name (`"balance"`, `"tracking"`).
     pub name: String,
-    /// The tasks.
+    /// The equality tasks.
     pub tasks: Vec<Task>,
+    /// The inequalities.
+    pub constraints: Vec<Constraint>,
+}
+
+impl Level {
+    /// A level of equality tasks.
+    pub fn of_tasks(name: &str, tasks: Vec<Task>) -> Self {
+        Self {
+            name: name.to_owned(),
+            tasks,
+            constraints: Vec::new(),
+        }
+    }
+
+    /// Rows of the equality tasks and of the inequalities.
+    fn rows(&self) -> usize {
+        let tasks: usize = self.tasks.iter().map(Task::rows).sum();
+        tasks + self.constraints.iter().map(Constraint::rows).sum::<usize>()
+    }
 }
 
 /// An optimization (gradient) task.
@@ -364,6 +414,16 @@ pub enum TableError {
         /// Which number.
         field: &'static str,
     },
+    /// A distance constraint's margin is negative or not finite.
+    #[error("task table {phase}: margin {margin} m of {constraint:?} is not finite and ≥ 0")]
+    InvalidMargin {
+        /// The table's phase.
+        phase: SupportPhase,
+        /// The constraint's name.
+        constraint: String,
+        /// The margin (m).
+        margin: f64,
+    },
 }
 
 fn foot_name(foot: Side) -> &'static str {
@@ -425,6 +485,24 @@ fn outer_edge(profile: &BipedProfile, foot: Side) -> [f64; 3] {
         Side::Right => ys.fold(0.0, f64::min),
     };
     [0.0, y, 0.0]
+}
+
+/// The "collision" level of the executable tables: every self-collision pair of the profile
+/// kept at its margin; none when the profile has no pairs.
+fn self_collision_level(profile: &BipedProfile) -> Option<Level> {
+    let collision = &profile.self_collision;
+    let constraints: Vec<Constraint> = (collision.pairs.iter())
+        .map(|[first, second]| Constraint::Distance {
+            first: first.clone(),
+            second: second.clone(),
+            margin: collision.margin,
+        })
+        .collect();
+    (!constraints.is_empty()).then(|| Level {
+        name: "collision".to_owned(),
+        tasks: Vec::new(),
+        constraints,
+    })
 }
 
 fn human_ankle(foot: Side) -> HumanJoint {
@@ -520,14 +598,8 @@ impl TaskTable {
             phase,
             model_root: root,
             levels: vec![
-                Level {
-                    name: "balance".to_owned(),
-                    tasks: vec![Task::ComXY(com)],
-                },
-                Level {
-                    name: "tracking".to_owned(),
-                    tasks: tracking,
-                },
+                Level::of_tasks("balance", vec![Task::ComXY(com)]),
+                Level::of_tasks("tracking", tracking),
             ],
             gradients: vec![
                 Gradient {
@@ -601,17 +673,8 @@ impl TaskTable {
                 other => rest.push(other),
             }
         }
-        table.levels.insert(
-            0,
-            Level {
-                name: "contact".to_owned(),
-                tasks: contact,
-            },
-        );
-        table.levels.push(Level {
-            name: "tracking".to_owned(),
-            tasks: rest,
-        });
+        table.levels.insert(0, Level::of_tasks("contact", contact));
+        table.levels.push(Level::of_tasks("tracking", rest));
         table
     }
 
@@ -634,6 +697,12 @@ impl TaskTable {
     ///   stance foot instead of the whole robot leaning 16° sideways, which put the swing foot
     ///   on the floor early when a servo sagged; and a hand out of reach cannot stretch the
     ///   legs straight (a singular, slow posture to step from).
+    /// * **Bodies keep apart** ("collision", below the balance level, when the profile has a
+    ///   self-collision model): every pair of
+    ///   [`BipedProfile::self_collision`](crate::robots::BipedProfile::self_collision) at least
+    ///   its margin apart, as inequalities ([`Constraint::Distance`]). Below contact and
+    ///   balance, so that a foot on the ground never slides to make room; above the posture,
+    ///   the swing foot and the hands, which go around the body instead of through it.
     /// * **Feet go where the human's went.** In single support the free foot is carried flat at
     ///   the lift height ρ ("swing": ankle height and sole orientation) to the target footprint
     ///   of the step ([`super::footsteps`]: the human's footprint, scaled and clipped to the step
@@ -703,12 +772,10 @@ impl TaskTable {
                 vec![carried(Axes::XY)],
             ]
         });
-        let level = |name: &str, tasks| Level {
-            name: name.to_owned(),
-            tasks,
-        };
+        let level = Level::of_tasks;
         let mut levels: Vec<Level> = contact.map(|c| level("contact", c)).into_iter().collect();
         levels.push(level("balance", vec![Task::ComXY(com)]));
+        levels.extend(self_collision_level(profile));
         levels.push(level(
             "posture",
             vec![
@@ -740,16 +807,17 @@ impl TaskTable {
     }
 
     /// The solver stack shape over `dof` joints: one level per [`Level`], one named task (see
-    /// [`Task::name`]) per [`Task`].
+    /// [`Task::name`], [`Constraint::name`]) per [`Task`] and [`Constraint`].
     pub fn shape(&self, dof: usize) -> StackShape {
         self.levels
             .iter()
             .fold(StackShape::new(dof), |shape, level| {
-                let names: Vec<(String, usize)> =
+                let tasks: Vec<(String, usize)> =
                     level.tasks.iter().map(|t| (t.name(), t.rows())).collect();
-                let tasks: Vec<(&str, usize)> =
-                    names.iter().map(|(n, r)| (n.as_str(), *r)).collect();
-                shape.with_level(&level.name, &tasks)
+                let constraints: Vec<(String, usize)> = (level.constraints.iter())
+                    .map(|c| (c.name(), c.rows()))
+                    .collect();
+                shape.with_mixed_level(&level.name, &borrowed(&tasks), &borrowed(&constraints))
             })
     }
 
@@ -762,7 +830,7 @@ impl TaskTable {
         }
         let mut names = HashSet::new();
         for level in &self.levels {
-            if level.tasks.iter().map(Task::rows).sum::<usize>() == 0 {
+            if level.rows() == 0 {
                 return Err(TableError::EmptyLevel {
                     phase,
                     level: level.name.clone(),
@@ -803,6 +871,20 @@ impl TaskTable {
                     return Err(TableError::DuplicateTask { phase, task: name });
                 }
             }
+            for constraint in &level.constraints {
+                let name = constraint.name();
+                let Constraint::Distance { margin, .. } = constraint;
+                if !(margin.is_finite() && *margin >= 0.0) {
+                    return Err(TableError::InvalidMargin {
+                        phase,
+                        constraint: name,
+                        margin: *margin,
+                    });
+                }
+                if !names.insert(name.clone()) {
+                    return Err(TableError::DuplicateTask { phase, task: name });
+                }
+            }
         }
         if let Some(g) = self.gradients.iter().find(|g| !g.kappa.is_finite()) {
             return Err(TableError::NotFinite {
@@ -813,6 +895,11 @@ impl TaskTable {
         }
         Ok(())
     }
+}
+
+/// `(name, rows)` pairs with borrowed names, as [`StackShape`] takes them.
+fn borrowed(named: &[(String, usize)]) -> Vec<(&str, usize)> {
+    named.iter().map(|(n, r)| (n.as_str(), *r)).collect()
 }
 
 /// Millimetres of a length in metres, for the rendering (`0.03` → `"30 mm"`, `0.0` → `"0"`).
@@ -919,6 +1006,14 @@ impl fmt::Display for TaskTable {
                         });
                     }
                 }
+            }
+            for constraint in &level.constraints {
+                let Constraint::Distance {
+                    first,
+                    second,
+                    margin,
+                } = constraint;
+                cells.push(format!("d({first}, {second}) ≥ {}", mm(*margin)));
             }
             if !cells.is_empty() {
                 tracked.push(cells.join(", "));

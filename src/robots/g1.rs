@@ -25,7 +25,7 @@ use nalgebra::{IsometryMatrix3, Translation3};
 use crate::human::{HumanJoint, Side};
 use crate::model::{Model, UrdfError, UrdfFrame, UrdfOptions};
 use crate::robots::profile_toml::with_fixed_link;
-use crate::robots::{BipedProfile, FootArea, FootFrames, MotionTuning, RobotPoint};
+use crate::robots::{BipedProfile, FootArea, FootFrames, MotionTuning, RobotPoint, SelfCollision};
 
 /// The URDF text (`robots/g1/g1_29dof_rev_1_0.urdf`, byte-identical to Unitree's).
 pub const URDF: &str = include_str!("../../robots/g1/g1_29dof_rev_1_0.urdf");
@@ -216,6 +216,8 @@ pub fn profile_with(models: [Model; 2]) -> BipedProfile {
         step_envelope: STEP_ENVELOPE,
         tuning: TUNING,
         joint_angles: None,
+        // Not modelled yet: the G1's bodies need sizing from its collision geometry.
+        self_collision: SelfCollision::default(),
     }
 }
 

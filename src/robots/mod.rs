@@ -6,8 +6,10 @@ pub mod g1;
 pub mod nao;
 pub mod profile;
 pub mod profile_toml;
+pub mod self_collision;
 
 pub use profile::{
     BipedProfile, FootArea, FootFrames, HumanJointAngles, JointAnglesFactory, MotionTuning,
     ProfileError, RobotPoint, SolePlacement,
 };
+pub use self_collision::{BodyCapsule, FramePoint, SelfCollision};

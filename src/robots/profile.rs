@@ -22,6 +22,7 @@ use nalgebra::{Rotation3, Vector2, Vector3};
 use thiserror::Error;
 
 use crate::human::{HumanJoint, SegmentDirections, Side};
+use super::self_collision::SelfCollision;
 use crate::model::{Model, ModelError, UrdfError};
 
 /// A robot point that stands for a human joint: a named frame's origin, or the midpoint of two.
@@ -277,6 +278,8 @@ pub struct BipedProfile {
     /// How fast the imitation may move this robot (the size-dependent defaults of the
     /// imitator's settings).
     pub tuning: MotionTuning,
+    /// The bodies kept apart and the distance they keep; empty: no self-collision avoidance.
+    pub self_collision: SelfCollision,
 }
 
 impl BipedProfile {
@@ -293,7 +296,9 @@ impl BipedProfile {
     /// Checks the profile against its models: both models have the same variables, every frame
     /// the profile names exists in both, each model's base is its sole, the outlines have three
     /// or more finite corners, the standing posture is finite and inside the limits, the step
-    /// envelope is valid. The error names the field.
+    /// envelope is valid, the self-collision bodies resolve on both models
+    /// ([`SelfCollision::resolve`]) and every pair keeps its margin in the standing posture.
+    /// The error names the field.
     pub fn validate(&self) -> Result<(), ProfileError> {
         let invalid = |field: &str, reason: String| ProfileError::Invalid {
             field: field.to_owned(),
@@ -356,6 +361,28 @@ impl BipedProfile {
                 &format!("step_envelope.{field}"),
                 format!("{value} breaks min ≤ max, finite, yaw_max ≥ 0"),
             ));
+        }
+        self.validate_self_collision()
+    }
+
+    /// Every self-collision pair resolves on both models and keeps its margin when standing.
+    fn validate_self_collision(&self) -> Result<(), ProfileError> {
+        for model in &self.models {
+            let pairs = self.self_collision.resolve(model, &self.stand)?;
+            let mut data = model.new_data();
+            model.forward_kinematics(&mut data, &self.stand)?;
+            for ([a, b], [first, second]) in self.self_collision.pairs.iter().zip(&pairs) {
+                let distance = first.distance_to(second, model, &data)?;
+                if distance < self.self_collision.margin {
+                    return Err(ProfileError::Invalid {
+                        field: "self_collision.pairs".to_owned(),
+                        reason: format!(
+                            "{a} and {b} are {distance:.4} m apart standing, closer than the margin {} m",
+                            self.self_collision.margin
+                        ),
+                    });
+                }
+            }
         }
         Ok(())
     }

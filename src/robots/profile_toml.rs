@@ -56,6 +56,7 @@ use nalgebra::{IsometryMatrix3, Translation3};
 use serde::Deserialize;
 
 use super::profile::{BipedProfile, FootArea, FootFrames, MotionTuning, ProfileError, RobotPoint};
+use super::self_collision::SelfCollision;
 use crate::human::{HumanJoint, Side};
 use crate::model::{Model, UrdfError, UrdfFrame, UrdfOptions};
 
@@ -266,6 +267,7 @@ fn build(file: File, urdf: &str) -> Result<BipedProfile, ProfileError> {
         },
         joint_angles: None,
         tuning: tuning(file.tuning),
+        self_collision: SelfCollision::default(),
     };
     profile.validate()?;
     Ok(profile)

@@ -7,8 +7,8 @@
 //! iteration is a Gauss–Newton step. Inequality rows get their position-level room the same way:
 //! `K (l − c(q)) ≤ C q̇ ≤ K (u − c(q))`, a violated side clipped to the largest task error. It
 //! stops when every task's error norm and every inequality row's violation is within tolerance,
-//! when no task error changed by more than the stall tolerance in the last iteration, or at the
-//! iteration cap — and says which.
+//! when no task error nor the largest violation changed by more than the stall tolerance in the
+//! last iteration, or at the iteration cap — and says which.
 
 use super::SolverError;
 use super::bounds::JointBounds;
@@ -137,6 +137,8 @@ pub struct PositionDriver {
     /// First stacked row of every task, plus the total at the end.
     task_start: Vec<usize>,
     previous: Vec<f64>,
+    /// The inequality violation of the previous iteration (task units).
+    previous_violation: f64,
     /// The caller's bounds with the per-iteration step limit as a velocity cap.
     step_bounds: JointBounds,
     report: DriverReport,
@@ -157,6 +159,7 @@ impl PositionDriver {
             settings,
             task_start,
             previous: vec![0.0; tasks],
+            previous_violation: 0.0,
             step_bounds: JointBounds::unbounded(solver.stack().dof()),
             report: DriverReport {
                 iterations: 0,
@@ -207,9 +210,8 @@ impl PositionDriver {
             solver.stack().check_finite()?;
             self.measure_errors(solver.stack());
             let errors = &self.report.task_errors;
-            if errors.iter().all(|&e| e <= s.tolerance)
-                && inequality_violation(solver.stack()) <= s.tolerance
-            {
+            let violation = inequality_violation(solver.stack());
+            if errors.iter().all(|&e| e <= s.tolerance) && violation <= s.tolerance {
                 break StopReason::Converged;
             }
             if iterations > 0
@@ -217,6 +219,7 @@ impl PositionDriver {
                     .iter()
                     .zip(&self.previous)
                     .all(|(e, p)| (e - p).abs() <= s.stall_tolerance)
+                && (violation - self.previous_violation).abs() <= s.stall_tolerance
             {
                 break StopReason::Stalled;
             }
@@ -224,6 +227,7 @@ impl PositionDriver {
                 break StopReason::IterationLimit;
             }
             self.previous.copy_from_slice(errors);
+            self.previous_violation = violation;
             self.set_velocities(model, solver.stack_mut());
             self.set_bounds(solver.stack_mut());
             solver.solve(q, &self.step_bounds, s.dt)?;

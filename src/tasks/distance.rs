@@ -73,6 +73,51 @@ impl Capsule {
         ])
     }
 
+    /// The signed distance (m; < 0 when they overlap) between `self` and `other` at the
+    /// forward kinematics in `data`.
+    ///
+    /// # Errors
+    /// [`ModelError`] when `data` has no kinematics or a frame is not in `model`.
+    pub fn distance_to(
+        &self,
+        other: &Capsule,
+        model: &Model,
+        data: &ModelData,
+    ) -> Result<f64, ModelError> {
+        Ok(self.closest(other, model, data)?.distance)
+    }
+
+    fn closest(
+        &self,
+        other: &Capsule,
+        model: &Model,
+        data: &ModelData,
+    ) -> Result<Closest, ModelError> {
+        let [p1, q1] = self.ends(model, data)?;
+        let [p2, q2] = other.ends(model, data)?;
+        let (s, t) = closest_segment_parameters(&p1, &q1, &p2, &q2);
+        let gap = (p1 + (q1 - p1) * s) - (p2 + (q2 - p2) * t);
+        let length = gap.norm();
+        // Touching axes: any direction is a subgradient; the one between the segments' middles
+        // pushes them apart.
+        let normal = if length > 1e-12 {
+            gap / length
+        } else {
+            let between = (p1 + q1 - p2 - q2) * 0.5;
+            if between.norm() > 1e-12 {
+                between.normalize()
+            } else {
+                Vector3::z()
+            }
+        };
+        Ok(Closest {
+            distance: length - self.radius - other.radius,
+            normal,
+            s,
+            t,
+        })
+    }
+
     /// The point at parameter `s ∈ [0, 1]` of the segment, in the frame's axes.
     fn local(&self, s: f64) -> Vector3<f64> {
         self.a + (self.b - self.a) * s
@@ -187,29 +232,7 @@ impl CapsuleDistanceTask {
     }
 
     fn closest(&self, model: &Model, data: &ModelData) -> Result<Closest, ModelError> {
-        let [p1, q1] = self.first.ends(model, data)?;
-        let [p2, q2] = self.second.ends(model, data)?;
-        let (s, t) = closest_segment_parameters(&p1, &q1, &p2, &q2);
-        let gap = (p1 + (q1 - p1) * s) - (p2 + (q2 - p2) * t);
-        let length = gap.norm();
-        // Touching axes: any direction is a subgradient; the one between the segments' middles
-        // pushes them apart.
-        let normal = if length > 1e-12 {
-            gap / length
-        } else {
-            let between = (p1 + q1 - p2 - q2) * 0.5;
-            if between.norm() > 1e-12 {
-                between.normalize()
-            } else {
-                Vector3::z()
-            }
-        };
-        Ok(Closest {
-            distance: length - self.first.radius - self.second.radius,
-            normal,
-            s,
-            t,
-        })
+        self.first.closest(&self.second, model, data)
     }
 }
 

@@ -41,7 +41,10 @@ pub use joint_angles::JointAngles;
 
 use crate::human::{HumanJoint, Side};
 use crate::model::{Model, ModelData, ModelError, UrdfError, UrdfFrame, UrdfOptions};
-use crate::robots::{BipedProfile, FootArea, FootFrames, MotionTuning, RobotPoint};
+use crate::robots::{
+    BipedProfile, BodyCapsule, FootArea, FootFrames, FramePoint, MotionTuning, RobotPoint,
+    SelfCollision,
+};
 
 /// The 23 IK variables (NAOqi joint names) in the order of `q` of every NAO model.
 pub const VARIABLES: [&str; 23] = [
@@ -188,6 +191,86 @@ pub fn points() -> Vec<(HumanJoint, RobotPoint)> {
     ]
 }
 
+/// Smallest distance the NAO's paired bodies keep ([`self_collision`]), m.
+pub const SELF_COLLISION_MARGIN: f64 = 0.01;
+
+/// The NAO's bodies for self-collision avoidance, sized by hand from the H25 V5 link lengths
+/// (upper arm 105 mm, forearm 55.95 mm, hand 57.75 mm, tibia 102.9 mm, foot about 160 × 90 mm)
+/// and its outer shell: the forearms with the hands (elbow to hand point, r = 25 mm), the torso
+/// (vertical, 85 mm below to 60 mm above the torso frame, r = 55 mm), the head (a sphere of
+/// r = 60 mm, 55 mm above the neck joint), the shins (knee to ankle, r = 30 mm) and the feet
+/// (heel to toe 20 mm above the sole, r = 35 mm). Standing, the closest pairs (shins, feet) are
+/// 30–40 mm apart.
+///
+/// Paired: each forearm with the torso, the head and the other forearm; the shins with each
+/// other and with the other foot; the feet with each other. The thighs have no frame of their
+/// own in the model and are left out.
+pub fn self_collision() -> SelfCollision {
+    let point = |frame: &str, offset| FramePoint {
+        frame: frame.to_owned(),
+        offset,
+    };
+    let body = |name: &str, frame: &str, ends: [FramePoint; 2], radius| BodyCapsule {
+        name: name.to_owned(),
+        frame: frame.to_owned(),
+        ends,
+        radius,
+    };
+    let mut bodies = vec![
+        body(
+            "torso",
+            "torso",
+            [point("torso", [0.0, 0.0, -0.045]), point("torso", [0.0, 0.0, 0.06])],
+            0.055,
+        ),
+        body(
+            "head",
+            "head",
+            [point("head", [0.0, 0.0, 0.055]), point("head", [0.0, 0.0, 0.055])],
+            0.06,
+        ),
+    ];
+    for side in Side::BOTH {
+        let p = side.pick("l_", "r_");
+        let frame = |name: &str| format!("{p}{name}");
+        bodies.push(body(
+            &frame("forearm"),
+            &frame("wrist"),
+            [FramePoint::origin(&frame("elbow")), FramePoint::origin(&frame("hand"))],
+            0.025,
+        ));
+        bodies.push(body(
+            &frame("shin"),
+            &frame("knee"),
+            [FramePoint::origin(&frame("knee")), FramePoint::origin(&frame("ankle"))],
+            0.03,
+        ));
+        let sole = frame("sole");
+        bodies.push(body(
+            &frame("foot"),
+            &sole,
+            [point(&sole, [-0.02, 0.0, 0.02]), point(&sole, [0.06, 0.0, 0.02])],
+            0.035,
+        ));
+    }
+    let pair = |a: &str, b: &str| [a.to_owned(), b.to_owned()];
+    SelfCollision {
+        bodies,
+        pairs: vec![
+            pair("l_forearm", "torso"),
+            pair("r_forearm", "torso"),
+            pair("l_forearm", "head"),
+            pair("r_forearm", "head"),
+            pair("l_forearm", "r_forearm"),
+            pair("l_shin", "r_shin"),
+            pair("l_foot", "r_foot"),
+            pair("l_shin", "r_foot"),
+            pair("r_shin", "l_foot"),
+        ],
+        margin: SELF_COLLISION_MARGIN,
+    }
+}
+
 /// The NAO's biped profile over the given models rooted at the left and right soles (the
 /// embedded DH models in [`profile`]; the URDF ones for a cross-check).
 pub fn profile_with(models: [Model; 2]) -> BipedProfile {
@@ -213,6 +296,7 @@ pub fn profile_with(models: [Model; 2]) -> BipedProfile {
         // The defaults were tuned on the NAO.
         tuning: MotionTuning::default(),
         joint_angles: Some(JointAngles::boxed),
+        self_collision: self_collision(),
     }
 }
 
