@@ -118,7 +118,10 @@ fn run_held(
         "{name}: CoM margin {}",
         m.min_com_margin
     );
-    let clearance = m.self_clearance.as_ref().expect("the NAO has self-collision pairs");
+    let clearance = m
+        .self_clearance
+        .as_ref()
+        .expect("the NAO has self-collision pairs");
     assert!(
         clearance.min_distance >= clearance.margin - CLEARANCE_TOLERANCE,
         "{name}: {:?} {:.4} m apart, margin {} m",

@@ -625,3 +625,54 @@ fn checked_in_table_matches_the_data() {
         "regenerate with `cargo run --example table1 > src/imitation/table1.md`"
     );
 }
+
+/// The executable tables keep the NAO's self-collision pairs apart in a level of inequalities
+/// right below balance (contact and balance first: a foot on the ground never slides to make
+/// room), one row per pair; without pairs in the profile there is no such level. A negative
+/// margin is refused.
+#[test]
+fn executable_tables_keep_the_bodies_apart_below_balance() {
+    use taskstack::imitation::tables::Constraint;
+    let profile = nao::profile();
+    let tables = TaskTables::executable(&PhaseConfig::default(), &profile);
+    let pairs = profile.self_collision.pairs.len();
+    for table in tables.iter() {
+        let names: Vec<&str> = table.levels.iter().map(|l| l.name.as_str()).collect();
+        let balance = names.iter().position(|n| *n == "balance").unwrap();
+        assert_eq!(
+            names[balance + 1],
+            "collision",
+            "{}: {names:?}",
+            table.phase
+        );
+        let level = &table.levels[balance + 1];
+        assert!(level.tasks.is_empty());
+        assert_eq!(level.constraints.len(), pairs);
+        let shape = table.shape(23);
+        assert_eq!(shape.levels()[balance + 1].inequality_rows(), pairs);
+        assert!(table.to_string().contains("d(l_forearm, torso) ≥ 10 mm"));
+    }
+    let mut bare = profile.clone();
+    bare.self_collision.pairs.clear();
+    let tables = TaskTables::executable(&PhaseConfig::default(), &bare);
+    assert!(
+        tables
+            .iter()
+            .all(|t| t.levels.iter().all(|l| l.name != "collision"))
+    );
+
+    let mut table = TaskTables::executable(&PhaseConfig::default(), &profile)
+        .table(P::Right)
+        .clone();
+    let level = table
+        .levels
+        .iter_mut()
+        .find(|l| l.name == "collision")
+        .unwrap();
+    let Constraint::Distance { margin, .. } = &mut level.constraints[0];
+    *margin = -0.01;
+    assert!(matches!(
+        table.validate(),
+        Err(TableError::InvalidMargin { .. })
+    ));
+}

@@ -21,8 +21,8 @@ use std::fmt;
 use nalgebra::{Rotation3, Vector2, Vector3};
 use thiserror::Error;
 
-use crate::human::{HumanJoint, SegmentDirections, Side};
 use super::self_collision::SelfCollision;
+use crate::human::{HumanJoint, SegmentDirections, Side};
 use crate::model::{Model, ModelError, UrdfError};
 
 /// A robot point that stands for a human joint: a named frame's origin, or the midpoint of two.

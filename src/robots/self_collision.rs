@@ -80,13 +80,12 @@ impl SelfCollision {
     /// [`ProfileError::Model`] for an unknown frame or a `stand` of the wrong length;
     /// [`ProfileError::Invalid`] for a pair naming an unknown body, a negative or non-finite
     /// radius, margin or offset, or an end not fixed to its body's frame.
-    pub fn resolve(
-        &self,
-        model: &Model,
-        stand: &[f64],
-    ) -> Result<Vec<[Capsule; 2]>, ProfileError> {
+    pub fn resolve(&self, model: &Model, stand: &[f64]) -> Result<Vec<[Capsule; 2]>, ProfileError> {
         if !(self.margin.is_finite() && self.margin >= 0.0) {
-            return Err(invalid("self_collision.margin", format!("{} is not finite and ≥ 0", self.margin)));
+            return Err(invalid(
+                "self_collision.margin",
+                format!("{} is not finite and ≥ 0", self.margin),
+            ));
         }
         let data = test_postures(model, stand)?;
         let capsule = |name: &str| self.body(name)?.resolve(model, &data);
@@ -150,10 +149,15 @@ impl BodyCapsule {
             let offset = Vector3::from(point.offset);
             let local = |d: &ModelData| {
                 let world = d.frame_placement(id).transform_point(&offset.into());
-                d.frame_placement(frame).inverse_transform_point(&world).coords
+                d.frame_placement(frame)
+                    .inverse_transform_point(&world)
+                    .coords
             };
             *end = local(&data[0]);
-            if data[1..].iter().any(|d| (local(d) - *end).norm() > RIGID_TOLERANCE) {
+            if data[1..]
+                .iter()
+                .any(|d| (local(d) - *end).norm() > RIGID_TOLERANCE)
+            {
                 return Err(invalid(
                     &field,
                     format!("{} is not fixed to {}", point.frame, self.frame),
@@ -161,7 +165,10 @@ impl BodyCapsule {
             }
         }
         if !(self.radius.is_finite() && self.radius >= 0.0) {
-            return Err(invalid(&field, format!("radius {} is not ≥ 0", self.radius)));
+            return Err(invalid(
+                &field,
+                format!("radius {} is not ≥ 0", self.radius),
+            ));
         }
         Ok(Capsule {
             frame,

@@ -14,12 +14,62 @@
 use faer::Mat;
 use nalgebra::{IsometryMatrix3, Rotation3, Vector2, Vector3};
 
+use crate::human::Side;
 use crate::imitation::error::ImitationError;
 use crate::imitation::imitator::Shared;
 use crate::model::{FrameId, Model, ModelData};
+use crate::robots::BipedProfile;
 use crate::solver::driver::{DriverReport, DriverSettings, PositionDriver, TaskModel};
 use crate::solver::{JointBounds, Method, Settings, Solver, SolverError, StackShape, TaskStack};
+use crate::tasks::{CapsuleDistanceTask, InequalityTask};
 
+/// Distance rows of an IK (self-collision pairs kept apart), one set per model root
+/// (`[left, right]`: the capsules' frames are the root model's), in a level of their own.
+#[derive(Debug, Clone, Default)]
+pub(super) struct Distances {
+    /// Number of goal levels above the distance level.
+    pub(super) below_levels: usize,
+    /// The rows on the model rooted at each sole, the same pairs in the same order.
+    pub(super) rows: [Vec<CapsuleDistanceTask>; 2],
+}
+
+impl Distances {
+    /// The profile's self-collision pairs that only the `moving` joints move apart: those whose
+    /// distance has a zero derivative in every other joint at the posture `q` (the pairs of
+    /// the upper body for the arms, of the legs for the legs; a leg joint turns the whole upper
+    /// body rigidly and leaves its distances unchanged). Below `below_levels` goal levels.
+    pub(super) fn moved_by(
+        profile: &BipedProfile,
+        q: &[f64],
+        moving: &[bool],
+        below_levels: usize,
+    ) -> Result<Self, ImitationError> {
+        let collision = &profile.self_collision;
+        let mut rows: [Vec<CapsuleDistanceTask>; 2] = Default::default();
+        for side in Side::BOTH {
+            let model = profile.model(side);
+            let mut data = model.new_data();
+            model.forward_kinematics(&mut data, q)?;
+            let pairs = collision.resolve(model, &profile.stand)?;
+            let mut jacobian = Mat::zeros(1, model.nv());
+            let (mut lower, mut upper) = ([0.0], [0.0]);
+            for ([a, b], [first, second]) in collision.pairs.iter().zip(pairs) {
+                let name = format!("d({a},{b})");
+                let task = CapsuleDistanceTask::new(model, &name, first, second, collision.margin)?;
+                task.write(model, &data, jacobian.as_mut(), &mut lower, &mut upper)?;
+                let column = |k: usize| jacobian[(0, k)].abs() > MOVED;
+                let mine = (0..model.nv()).any(column);
+                if mine && (0..model.nv()).all(|k| moving[k] || !column(k)) {
+                    rows[side.index()].push(task);
+                }
+            }
+        }
+        Ok(Self { below_levels, rows })
+    }
+}
+
+/// A distance derivative (m/rad) below this is a joint that does not move the pair.
+const MOVED: f64 = 1e-9;
 /// Metres per radian of a normal or orientation row: Koenemann et al.'s tolerances, 1 mm and
 /// 0.033 rad, become one.
 pub(super) const NORMAL_WEIGHT: f64 = 0.001 / 0.033;
@@ -71,6 +121,7 @@ impl Goal {
 #[derive(Debug)]
 pub(super) struct GoalIk {
     pub(super) goals: Vec<Goal>,
+    distances: Distances,
     /// The joints the problem may move; the others keep their place.
     moving: Vec<bool>,
     solver: Solver,
@@ -82,11 +133,14 @@ pub(super) struct GoalIk {
 impl GoalIk {
     /// An IK for goals shaped like `goals` (their kinds fix the rows; targets change per frame)
     /// solved by `method`: the first `levels[0]` goals in the top level, the next `levels[1]`
-    /// below them, and so on, the remaining goals in the last level (`&[]`: one level). Only
-    /// the joints `moving` marks move (its length is the model's number of joints).
+    /// below them, and so on, the remaining goals (if any) in the last level (`&[]`: one
+    /// level); the `distances` in a level of their own below the first
+    /// [`Distances::below_levels`] goal levels. Only the joints `moving` marks move (its
+    /// length is the model's number of joints).
     pub(super) fn new(
         goals: Vec<Goal>,
         levels: &[usize],
+        distances: Distances,
         moving: Vec<bool>,
         method: Method,
         settings: DriverSettings,
@@ -97,14 +151,28 @@ impl GoalIk {
             .zip(&goals)
             .map(|(n, g)| (n.as_str(), g.rows()))
             .collect();
-        let nv = moving.len();
-        let mut shape = StackShape::new(nv);
+        let mut goal_levels = Vec::new();
         let mut first = 0;
         for &count in levels {
-            shape = shape.with_level("priority", &tasks[first..first + count]);
+            goal_levels.push(&tasks[first..first + count]);
             first += count;
         }
-        let shape = shape.with_level("goals", &tasks[first..]);
+        if first < tasks.len() {
+            goal_levels.push(&tasks[first..]);
+        }
+        let distance_rows: Vec<(&str, usize)> =
+            (distances.rows[0].iter()).map(|d| (d.name(), 1)).collect();
+        let nv = moving.len();
+        let mut shape = StackShape::new(nv);
+        for (k, level) in goal_levels.iter().enumerate() {
+            if k == distances.below_levels && !distance_rows.is_empty() {
+                shape = shape.with_inequality_level("distances", &distance_rows);
+            }
+            shape = shape.with_level("goals", level);
+        }
+        if goal_levels.len() <= distances.below_levels && !distance_rows.is_empty() {
+            shape = shape.with_inequality_level("distances", &distance_rows);
+        }
         let solver = Solver::with_settings(
             &shape,
             Settings {
@@ -115,6 +183,7 @@ impl GoalIk {
         let driver = PositionDriver::new(&solver, settings)?;
         Ok(GoalIk {
             goals,
+            distances,
             moving,
             solver,
             driver,
@@ -138,6 +207,8 @@ impl GoalIk {
             data: &mut shared.data[root.index()],
             torso,
             goals: &self.goals,
+            distances: &self.distances.rows[root.index()],
+            distance_level: self.distances.below_levels,
             moving: &self.moving,
             scratch: &mut self.scratch,
         };
@@ -151,6 +222,9 @@ struct GoalRows<'a> {
     data: &'a mut ModelData,
     torso: FrameId,
     goals: &'a [Goal],
+    distances: &'a [CapsuleDistanceTask],
+    /// The level of the distance rows (when there are any).
+    distance_level: usize,
     moving: &'a [bool],
     scratch: &'a mut [Mat<f64>; 4],
 }
@@ -170,7 +244,8 @@ impl TaskModel for GoalRows<'_> {
         let (mut level, mut first) = (0, 0);
         for goal in self.goals {
             let rows = goal.rows();
-            if first == stack.level_mut(level).rows() {
+            // Past a full level, and past the distance level (no equality rows).
+            while first == stack.level_mut(level).rows() {
                 (level, first) = (level + 1, 0);
             }
             let mut rows_of = stack.level_mut(level);
@@ -262,7 +337,32 @@ impl TaskModel for GoalRows<'_> {
                 }
             }
         }
+        self.write_distances(stack)?;
         stack.clear_gradient();
+        Ok(())
+    }
+}
+
+impl GoalRows<'_> {
+    /// The distance rows, the columns of the joints that do not move zeroed.
+    fn write_distances(&self, stack: &mut TaskStack) -> Result<(), ImitationError> {
+        if self.distances.is_empty() {
+            return Ok(());
+        }
+        let mut level = stack.level_mut(self.distance_level);
+        let (mut jac, lower, upper) = level.inequalities_mut();
+        for (r, d) in self.distances.iter().enumerate() {
+            d.write(
+                self.model,
+                self.data,
+                jac.as_mut().subrows_mut(r, 1),
+                &mut lower[r..r + 1],
+                &mut upper[r..r + 1],
+            )?;
+            for k in (0..self.moving.len()).filter(|&k| !self.moving[k]) {
+                jac[(r, k)] = 0.0;
+            }
+        }
         Ok(())
     }
 }

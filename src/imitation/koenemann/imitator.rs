@@ -6,7 +6,7 @@ use std::time::Instant;
 use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 
 use super::KoenemannConfig;
-use super::goals::{Goal, GoalIk, in_torso};
+use super::goals::{Distances, Goal, GoalIk, in_torso};
 use super::mapping::{Limbs, Posture, PostureMapping};
 use super::offset::offset;
 use super::retarget::{FootRetargeting, retarget_double, support_normal};
@@ -67,6 +67,9 @@ pub(crate) struct KoenemannImitator {
     mapping: Option<PostureMapping>,
     detector: SupportDetector,
     arms: GoalIk,
+    /// The upper body's self-collision pairs alone: moves the arms the least that keeps them
+    /// apart after `arms`.
+    arms_apart: GoalIk,
     /// The CoM strictly, then 3 + 2 rows (the swing foot), then 3 + 2 rows (the support sole
     /// in the torso frame): single support, landing, the paper's double support.
     feet: GoalIk,
@@ -212,7 +215,30 @@ impl KoenemannImitator {
             damping: method.damping,
         };
         let all = vec![true; shared.q.len()];
-        let arms = GoalIk::new(f.hands.map(point).to_vec(), &[], all, dls, arm_settings)?;
+        let arms = GoalIk::new(
+            f.hands.map(point).to_vec(),
+            &[],
+            Distances::default(),
+            all,
+            dls,
+            arm_settings,
+        )?;
+        // The arms' self-collision pairs: weighted DLS has no inequalities, so a second IK
+        // moves the upper body the least that keeps them apart, after the hands' IK.
+        let upper_body: Vec<bool> = shared.legs.iter().map(|leg| !leg).collect();
+        let upper_distances = Distances::moved_by(profile, &shared.q, &upper_body, 0)?;
+        let guard_settings = DriverSettings {
+            max_iterations: 4,
+            ..arm_settings
+        };
+        let arms_apart = GoalIk::new(
+            Vec::new(),
+            &[],
+            upper_distances,
+            upper_body,
+            Method::Prioritized,
+            guard_settings,
+        )?;
         let com = Goal::RootCom {
             target: Default::default(),
         };
@@ -228,9 +254,12 @@ impl KoenemannImitator {
         // agree and converge in a few iterations where DLS needs tens (see `taskstack solve`).
         // The legs alone: the CoM rows would move the arms and head too.
         let legs = shared.legs.clone();
+        // The legs' self-collision pairs below the CoM (feet) or the held sole (stance), above
+        // the goals the feet follow the human with.
         let feet = GoalIk::new(
             feet_goals,
             &[1, 2],
+            Distances::moved_by(profile, &shared.q, &legs, 1)?,
             legs.clone(),
             Method::Prioritized,
             leg_settings,
@@ -251,6 +280,7 @@ impl KoenemannImitator {
         let settle = GoalIk::new(
             settle_goals,
             &[],
+            Distances::default(),
             legs.clone(),
             Method::Prioritized,
             settle_settings,
@@ -265,6 +295,7 @@ impl KoenemannImitator {
         let stance = GoalIk::new(
             stance_goals,
             &[2, 1],
+            Distances::moved_by(profile, &shared.q, &legs, 2)?,
             legs,
             Method::Prioritized,
             leg_settings,
@@ -284,6 +315,7 @@ impl KoenemannImitator {
             body,
             mapping: None,
             arms,
+            arms_apart,
             feet,
             stance,
             settle,
@@ -327,6 +359,7 @@ impl KoenemannImitator {
         self.track_hands(mapped.as_ref(), dt)?;
         self.stabilize(mapped.as_ref(), dt)?;
         self.limit_velocities(dt);
+        self.keep_arms_apart(dt)?;
         self.settle_hold(dt)?;
         self.shared.refresh()?;
         self.measure();
@@ -606,6 +639,19 @@ impl KoenemannImitator {
             }
         };
         ik.run(&mut self.shared, f.torso, &self.position_bounds)?;
+        Ok(())
+    }
+
+    /// The upper body's self-collision pairs kept apart, within what the velocity limits reach
+    /// this frame: after [`Self::limit_velocities`], whose straight line in joint space can cut
+    /// through the torso where the hands' IK went around it. The frame's start was apart, so
+    /// the reach always holds a posture that is.
+    fn keep_arms_apart(&mut self, dt: f64) -> Result<(), ImitationError> {
+        let f = &self.frames[self.shared.root.index()];
+        self.frame_bounds
+            .copy_within_reach(&self.shared.bounds, &self.q_start, dt);
+        self.arms_apart
+            .run(&mut self.shared, f.torso, &self.frame_bounds)?;
         Ok(())
     }
 

@@ -220,13 +220,19 @@ pub fn self_collision() -> SelfCollision {
         body(
             "torso",
             "torso",
-            [point("torso", [0.0, 0.0, -0.045]), point("torso", [0.0, 0.0, 0.06])],
+            [
+                point("torso", [0.0, 0.0, -0.045]),
+                point("torso", [0.0, 0.0, 0.06]),
+            ],
             0.055,
         ),
         body(
             "head",
             "head",
-            [point("head", [0.0, 0.0, 0.055]), point("head", [0.0, 0.0, 0.055])],
+            [
+                point("head", [0.0, 0.0, 0.055]),
+                point("head", [0.0, 0.0, 0.055]),
+            ],
             0.06,
         ),
     ];
@@ -236,20 +242,29 @@ pub fn self_collision() -> SelfCollision {
         bodies.push(body(
             &frame("forearm"),
             &frame("wrist"),
-            [FramePoint::origin(&frame("elbow")), FramePoint::origin(&frame("hand"))],
+            [
+                FramePoint::origin(&frame("elbow")),
+                FramePoint::origin(&frame("hand")),
+            ],
             0.025,
         ));
         bodies.push(body(
             &frame("shin"),
             &frame("knee"),
-            [FramePoint::origin(&frame("knee")), FramePoint::origin(&frame("ankle"))],
+            [
+                FramePoint::origin(&frame("knee")),
+                FramePoint::origin(&frame("ankle")),
+            ],
             0.03,
         ));
         let sole = frame("sole");
         bodies.push(body(
             &frame("foot"),
             &sole,
-            [point(&sole, [-0.02, 0.0, 0.02]), point(&sole, [0.06, 0.0, 0.02])],
+            [
+                point(&sole, [-0.02, 0.0, 0.02]),
+                point(&sole, [0.06, 0.0, 0.02]),
+            ],
             0.035,
         ));
     }
