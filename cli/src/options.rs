@@ -188,6 +188,15 @@ pub(crate) fn positive(text: &str) -> Result<f64, String> {
     }
 }
 
+pub(crate) fn non_negative(text: &str) -> Result<f64, String> {
+    let value = number(text)?;
+    if value >= 0.0 {
+        Ok(value)
+    } else {
+        Err(format!("{value} is not ≥ 0"))
+    }
+}
+
 fn fraction(text: &str) -> Result<f64, String> {
     let value = positive(text)?;
     if value <= 1.0 {

@@ -39,6 +39,11 @@ pub(crate) struct SolveArgs {
     #[arg(long, value_name = "LAMBDA", default_value_t = 0.01, value_parser = crate::options::positive,
           allow_negative_numbers = true)]
     damping: f64,
+    /// Solve the CoM task as an inequality instead of a target point: its ground projection
+    /// inside the support polygon (the soles on the ground at the initial posture) shrunk by
+    /// MARGIN metres, at the CoM task's level.
+    #[arg(long, value_name = "MARGIN", value_parser = crate::options::non_negative)]
+    com_polygon: Option<f64>,
 }
 
 /// The solver method of `taskstack solve`.
@@ -61,6 +66,7 @@ pub(crate) fn run(args: SolveArgs, report: Report) -> Result<ExitCode> {
             damping: args.damping,
         },
     };
+    problem.com_polygon_margin = args.com_polygon;
     let count = args.frames.map_or(problem.frames, |n| n as usize);
     let repeats = args.repeats as usize;
     let solution = solve_frames(&problem, count, repeats).with_context(in_file)?;
