@@ -22,10 +22,15 @@
 //!    single support), which is what eq. 7's normal means on the floor; then, as well as it
 //!    can, the retargeted soles in the torso frame with their normals (the 5-DoF foot goals of
 //!    the paper: turning about the normal is free) and the swing foot, to 1 mm and 0.033 rad.
+//!    When the profile has a self-collision model, the leg pairs (shins, feet) are kept apart
+//!    by a level of inequalities right below the CoM.
 //! 5. **Post-processing** (§V.D): the hands' and the swing foot's targets move at most at a
 //!    speed limit, the hands stay out of the torso, the swing foot stays above the floor and
 //!    out of the other foot's way (the profile's step envelope), and every joint within its
 //!    velocity limit (the legs slowed down together, so their posture keeps its balance).
+//!    Last, the upper body's self-collision pairs (forearms, torso, head) are kept apart by an
+//!    IK of inequalities alone, within what the velocity limits reach from the frame's start:
+//!    the least upper-body motion that restores the margin (weighted DLS has no inequalities).
 //!
 //! Departures from the paper, each because the physics judge showed the need or the paper is
 //! silent: stability is a strict CoM level rather than the soles' normals alone (in torso
