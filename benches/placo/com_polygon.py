@@ -14,7 +14,7 @@ kept inside the right sole's outline shrunk by MARGIN:
 Prints each solver's median time per frame and the ratio. Usage (the PlaCo environment is in
 benches/placo/requirements.txt; see the README there):
 
-    python benches/placo/com_polygon.py ../shared/bench/problem_rs.json [--margin 0.01]
+    python benches/placo/com_polygon.py tests/data/bench/problem_rs.json [--margin 0.01]
 """
 
 import argparse
