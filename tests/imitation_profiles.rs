@@ -16,10 +16,15 @@ const TINY: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/tiny_biped/"
 
 /// Imitates `clip` with `profile` and checks every frame's joint angles against the bounds.
 fn imitate(profile: BipedProfile, clip: &str) -> ImitationMetrics {
+    imitate_with(profile, clip, ImitatorConfig::default())
+}
+
+/// [`imitate`] with `config` (its support detection set for the clip).
+fn imitate_with(profile: BipedProfile, clip: &str, config: ImitatorConfig) -> ImitationMetrics {
     let mut source = Clip::open(format!("{MOCAP}{clip}")).unwrap();
     let config = ImitatorConfig {
         support: SupportConfig::for_capture(source.capture()),
-        ..ImitatorConfig::default()
+        ..config
     };
     let mut imitator = Imitator::new(profile, config).unwrap();
     let mut recorder = MetricsRecorder::new(&imitator);
@@ -84,6 +89,31 @@ fn g1_imitates_every_bundled_clip_within_its_limits() {
     }
     // The G1 follows the human onto one leg on the clips that have a long stance.
     assert!(single_support >= 2, "{single_support}");
+}
+
+/// Both methods run on a profile without a self-collision model (the G1's, and the NAO's with
+/// its pairs removed): no collision level, no distance IK, no clearance in the metrics.
+#[test]
+fn profiles_without_self_collision_pairs_imitate_with_both_methods() {
+    use taskstack::imitation::config::ImitationMethod;
+    use taskstack::imitation::koenemann::KoenemannConfig;
+    let mut bare_nao = taskstack::robots::nao::profile();
+    bare_nao.self_collision = Default::default();
+    let clip = "kinect2_labanotation_ges01_wavehand.csv";
+    for method in [
+        ImitationMethod::Poubel,
+        ImitationMethod::Koenemann(KoenemannConfig::default()),
+    ] {
+        for profile in [g1::profile(), bare_nao.clone()] {
+            let config = ImitatorConfig {
+                method,
+                ..ImitatorConfig::default()
+            };
+            let m = imitate_with(profile.clone(), clip, config);
+            assert!(m.self_clearance.is_none(), "{}", profile.name);
+            assert_eq!(m.joint_limit_violations, 0, "{}", profile.name);
+        }
+    }
 }
 
 #[test]

@@ -1,5 +1,5 @@
 //! Task tables (Poubel §II.B, §IV.B, Table I) as data: for each [`SupportPhase`], the model root,
-//! the equality levels in priority order (balance first, then Cartesian tracking), the gradient
+//! the levels in priority order (balance first, then Cartesian tracking), the gradient
 //! (optimization) tasks with their weights κ, and whether the clamping loop runs.
 //!
 //! # Task targets
@@ -361,7 +361,7 @@ pub struct TaskTable {
     pub phase: SupportPhase,
     /// The sole the model is rooted at (all targets are in its frame).
     pub model_root: Side,
-    /// Equality levels, highest priority first.
+    /// Levels (equality tasks and inequalities), highest priority first.
     pub levels: Vec<Level>,
     /// Gradient tasks, summed in the null space of all levels.
     pub gradients: Vec<Gradient>,

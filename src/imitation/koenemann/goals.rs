@@ -34,6 +34,11 @@ pub(super) struct Distances {
 }
 
 impl Distances {
+    /// Whether there are no rows.
+    pub(super) fn is_empty(&self) -> bool {
+        self.rows[0].is_empty()
+    }
+
     /// The profile's self-collision pairs that only the `moving` joints move apart: those whose
     /// distance has a zero derivative in every other joint at the posture `q` (the pairs of
     /// the upper body for the arms, of the legs for the legs; a leg joint turns the whole upper

@@ -68,8 +68,8 @@ pub(crate) struct KoenemannImitator {
     detector: SupportDetector,
     arms: GoalIk,
     /// The upper body's self-collision pairs alone: moves the arms the least that keeps them
-    /// apart after `arms`.
-    arms_apart: GoalIk,
+    /// apart after `arms`; `None` when the profile pairs no upper-body bodies.
+    arms_apart: Option<GoalIk>,
     /// The CoM strictly, then 3 + 2 rows (the swing foot), then 3 + 2 rows (the support sole
     /// in the torso frame): single support, landing, the paper's double support.
     feet: GoalIk,
@@ -231,14 +231,18 @@ impl KoenemannImitator {
             max_iterations: 4,
             ..arm_settings
         };
-        let arms_apart = GoalIk::new(
-            Vec::new(),
-            &[],
-            upper_distances,
-            upper_body,
-            Method::Prioritized,
-            guard_settings,
-        )?;
+        let arms_apart = (!upper_distances.is_empty())
+            .then(|| {
+                GoalIk::new(
+                    Vec::new(),
+                    &[],
+                    upper_distances,
+                    upper_body,
+                    Method::Prioritized,
+                    guard_settings,
+                )
+            })
+            .transpose()?;
         let com = Goal::RootCom {
             target: Default::default(),
         };
@@ -647,11 +651,13 @@ impl KoenemannImitator {
     /// through the torso where the hands' IK went around it. The frame's start was apart, so
     /// the reach always holds a posture that is.
     fn keep_arms_apart(&mut self, dt: f64) -> Result<(), ImitationError> {
+        let Some(arms_apart) = &mut self.arms_apart else {
+            return Ok(());
+        };
         let f = &self.frames[self.shared.root.index()];
         self.frame_bounds
             .copy_within_reach(&self.shared.bounds, &self.q_start, dt);
-        self.arms_apart
-            .run(&mut self.shared, f.torso, &self.frame_bounds)?;
+        arms_apart.run(&mut self.shared, f.torso, &self.frame_bounds)?;
         Ok(())
     }
 
