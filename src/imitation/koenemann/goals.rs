@@ -49,28 +49,51 @@ impl Distances {
         moving: &[bool],
         below_levels: usize,
     ) -> Result<Self, ImitationError> {
-        let collision = &profile.self_collision;
-        let mut rows: [Vec<CapsuleDistanceTask>; 2] = Default::default();
-        for side in Side::BOTH {
-            let model = profile.model(side);
-            let mut data = model.new_data();
-            model.forward_kinematics(&mut data, q)?;
-            let pairs = collision.resolve(model, &profile.stand)?;
-            let mut jacobian = Mat::zeros(1, model.nv());
-            let (mut lower, mut upper) = ([0.0], [0.0]);
-            for ([a, b], [first, second]) in collision.pairs.iter().zip(pairs) {
-                let name = format!("d({a},{b})");
-                let task = CapsuleDistanceTask::new(model, &name, first, second, collision.margin)?;
-                task.write(model, &data, jacobian.as_mut(), &mut lower, &mut upper)?;
-                let column = |k: usize| jacobian[(0, k)].abs() > MOVED;
-                let mine = (0..model.nv()).any(column);
-                if mine && (0..model.nv()).all(|k| moving[k] || !column(k)) {
-                    rows[side.index()].push(task);
-                }
-            }
+        // Which pairs is decided once, on the right-rooted model: a distance between two bodies
+        // does not depend on the root, and both roots must get the same rows.
+        let right = distance_tasks(profile, Side::Right)?;
+        let model = profile.model(Side::Right);
+        let mut data = model.new_data();
+        model.forward_kinematics(&mut data, q)?;
+        let mut jacobian = Mat::zeros(1, model.nv());
+        let (mut lower, mut upper) = ([0.0], [0.0]);
+        let mut keep = Vec::with_capacity(right.len());
+        for task in &right {
+            task.write(model, &data, jacobian.as_mut(), &mut lower, &mut upper)?;
+            let column = |k: usize| jacobian[(0, k)].abs() > MOVED;
+            let mine = (0..model.nv()).any(column);
+            keep.push(mine && (0..model.nv()).all(|k| moving[k] || !column(k)));
         }
+        let kept = |tasks: Vec<CapsuleDistanceTask>| -> Vec<CapsuleDistanceTask> {
+            (tasks.into_iter().zip(&keep))
+                .filter_map(|(task, &k)| k.then_some(task))
+                .collect()
+        };
+        let rows = [kept(distance_tasks(profile, Side::Left)?), kept(right)];
         Ok(Self { below_levels, rows })
     }
+}
+
+/// Every self-collision pair of the profile as a distance task on the model rooted at `side`.
+fn distance_tasks(
+    profile: &BipedProfile,
+    side: Side,
+) -> Result<Vec<CapsuleDistanceTask>, ImitationError> {
+    let collision = &profile.self_collision;
+    let model = profile.model(side);
+    let pairs = collision.resolve(model, &profile.stand)?;
+    (collision.pairs.iter().zip(pairs))
+        .map(|([a, b], [first, second])| {
+            let name = format!("d({a},{b})");
+            Ok(CapsuleDistanceTask::new(
+                model,
+                &name,
+                first,
+                second,
+                collision.margin,
+            )?)
+        })
+        .collect()
 }
 
 /// A distance derivative (m/rad) below this is a joint that does not move the pair.
@@ -167,17 +190,15 @@ impl GoalIk {
         }
         let distance_rows: Vec<(&str, usize)> =
             (distances.rows[0].iter()).map(|d| (d.name(), 1)).collect();
+        let (above, below) = goal_levels.split_at(distances.below_levels.min(goal_levels.len()));
+        let with_goals =
+            |shape: StackShape, level: &&[(&str, usize)]| shape.with_level("goals", level);
         let nv = moving.len();
-        let mut shape = StackShape::new(nv);
-        for (k, level) in goal_levels.iter().enumerate() {
-            if k == distances.below_levels && !distance_rows.is_empty() {
-                shape = shape.with_inequality_level("distances", &distance_rows);
-            }
-            shape = shape.with_level("goals", level);
-        }
-        if goal_levels.len() <= distances.below_levels && !distance_rows.is_empty() {
+        let mut shape = above.iter().fold(StackShape::new(nv), with_goals);
+        if !distance_rows.is_empty() {
             shape = shape.with_inequality_level("distances", &distance_rows);
         }
+        let shape = below.iter().fold(shape, with_goals);
         let solver = Solver::with_settings(
             &shape,
             Settings {
