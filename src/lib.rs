@@ -4,9 +4,9 @@
 //!
 //! Units everywhere: metres, radians, kilograms, seconds. Frames: x forward, y left, z up.
 //!
-//! The layers point one way: [`solver`], [`model`] and [`human`] at the bottom; [`tasks`] (tasks
-//! named by frame) and [`robots`] (what imitation knows of a robot) above them; [`io`] (clip
-//! readers) and [`imitation`] above those; [`batch`] and [`problem`] at the edge. The
+//! The layers point one way: [`solver`], [`model`], [`human`] and [`scene`] (the surfaces around
+//! the human) at the bottom; [`tasks`] (tasks named by frame) and [`robots`] (what imitation knows
+//! of a robot) above them; [`io`] (clip readers) and [`imitation`] above those; [`batch`] and [`problem`] at the edge. The
 //! `taskstack` command-line tool (the `cli/` folder of the repository) is built on this API.
 //!
 //! # Guide
@@ -111,6 +111,7 @@ pub mod io;
 pub mod model;
 pub mod problem;
 pub mod robots;
+pub mod scene;
 pub mod solver;
 pub mod tasks;
 

@@ -4,6 +4,7 @@
 //! every option.
 
 mod batch;
+mod contacts;
 mod fk;
 mod imitate;
 mod options;
@@ -37,6 +38,7 @@ struct Cli {
 enum Command {
     Imitate(imitate::ImitateArgs),
     Batch(batch::BatchArgs),
+    Contacts(contacts::ContactsArgs),
     Fk(fk::FkArgs),
     Solve(solve::SolveArgs),
     View(view::ViewArgs),
@@ -65,6 +67,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Imitate(args) => imitate::run(args, report),
         Command::Batch(args) => batch::run(args, report),
+        Command::Contacts(args) => contacts::run(args, report),
         Command::Fk(args) => fk::run(args),
         Command::Solve(args) => solve::run(args, report),
         Command::View(args) => view::run(args, report),

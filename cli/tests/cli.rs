@@ -10,7 +10,7 @@ use serde_json::Value;
 fn every_subcommand_explains_its_options_and_outputs() {
     let top = taskstack(&["--help"]);
     assert_eq!(top.code, Some(0), "{}", top.stderr);
-    for command in ["imitate", "batch", "fk", "solve", "view"] {
+    for command in ["imitate", "batch", "contacts", "fk", "solve", "view"] {
         assert!(
             top.stdout.contains(command),
             "top-level help lists {command}"
@@ -54,6 +54,7 @@ fn every_subcommand_explains_its_options_and_outputs() {
             &["PROBLEM.json", "--frames", "--repeats", "µs"][..],
         ),
         ("view", &["OUT_DIR", "--no-open"][..]),
+        ("contacts", &["--scene", "--knees", "seconds", "metres"][..]),
     ] {
         let help = taskstack(&[command, "--help"]);
         assert_eq!(help.code, Some(0), "{command} --help");
@@ -366,6 +367,40 @@ fn fk_answers_json_lines_and_names_the_bad_line() {
         run.stdout.lines().count(),
         1,
         "the good line before it was answered"
+    );
+}
+
+#[test]
+fn contacts_lists_the_hands_landing_on_the_stool() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data/contact");
+    let clip = dir.join("cmu_23_19_lean_hands_on_stool.bvh");
+    let scene = dir.join("stool_23_19.toml");
+    let run = taskstack(&["--json", "contacts", s(&clip), "--scene", s(&scene)]);
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    let value: Value = serde_json::from_str(&run.stdout).unwrap();
+    let events = value["events"].as_array().unwrap();
+    let on_stool: Vec<_> = events
+        .iter()
+        .filter(|e| e["surface"] == "stool" && e["change"] == "enter")
+        .map(|e| e["link"].as_str().unwrap())
+        .collect();
+    assert_eq!(on_stool, ["right_hand", "left_hand"], "{}", run.stdout);
+    let table = taskstack(&["contacts", s(&clip), "--scene", s(&scene)]);
+    assert!(
+        table.stdout.contains("right_hand  stool"),
+        "{}",
+        table.stdout
+    );
+    let bad = temp_dir("contacts").join("bad.toml");
+    std::fs::write(
+        &bad,
+        "[[surface]]\nname = \"t\"\nheight = 0.7\nsize = [0.5, -1.0]\n",
+    )
+    .unwrap();
+    fails(
+        &["contacts", s(&clip), "--scene", s(&bad)],
+        1,
+        &["surface \"t\"", "size"],
     );
 }
 

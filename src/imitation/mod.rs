@@ -13,6 +13,7 @@
 
 pub mod clearance;
 pub mod config;
+pub mod contact_events;
 pub mod error;
 pub mod footsteps;
 pub mod imitator;
