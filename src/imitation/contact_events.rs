@@ -266,10 +266,9 @@ pub fn contact_events<'a>(
         .filter_map(|&l| config.thresholds(l).map(|t| (l, *t)))
         .collect();
     let surfaces = scene.surfaces().len();
-    let mut open = vec![None::<OpenContact>; links.len() * surfaces];
-    let mut previous: Vec<Option<Vector3<f64>>> = vec![None; links.len()];
+    let mut list = EventList::new(links.len() * surfaces, config.min_duration);
+    let mut previous: Vec<Option<(f64, Vector3<f64>)>> = vec![None; links.len()];
     let mut last_time = f64::NEG_INFINITY;
-    let mut events = Vec::new();
     for (index, frame) in frames.into_iter().enumerate() {
         if frame.time.is_nan() || frame.time <= last_time {
             return Err(ContactError::Time {
@@ -277,24 +276,23 @@ pub fn contact_events<'a>(
                 time: frame.time,
             });
         }
-        let dt = frame.time - last_time;
         last_time = frame.time;
         feet.update(frame);
         for (k, &(link, thresholds)) in links.iter().enumerate() {
             let Some((lowest, mean)) = link_points(frame, link) else {
                 continue;
             };
-            let speed = previous[k].map_or(0.0, |p| (mean - p).norm() / dt);
-            previous[k] = Some(mean);
+            let speed = previous[k].map_or(0.0, |(t, p)| (mean - p).norm() / (frame.time - t));
+            previous[k] = Some((frame.time, mean));
             for (s, surface) in scene.surfaces().iter().enumerate() {
-                let state = &mut open[k * surfaces + s];
+                let slot = k * surfaces + s;
                 let touching = match link.foot_side() {
                     Some(side) if surface.is_unbounded() => feet.foot(side).in_support,
                     _ => {
                         let height = surface.height_above(&lowest);
                         let over = surface.outside_distance(&lowest) <= config.edge_margin
                             && height >= -config.max_penetration;
-                        if state.is_some() {
+                        if list.is_open(slot) {
                             over && height <= thresholds.leave_height
                         } else {
                             over && height <= thresholds.enter_height
@@ -302,47 +300,73 @@ pub fn contact_events<'a>(
                         }
                     }
                 };
-                let change = match (*state, touching) {
-                    (None, true) => {
-                        *state = Some(OpenContact {
-                            start: frame.time,
-                            event: events.len(),
-                        });
-                        ContactChange::Enter
-                    }
-                    (Some(contact), false) => {
-                        *state = None;
-                        if frame.time - contact.start < config.min_duration {
-                            events.remove(contact.event);
-                            for later in open.iter_mut().flatten() {
-                                if later.event > contact.event {
-                                    later.event -= 1;
-                                }
-                            }
-                            continue;
-                        }
-                        ContactChange::Leave
-                    }
-                    _ => continue,
-                };
-                events.push(ContactEvent {
-                    link,
-                    surface: s,
-                    time: frame.time,
-                    frame: index,
-                    change,
-                });
+                list.update(slot, touching, link, s, frame.time, index);
             }
         }
     }
-    Ok(events)
+    Ok(list.events)
 }
 
-/// A contact under way: when it started and where its entering event is in the list.
-#[derive(Clone, Copy, Debug)]
-struct OpenContact {
-    start: f64,
-    event: usize,
+/// The events found so far, and the contacts under way (one slot per link and surface).
+struct EventList {
+    events: Vec<ContactEvent>,
+    /// Per slot: when the contact under way started and where its entering event is.
+    open: Vec<Option<(f64, usize)>>,
+    min_duration: f64,
+}
+
+impl EventList {
+    fn new(slots: usize, min_duration: f64) -> Self {
+        Self {
+            events: Vec::new(),
+            open: vec![None; slots],
+            min_duration,
+        }
+    }
+
+    fn is_open(&self, slot: usize) -> bool {
+        self.open[slot].is_some()
+    }
+
+    /// Records the start or end of `slot`'s contact when `touching` differs from its state. A
+    /// contact ending before `min_duration` is dropped with its entering event.
+    fn update(
+        &mut self,
+        slot: usize,
+        touching: bool,
+        link: ContactLink,
+        surface: usize,
+        time: f64,
+        frame: usize,
+    ) {
+        let change = match (self.open[slot], touching) {
+            (None, true) => {
+                self.open[slot] = Some((time, self.events.len()));
+                ContactChange::Enter
+            }
+            (Some((start, entered)), false) => {
+                self.open[slot] = None;
+                if time - start < self.min_duration {
+                    self.events.remove(entered);
+                    for (_, later) in self.open.iter_mut().flatten() {
+                        if *later > entered {
+                            *later -= 1;
+                        }
+                    }
+                    return;
+                }
+                ContactChange::Leave
+            }
+            _ => return,
+        };
+        self.events.push(ContactEvent {
+            link,
+            surface,
+            time,
+            frame,
+            change,
+        });
+    }
 }
 
 /// The lowest of `link`'s joints and the mean of them, or `None` if the frame has none.
