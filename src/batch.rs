@@ -303,7 +303,10 @@ pub fn hold_frames(hold: f64) -> u64 {
 
 /// Imitates every frame of `source` (read from `path`, named in errors) with `imitator`, then
 /// holds the human's last pose for `hold` seconds (frames 1/120 s apart) so that the robot
-/// can finish the step it is taking. Calls `each` with every robot frame, in order; returns the
+/// can finish the step it is taking. A frame the imitator asks for again
+/// ([`RobotFrame::awaiting_contact`]: a hand being placed before its contact) is fed again, so
+/// the human's clock pauses while the robot's runs on. Calls `each` with every robot frame, in
+/// order; returns the
 /// metrics of the run, the clip's end marked before the hold
 /// ([`MetricsRecorder::mark_clip_end`]). The one clip loop of batch retargeting and of the
 /// `imitate` example.
@@ -324,12 +327,15 @@ pub fn imitate_clip(
     let hold_frames = hold_frames(hold);
     let mut held_frames = 0;
     let mut clip_end = None;
-    for index in 0.. {
-        let read = source.read_frame(&mut frame);
-        let more = read.map_err(|source| BatchError::Clip {
-            path: path.to_path_buf(),
-            source,
-        })?;
+    let mut again = false;
+    let mut index = 0;
+    loop {
+        let more = again
+            || (source.read_frame(&mut frame)).map_err(|source| BatchError::Clip {
+                path: path.to_path_buf(),
+                source,
+            })?;
+        index += usize::from(!again);
         if more {
             last = Some(frame);
         } else {
@@ -354,9 +360,10 @@ pub fn imitate_clip(
             .step(&frame)
             .map_err(|source| BatchError::Imitation {
                 path: path.to_path_buf(),
-                frame: index,
+                frame: index - 1,
                 source,
             })?;
+        again = robot.awaiting_contact;
         recorder.record(robot);
         each(robot);
     }
@@ -505,6 +512,7 @@ pub fn metrics_value(m: &ImitationMetrics, clip: &Path) -> Value {
         "duration_s": m.duration,
         "clip_frames": m.clip_frames,
         "clip_duration_s": m.clip_duration,
+        "human_clock_pause_s": m.human_clock_pause,
         "human_support_changes": m.human_support_changes,
         "robot_support_changes": m.robot_support_changes,
         "robot_support_sequence": m.robot_support_sequence,

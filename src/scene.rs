@@ -62,10 +62,19 @@ pub enum SceneError {
     },
 }
 
-/// A horizontal rectangle (or the unbounded plane) something can rest on.
+/// A named surface of a scene: a horizontal rectangle (or the unbounded plane) something can
+/// rest on.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Surface {
     name: String,
+    shape: SurfaceShape,
+}
+
+/// The geometry of a surface, without its name (so that it can be copied freely): a horizontal
+/// rectangle, or the unbounded plane, at a height. Metres and radians, in whichever frame it was
+/// built in.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfaceShape {
     centre: Vector2<f64>,
     half_size: Option<Vector2<f64>>,
     yaw: f64,
@@ -78,7 +87,7 @@ impl Surface {
     /// # Errors
     /// [`SceneError::Invalid`] if `height` is not finite.
     pub fn plane(name: impl Into<String>, height: f64) -> Result<Self, SceneError> {
-        Self::build(name.into(), [0.0, 0.0], None, 0.0, height)
+        Self::build(name.into(), [0.0; 2], None, 0.0, height)
     }
 
     /// A horizontal rectangle centred at `centre` (m), `size` (m) long along its own axes,
@@ -115,18 +124,40 @@ impl Surface {
         {
             return Err(invalid("size must be positive and finite (m)"));
         }
-        Ok(Self {
+        let shape = SurfaceShape {
             centre: Vector2::from(centre),
             half_size: size.map(|s| Vector2::new(s[0], s[1]) / 2.0),
             yaw: yaw_deg.to_radians(),
             height,
-            name,
-        })
+        };
+        Ok(Self { name, shape })
     }
 
     /// The surface's name.
     pub fn name(&self) -> &str {
         &self.name
+    }
+
+    /// Its geometry.
+    pub fn shape(&self) -> &SurfaceShape {
+        &self.shape
+    }
+}
+
+impl SurfaceShape {
+    /// The rectangle's centre (m, xy); the origin for an unbounded surface.
+    pub fn centre(&self) -> Vector2<f64> {
+        self.centre
+    }
+
+    /// Half the rectangle's length and width along its own axes (m); `None` when unbounded.
+    pub fn half_size(&self) -> Option<Vector2<f64>> {
+        self.half_size
+    }
+
+    /// The rectangle's turn about z (rad).
+    pub fn yaw(&self) -> f64 {
+        self.yaw
     }
 
     /// The surface's height (m).
@@ -139,6 +170,13 @@ impl Surface {
         self.half_size.is_none()
     }
 
+    /// `xy` in the rectangle's own axes, relative to its centre (m).
+    fn local(&self, xy: Vector2<f64>) -> Vector2<f64> {
+        let (sin, cos) = self.yaw.sin_cos();
+        let d = xy - self.centre;
+        Vector2::new(cos * d.x + sin * d.y, -sin * d.x + cos * d.y)
+    }
+
     /// How far the vertical projection of `point` lies outside the rectangle (m): 0 over the
     /// surface, the horizontal distance to its nearest edge or corner otherwise; 0 everywhere
     /// for an unbounded surface.
@@ -146,16 +184,46 @@ impl Surface {
         let Some(half) = self.half_size else {
             return 0.0;
         };
-        let (sin, cos) = self.yaw.sin_cos();
-        let d = Vector2::new(point.x, point.y) - self.centre;
-        let local = Vector2::new(cos * d.x + sin * d.y, -sin * d.x + cos * d.y);
-        let excess = local.abs() - half;
+        let excess = self.local(point.xy()).abs() - half;
         excess.sup(&Vector2::zeros()).norm()
     }
 
     /// Height of `point` above the surface's plane (m; negative below it).
     pub fn height_above(&self, point: &Vector3<f64>) -> f64 {
         point.z - self.height
+    }
+
+    /// The point of the rectangle shrunk by `margin` (m) on every side nearest to `xy` (m); the
+    /// centre line or the centre when the margin eats a whole side; `xy` itself when unbounded.
+    pub fn nearest_inside(&self, xy: Vector2<f64>, margin: f64) -> Vector2<f64> {
+        let Some(half) = self.half_size else {
+            return xy;
+        };
+        let room = (half - Vector2::repeat(margin)).sup(&Vector2::zeros());
+        let local = self.local(xy).zip_map(&room, |v, r| v.clamp(-r, r));
+        let (sin, cos) = self.yaw.sin_cos();
+        self.centre + Vector2::new(cos * local.x - sin * local.y, sin * local.x + cos * local.y)
+    }
+
+    /// The image of the surface under the similarity `x ↦ to + scale·R(turn)·(x − from)` of the
+    /// horizontal plane (`turn` in rad about z), at `height` (m): how a surface of one frame
+    /// looks in another that is turned, shifted and scaled about a point the two frames share.
+    pub fn mapped(
+        &self,
+        from: Vector2<f64>,
+        to: Vector2<f64>,
+        scale: f64,
+        turn: f64,
+        height: f64,
+    ) -> SurfaceShape {
+        let (sin, cos) = turn.sin_cos();
+        let d = (self.centre - from) * scale;
+        SurfaceShape {
+            centre: to + Vector2::new(cos * d.x - sin * d.y, sin * d.x + cos * d.y),
+            half_size: self.half_size.map(|h| h * scale),
+            yaw: self.yaw + turn,
+            height,
+        }
     }
 }
 
@@ -195,7 +263,7 @@ impl Scene {
             let earlier = &surfaces[..i];
             let reason = if earlier.iter().any(|t| t.name == s.name) {
                 "two surfaces have this name"
-            } else if s.is_unbounded() && earlier.iter().any(Surface::is_unbounded) {
+            } else if s.shape.is_unbounded() && earlier.iter().any(|t| t.shape.is_unbounded()) {
                 "a second unbounded surface: give it a size"
             } else {
                 continue;

@@ -34,11 +34,14 @@ use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 use taskstack::human::HumanFrame;
 use taskstack::human::Side;
 use taskstack::imitation::config::ImitationMethod;
+use taskstack::imitation::contact_events::ContactConfig;
+use taskstack::imitation::hand_support::{HandContactPlan, HandSupportConfig};
 use taskstack::imitation::imitator::{Imitator, ImitatorConfig, RobotFrame};
 use taskstack::imitation::koenemann::KoenemannConfig;
 use taskstack::imitation::metrics::{CONTACT_HEIGHT, MetricsRecorder, convex_margin};
 use taskstack::io::clip::Clip;
 use taskstack::robots::{g1, nao};
+use taskstack::scene::Scene;
 
 struct Counting;
 
@@ -326,6 +329,47 @@ fn koenemann_step_does_not_allocate_after_warm_up() {
         ..ImitatorConfig::default()
     };
     assert_no_allocation_after_warm_up(Imitator::new(nao::profile(), config).unwrap());
+}
+
+/// Nor does the imitator with hands as supports, through placing, the paused clock and holding
+/// (CMU 23_19, both hands on a stool): every step after the first frame.
+#[test]
+fn hand_support_step_does_not_allocate_after_warm_up() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/contact");
+    let clip = Clip::open(dir.join("cmu_23_19_lean_hands_on_stool.bvh")).unwrap();
+    let frames: Vec<HumanFrame> = clip.collect::<Result<_, _>>().unwrap();
+    let scene = Scene::from_toml_file(dir.join("stool_23_19.toml")).unwrap();
+    let plan = HandContactPlan::of_clip(&frames, &scene, &ContactConfig::default()).unwrap();
+    let config = ImitatorConfig {
+        hand_supports: Some(HandSupportConfig::new(plan)),
+        ..ImitatorConfig::default()
+    };
+    let mut imitator = Imitator::new(nao::profile(), config).unwrap();
+    let (mut after_warm_up, mut steps, mut held) = (0, 0, 0);
+    for (i, human) in frames.iter().enumerate() {
+        loop {
+            let before = allocations();
+            let r = imitator.step(human).unwrap();
+            let n = allocations() - before;
+            let again = r.awaiting_contact;
+            held += usize::from(r.hand_supports.iter().flatten().any(|h| h.holding));
+            if i > 0 {
+                after_warm_up += n;
+                steps += 1;
+            }
+            if !again {
+                break;
+            }
+        }
+    }
+    assert!(
+        steps > frames.len() && held > 10,
+        "{steps} steps, {held} held"
+    );
+    assert_eq!(
+        after_warm_up, 0,
+        "{after_warm_up} allocations in {steps} steps"
+    );
 }
 
 /// Allocations counted on this thread over the short clips after the first (the warm-up).

@@ -5,14 +5,18 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Duration;
 
-use anyhow::{Result, bail};
+use anyhow::{Context, Result, bail};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
+use taskstack::human::HumanFrame;
+use taskstack::imitation::contact_events::ContactConfig;
+use taskstack::imitation::hand_support::{HandContactPlan, HandSupportConfig};
 use taskstack::imitation::metrics::ImitationMetrics;
+use taskstack::scene::Scene;
 
 use crate::Report;
-use crate::options::ImitationOptions;
+use crate::options::{ImitationOptions, open_clip};
 use crate::run::{OUTPUT_FILES, Progress, Settings, default_out, imitate_into};
 
 /// The clip imitated when none is given: CMU 05_02 (standing, arm gestures, small steps, a
@@ -46,6 +50,13 @@ pub(crate) struct ImitateArgs {
     /// folder.
     #[arg(long, short, value_name = "DIR")]
     out: Option<PathBuf>,
+    /// Hands as supports (Di Fava et al.): the contacts of the human's hands with the surfaces
+    /// of this scene (TOML, the clip's world frame; see `taskstack contacts`) are found first;
+    /// a hand the human rests on a surface is placed on it, held there and joins the support
+    /// polygon, whose centre the CoM goes to. The human's clock pauses until the hand is
+    /// placed, so joints.csv has its own time axis. Poubel et al.'s method only.
+    #[arg(long, value_name = "SCENE.toml")]
+    scene: Option<PathBuf>,
     #[command(flatten)]
     options: ImitationOptions,
 }
@@ -59,12 +70,16 @@ pub(crate) fn run(args: ImitateArgs, report: Report) -> Result<ExitCode> {
         bail!("the bundled clip is not at {}: give a CLIP", clip.display());
     }
     let out = args.out.clone().unwrap_or_else(|| default_out(&clip));
-    let settings = Settings {
+    let mut settings = Settings {
         profile: args.options.profile()?,
         config: args.options.imitator_config(),
         hold: args.options.hold,
         map: args.options.skeleton_map()?,
     };
+    if let Some(scene) = &args.scene {
+        let plan = hand_contacts(&clip, scene, &settings)?;
+        settings.config.hand_supports = Some(HandSupportConfig::new(plan));
+    }
     let bar = ProgressBar::hidden();
     let mut progress = |event: Progress| match event {
         Progress::Start(total) if report.human() => {
@@ -100,6 +115,17 @@ pub(crate) fn run(args: ImitateArgs, report: Report) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// The hand contacts of `clip` with the surfaces of the scene file `scene`.
+fn hand_contacts(clip: &Path, scene: &Path, settings: &Settings) -> Result<HandContactPlan> {
+    let scene = Scene::from_toml_file(scene)?;
+    let source = open_clip(clip, settings.map.as_ref())?;
+    let config = ContactConfig::for_capture(source.capture());
+    let frames = (source.collect::<Result<Vec<HumanFrame>, _>>())
+        .with_context(|| format!("clip {}", clip.display()))?;
+    HandContactPlan::of_clip(&frames, &scene, &config)
+        .with_context(|| format!("contacts of clip {}", clip.display()))
+}
+
 fn print_summary(
     text: &mut String,
     m: &ImitationMetrics,
@@ -118,6 +144,13 @@ fn print_summary(
         hold_frames,
         m.duration - m.clip_duration
     );
+    if m.human_clock_pause > 0.0 {
+        let _ = writeln!(
+            text,
+            "hand supports: the human's clock paused {:.2} s in all while hands were placed",
+            m.human_clock_pause
+        );
+    }
     let _ = writeln!(
         text,
         "support changes: human {}, robot {} ({})",

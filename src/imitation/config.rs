@@ -2,6 +2,7 @@
 
 use super::error::ImitationError;
 use super::footsteps::FootstepConfig;
+use super::hand_support::HandSupportConfig;
 use super::koenemann::KoenemannConfig;
 use super::phase::PhaseConfig;
 use super::shaping::MotionLimits;
@@ -88,6 +89,9 @@ pub struct ImitatorConfig {
     /// Initial posture (model variable order, rad); `None` (default): the profile's
     /// [`BipedProfile::stand`](crate::robots::BipedProfile::stand).
     pub initial_q: Option<Vec<f64>>,
+    /// Hands as supports, from a recording's contact list (see [`super::hand_support`]; Poubel
+    /// et al.'s method only). `None` (default): the hands only follow the human.
+    pub hand_supports: Option<HandSupportConfig>,
 }
 
 impl Default for ImitatorConfig {
@@ -109,6 +113,7 @@ impl Default for ImitatorConfig {
             nominal_dt: 1.0 / 120.0,
             solver: Settings::default(),
             initial_q: None,
+            hand_supports: None,
         }
     }
 }
@@ -172,6 +177,13 @@ impl ImitatorConfig {
         }
         if self.iterations_per_frame == 0 {
             return invalid("iterations_per_frame", 0.0, "must be >= 1");
+        }
+        if let Some(hands) = &self.hand_supports {
+            if matches!(self.method, ImitationMethod::Koenemann(_)) {
+                let reason = "hand supports need Poubel et al.'s method (task tables)";
+                return invalid("hand_supports", f64::NAN, reason);
+            }
+            hands.validate()?;
         }
         Ok(())
     }

@@ -287,10 +287,10 @@ pub fn contact_events<'a>(
             for (s, surface) in scene.surfaces().iter().enumerate() {
                 let slot = k * surfaces + s;
                 let touching = match link.foot_side() {
-                    Some(side) if surface.is_unbounded() => feet.foot(side).in_support,
+                    Some(side) if surface.shape().is_unbounded() => feet.foot(side).in_support,
                     _ => {
-                        let height = surface.height_above(&lowest);
-                        let over = surface.outside_distance(&lowest) <= config.edge_margin
+                        let height = surface.shape().height_above(&lowest);
+                        let over = surface.shape().outside_distance(&lowest) <= config.edge_margin
                             && height >= -config.max_penetration;
                         if list.is_open(slot) {
                             over && height <= thresholds.leave_height

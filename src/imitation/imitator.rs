@@ -154,6 +154,9 @@ pub(crate) struct Shared {
     pub(crate) velocity_fraction: f64,
     pub(crate) nominal_dt: f64,
     pub(crate) previous_time: Option<f64>,
+    /// Robot time spent with the human's clock paused (s): the robot's clock is the human
+    /// frame's time plus this.
+    pub(crate) paused: f64,
     pub(crate) output: RobotFrame,
 }
 
@@ -188,6 +191,7 @@ impl Shared {
             velocity_fraction: config.velocity_fraction,
             nominal_dt: config.nominal_dt,
             previous_time: None,
+            paused: 0.0,
             output,
         };
         Ok((shared, position_bounds))
@@ -201,15 +205,18 @@ impl Shared {
     }
 
     /// The time step ending at `time` (s): the nominal one for the first frame and for a
-    /// repeated time.
-    pub(crate) fn frame_dt(&self, time: f64) -> Result<f64, ImitationError> {
+    /// repeated time, which pauses the human's clock for that long (the robot's runs on).
+    pub(crate) fn begin_frame(&mut self, time: f64) -> Result<f64, ImitationError> {
         if !time.is_finite() {
             return Err(super::scaler::ScaleError::NonFiniteTime(time).into());
         }
         match self.previous_time {
             None => Ok(self.nominal_dt),
             Some(previous) if time > previous => Ok(time - previous),
-            Some(previous) if time == previous => Ok(self.nominal_dt),
+            Some(previous) if time == previous => {
+                self.paused += self.nominal_dt;
+                Ok(self.nominal_dt)
+            }
             Some(previous) => Err(ImitationError::TimeGoesBack { time, previous }),
         }
     }
@@ -260,7 +267,8 @@ impl Shared {
         out.com = world_t_root
             .transform_point(&model.com(data)?.into())
             .coords;
-        out.time = time;
+        out.time = time + self.paused;
+        out.human_time = time;
         out.q.copy_from_slice(&self.q);
         for (position, &id) in out.effectors.iter_mut().zip(effectors) {
             *position = data.frame_placement(id).translation.vector;

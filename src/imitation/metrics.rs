@@ -5,7 +5,8 @@
 //! * **Static stability**: the signed distance of the CoM ground projection to the edge of the
 //!   support polygon (positive inside, m): the convex hull of the sole outlines
 //!   ([`FootFrames::outline`](crate::robots::FootFrames::outline)) of the feet on the ground, a foot being on the ground when all its
-//!   outline points are within [`CONTACT_HEIGHT`] of the floor.
+//!   outline points are within [`CONTACT_HEIGHT`] of the floor, and the contact points of the
+//!   hands held as supports ([`super::hand_support`]).
 //! * **Executability**: joint-limit violations, and velocity-limit violations
 //!   (`|Δq|/Δt > fraction · v_max`), counted per joint and frame.
 //! * **Side slip**: how far a standing foot moved in the world from where it stood at the start
@@ -241,6 +242,9 @@ pub struct ImitationMetrics {
     pub hands_clip_lag_removed: Vec<EffectorError>,
     /// The time shift (s) that best aligns the robot's hands with the scaled reference.
     pub hand_lag_s: f64,
+    /// How long the human's clock was paused in all while hands were placed on their contacts
+    /// (s): the robot's run is that much longer than the human's.
+    pub human_clock_pause: f64,
     /// Travel of the scaled human and of the robot.
     pub travel: Travel,
     /// Steps (a foot off the floor ≥ 0.2 s) of the human and of the robot.
@@ -271,6 +275,8 @@ pub struct MetricsRecorder {
     frames: usize,
     first_time: Option<f64>,
     last_time: f64,
+    /// The last frame's robot clock minus its human clock (s).
+    clock_pause: f64,
     last_q: Vec<f64>,
     last_human: Option<HumanSupport>,
     human_changes: usize,
@@ -389,6 +395,7 @@ impl MetricsRecorder {
             frames: 0,
             first_time: None,
             last_time: 0.0,
+            clock_pause: 0.0,
             last_q: Vec::new(),
             last_human: None,
             human_changes: 0,
@@ -459,6 +466,7 @@ impl MetricsRecorder {
         self.record_supports(frame);
         self.first_time.get_or_insert(frame.time);
         self.last_time = frame.time;
+        self.clock_pause = frame.time - frame.human_time;
         self.last_q.clear();
         self.last_q.extend_from_slice(&frame.q);
         self.times.record(frame.micros);
@@ -503,6 +511,8 @@ impl MetricsRecorder {
                     .extend(outline.iter().map(|c| corner(c).xy().coords));
             }
         }
+        let held = frame.hand_supports.iter().flatten().filter(|h| h.holding);
+        self.points.extend(held.map(|h| h.point.xy()));
         let margin = convex_margin(&self.points, frame.com.xy());
         self.min_margin = self.min_margin.min(margin);
         if margin < 0.0 {
@@ -637,6 +647,7 @@ impl MetricsRecorder {
                     .collect()
             },
             hand_lag_s,
+            human_clock_pause: self.clock_pause,
             travel: self.travel.travel(),
             human_steps: self.human_steps.steps(),
             robot_steps: self.robot_steps.steps(),

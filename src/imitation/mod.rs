@@ -16,6 +16,7 @@ pub mod config;
 pub mod contact_events;
 pub mod error;
 pub mod footsteps;
+pub mod hand_support;
 pub mod imitator;
 pub mod koenemann;
 pub mod metrics;

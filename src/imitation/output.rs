@@ -2,6 +2,7 @@
 
 use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 
+use super::hand_support::HandPlacement;
 use super::phase::SupportPhase;
 use super::support::HumanSupport;
 use crate::human::{HumanJoint, Side};
@@ -29,8 +30,18 @@ pub(super) fn effector_frames(profile: &BipedProfile) -> [&str; 4] {
 /// One robot output frame.
 #[derive(Debug, Clone)]
 pub struct RobotFrame {
-    /// Time of the human frame (s).
+    /// The robot's clock (s): the human frame's time plus every pause of the human's clock so
+    /// far (each frame fed again at the same time adds the configured `nominal_dt`); equal to
+    /// `human_time` when nothing paused.
     pub time: f64,
+    /// Time of the human frame (s).
+    pub human_time: f64,
+    /// Whether the imitator waits for a hand to be placed before its contact (Algorithm 1 of
+    /// [`super::hand_support`]): the caller should feed the same human frame again, so that
+    /// the human's clock pauses while the robot's runs on.
+    pub awaiting_contact: bool,
+    /// Each hand's support (`[left, right]`, robot world frame) while it is placed or held.
+    pub hand_supports: [Option<HandPlacement>; 2],
     /// Joint angles in the model's variable order (rad); names in [`Imitator::variable_names`](super::imitator::Imitator::variable_names).
     pub q: Vec<f64>,
     /// The human's support at this frame.
@@ -92,6 +103,9 @@ impl RobotFrame {
     ) -> Self {
         RobotFrame {
             time: 0.0,
+            human_time: 0.0,
+            awaiting_contact: false,
+            hand_supports: [None; 2],
             q: q.to_vec(),
             human_support: HumanSupport::Double,
             phase: SupportPhase::Double,

@@ -64,8 +64,11 @@ pub(super) struct FrameTargets<'a> {
     pub(super) swing_lift: f64,
     /// The swing foot's target footprint, while the robot steps.
     pub(super) footstep: Option<GroundPose>,
-    /// Largest error (m) a task following the scaled human asks for in one iteration.
+    /// Largest error (m) a task following the scaled human, or placing a hand, asks for in one
+    /// iteration.
     pub(super) tracking_step: f64,
+    /// The hands' contact points (`[left, right]`) while they are placed or held as supports.
+    pub(super) hand_contacts: [Option<Vector3<f64>>; 2],
 }
 
 /// The gradient criteria of the imitator, shared by every phase.
@@ -358,7 +361,7 @@ impl TaskModel for PhaseTasks<'_> {
         let follows_human = matches!(
             self.tasks.get(task)?.task,
             Task::Point {
-                target: PointTarget::Scaled(_),
+                target: PointTarget::Scaled(_) | PointTarget::HandContact(_),
                 ..
             }
         );
@@ -413,6 +416,15 @@ impl PhaseTasks<'_> {
             return Ok(com_rows(model, data, &[com.x, com.y], jacobian, error)?);
         };
         match task.task {
+            // A free hand's support task: no rows.
+            Task::Point {
+                target: PointTarget::HandContact(side),
+                ..
+            } if self.targets.hand_contacts[side.index()].is_none() => {
+                let (mut jacobian, error) = (jacobian, error);
+                jacobian.fill(0.0);
+                error.fill(0.0);
+            }
             Task::Point { target, .. } => {
                 let goal = self.point_goal(task, target, point)?;
                 let axes = &task.axes[..task.rows];
@@ -493,6 +505,12 @@ impl PhaseTasks<'_> {
                 let xy = targets.footstep.map_or(task.held.xy(), |f| f.xy);
                 Vector3::new(xy.x, xy.y, task.rest_height + lift)
             }
+            PointTarget::HandContact(side) => match targets.hand_contacts[side.index()] {
+                Some(p) => p,
+                None => self
+                    .model
+                    .point_position(self.data, point.frame, &point.offset)?,
+            },
         })
     }
 }

@@ -28,6 +28,7 @@ use std::time::Instant;
 use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 
 use super::footsteps::{FootstepPlanner, GroundPose};
+use super::hand_support::{HandSupports, HandView, hand_point};
 use super::imitator::{Shared, effector_ids, ground_pose, human_stance};
 use super::phase::{Measurements, PhaseMachine, Settling, SupportPhase, TakeOff};
 use super::phase_solver::{Criteria, FrameTargets, PhaseSolver};
@@ -44,6 +45,10 @@ use crate::solver::{JointLimitAvoidance, JointTracking, Settings};
 use super::config::ImitatorConfig;
 use super::error::ImitationError;
 use super::output::{EFFECTORS, RobotFrame, effector_frames};
+
+/// Largest height of a sole corner above the ground (m) for the foot to count as flat on it in
+/// the contact hull of a hand support.
+const SOLE_ON_GROUND: f64 = 1e-3;
 
 /// Poubel et al.'s imitator.
 pub(crate) struct PoubelImitator {
@@ -75,6 +80,8 @@ pub(crate) struct PoubelImitator {
     com_reference: Option<ComReference>,
     /// The shaped height of the swing foot above the ground.
     swing: SwingHeight,
+    /// Hands as supports, when configured.
+    hands: Option<HandSupports>,
 }
 
 impl std::fmt::Debug for PoubelImitator {
@@ -119,10 +126,15 @@ impl PoubelImitator {
         profile: BipedProfile,
         mut config: ImitatorConfig,
     ) -> Result<Self, ImitationError> {
-        let tables = match config.tables.take() {
+        let mut tables = match config.tables.take() {
             Some(tables) => tables,
             None => TaskTables::executable(&config.phase, &profile),
         };
+        let outline_points = profile.feet.iter().map(|f| f.outline.len()).sum();
+        let hands = (config.hand_supports.take()).map(|c| HandSupports::new(c, outline_points));
+        if hands.is_some() {
+            tables.add_hand_supports(&profile);
+        }
         // Position limits only matter to the limit-avoidance gradient and the start clamp.
         let (mut shared, position_bounds) = Shared::new(profile, &config)?;
         let (profile, q) = (&shared.profile, &shared.q);
@@ -176,6 +188,7 @@ impl PoubelImitator {
             motion: config.motion,
             com_reference: None,
             swing: SwingHeight::at(0.0),
+            hands,
             shared,
         })
     }
@@ -212,7 +225,7 @@ impl PoubelImitator {
     /// from valid input; the imitator is then in an unspecified but safe state).
     pub(crate) fn step(&mut self, frame: &HumanFrame) -> Result<&RobotFrame, ImitationError> {
         let start = Instant::now();
-        let dt = self.shared.frame_dt(frame.time)?;
+        let dt = self.shared.begin_frame(frame.time)?;
         let human = self.detector.update(frame);
         let feet = [
             ground_pose(&self.shared.output.left_sole),
@@ -225,6 +238,7 @@ impl PoubelImitator {
         self.shared
             .switch_root(self.phases[phase.index()].table.model_root)?;
         self.scale(frame, human)?;
+        self.update_hands(frame, dt);
         if changed {
             self.hold_targets(phase);
         }
@@ -306,6 +320,7 @@ impl PoubelImitator {
             swing_lift: self.swing.height(),
             footstep: self.footstep_in_root(),
             tracking_step: self.max_tracking_speed * step_dt,
+            hand_contacts: self.hand_contacts(),
         };
         let criteria = Criteria {
             limits: &self.limits,
@@ -398,7 +413,74 @@ impl PoubelImitator {
         out.human_stance = human_stance(frame);
         out.leg_ratio = self.scaler.leg_ratio();
         out.pending_steps = self.footsteps.steps_pending();
+        if let Some(hands) = &self.hands {
+            out.hand_supports = hands.placements();
+            out.awaiting_contact = hands.awaiting(frame.time);
+        }
         Ok(())
+    }
+
+    /// Advances the hand supports to this frame (the scaled reference is current).
+    fn update_hands(&mut self, frame: &HumanFrame, dt: f64) {
+        let views = Side::BOTH.map(|side| self.hand_view(frame, side));
+        if let Some(hands) = &mut self.hands {
+            hands.update(frame.time, dt, views);
+        }
+    }
+
+    /// What the hand supports need to know of the `side` hand this frame (robot world frame);
+    /// `None` without the human hand or its scaled reference.
+    fn hand_view(&self, frame: &HumanFrame, side: Side) -> Option<HandView> {
+        let shared = &self.shared;
+        let root = shared.root.index();
+        let data = &shared.data[root];
+        let to_world = |p: Vector3<f64>| shared.world_t_root.transform_point(&p.into()).coords;
+        let (_, joint) = EFFECTORS[side.index()];
+        let scaled = shared.output.reference[joint.index()]?;
+        let robot = data.frame_placement(self.effectors[root][side.index()]);
+        // The scaled points' frame is the base sole's, its x axis the human base foot's heading.
+        let base = self.scaler.scaled().base();
+        let base_sole = data.frame_placement(shared.soles[root][base.index()]);
+        let base_yaw = ground_pose(&(shared.world_t_root * base_sole)).yaw;
+        Some(HandView {
+            human: hand_point(frame, side)?,
+            scaled: to_world(scaled),
+            robot: to_world(robot.translation.vector),
+            turn: base_yaw - self.scaler.foot_heading(base),
+            ratio: self.scaler.leg_ratio(),
+        })
+    }
+
+    /// Where the hands go this frame, in the root frame, while placed or held.
+    fn hand_contacts(&self) -> [Option<Vector3<f64>>; 2] {
+        let aims = self.hands.as_ref().map(HandSupports::aims);
+        let world_t_root = &self.shared.world_t_root;
+        (aims.unwrap_or_default())
+            .map(|p| p.map(|p| world_t_root.inverse_transform_point(&p.into()).coords))
+    }
+
+    /// The centre of the contact hull (world frame, m) when a hand is held: the feet flat on
+    /// the ground and the held hands' contact points.
+    fn hand_support_goal(&mut self) -> Option<Vector2<f64>> {
+        let hands = self.hands.as_mut()?;
+        let shared = &self.shared;
+        let root = shared.root.index();
+        let data = &shared.data[root];
+        let profile = &shared.profile;
+        let soles = Side::BOTH.map(|side| {
+            let sole = shared.world_t_root * data.frame_placement(shared.soles[root][side.index()]);
+            let corners = profile.foot(side).outline.iter();
+            let corners = corners.map(move |&[x, y]| sole.transform_point(&[x, y, 0.0].into()));
+            (
+                corners.clone().all(|c| c.z.abs() <= SOLE_ON_GROUND),
+                corners,
+            )
+        });
+        let points = soles
+            .into_iter()
+            .filter(|(flat, _)| *flat)
+            .flat_map(|(_, corners)| corners.map(|c| [c.x, c.y]));
+        hands.com_goal(points)
     }
 
     /// At the start of a step: the held targets of `phase`'s tasks become the frames' current
@@ -420,6 +502,7 @@ impl PoubelImitator {
         phase: SupportPhase,
         dt: f64,
     ) -> Result<(Vector2<f64>, f64), ImitationError> {
+        let hand_goal = self.hand_support_goal();
         let root = self.shared.root.index();
         let model = self.shared.profile.model(self.shared.root);
         let data = &self.shared.data[root];
@@ -437,7 +520,7 @@ impl PoubelImitator {
                 .coords
                 .xy()
         };
-        let goal_world = to_world(goal);
+        let goal_world = hand_goal.unwrap_or_else(|| to_world(goal));
         let com = to_world(model.com(data)?.xy());
         let reference = self
             .com_reference

@@ -465,6 +465,12 @@ impl Scaler {
         })
     }
 
+    /// Heading of the human's `side` foot (rad about z, human world frame) as of the last
+    /// frame: the scaled points' frame has its x axis along the base foot's heading.
+    pub fn foot_heading(&self, side: Side) -> f64 {
+        self.headings[side.index()]
+    }
+
     /// The robot skeleton.
     pub fn skeleton(&self) -> &RobotSkeleton {
         &self.skeleton

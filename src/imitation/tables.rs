@@ -194,6 +194,10 @@ pub enum PointTarget {
         /// Height above the rest height (m).
         lift: f64,
     },
+    /// The contact point of the `Side` hand while it is placed on a surface or rests there as
+    /// a support ([`super::hand_support`]); the task has no effect (zero rows) while the hand
+    /// is free.
+    HandContact(Side),
 }
 
 /// Target of a [`Task::Orientation`].
@@ -244,10 +248,15 @@ pub enum Task {
 
 impl Task {
     /// The task's name in the stack: `"com_xy"`, the frame name, or the frame name with the axes
-    /// (`"l_toe.z"`) when not all three are tracked.
+    /// (`"l_toe.z"`) when not all three are tracked; a hand support is `"<hand>.support"`.
     pub fn name(&self) -> String {
         match self {
             Task::ComXY(_) => "com_xy".to_owned(),
+            Task::Point {
+                frame,
+                target: PointTarget::HandContact(_),
+                ..
+            } => format!("{frame}.support"),
             Task::Point { frame, axes, .. } => format!("{frame}{}", axes.suffix()),
             Task::Orientation {
                 frame,
@@ -965,6 +974,7 @@ impl fmt::Display for PointCell<'_> {
             PointTarget::Footstep { lift } => {
                 write!(f, "{coords} over the footstep + {}", mm(lift))
             }
+            PointTarget::HandContact(_) => write!(f, "{coords} on its contact, while a support"),
         }
     }
 }
@@ -1094,6 +1104,25 @@ impl TaskTables {
         let index = table.phase.index();
         self.tables[index] = table;
         Ok(())
+    }
+
+    /// Adds the hand supports of [`super::hand_support`] to every table: a point task per hand
+    /// ([`PointTarget::HandContact`]) at the end of the top level when it is the feet's
+    /// `"contact"` level, else in a `"contact"` level of their own above the others. A hand
+    /// support then ranks with the feet, above balance.
+    pub fn add_hand_supports(&mut self, profile: &BipedProfile) {
+        for table in &mut self.tables {
+            let tasks = Side::BOTH.map(|side| Task::Point {
+                frame: profile.hands[side.index()].clone(),
+                offset: [0.0; 3],
+                axes: Axes::XYZ,
+                target: PointTarget::HandContact(side),
+            });
+            match table.levels.first_mut() {
+                Some(level) if level.name == "contact" => level.tasks.extend(tasks),
+                _ => (table.levels).insert(0, Level::of_tasks("contact", tasks.into())),
+            }
+        }
     }
 
     /// All tables, in the row order of Table I ([`SupportPhase::ALL`]).

@@ -341,7 +341,7 @@ impl KoenemannImitator {
     /// Imitates one human frame.
     pub(crate) fn step(&mut self, frame: &HumanFrame) -> Result<&RobotFrame, ImitationError> {
         let start = Instant::now();
-        let dt = self.shared.frame_dt(frame.time)?;
+        let dt = self.shared.begin_frame(frame.time)?;
         let human = self.detector.update(frame);
         self.q_start.copy_from_slice(&self.shared.q);
         let posture = Posture::of_human(frame);
