@@ -2,7 +2,7 @@
 //! leaning with both hands on a stool (CMU 23_19): the judge cannot model a stool, so the
 //! invariants are checked here, frame by frame, on the robot's own output:
 //!
-//! * each hand is placed before its contact and then holds its place;
+//! * each hand is placed before its contact and then holds its place, and the feet stay put;
 //! * the CoM ground projection stays inside the hull of the feet and the held hands, and goes
 //!   to the hull's centre;
 //! * no hand sinks into the surface it rests on;
@@ -156,6 +156,12 @@ fn hands_are_placed_then_hold_their_place_and_carry_the_com() {
             }
             assert!(hand.surface.height_above(&hand.point) > 0.0);
         }
+    }
+    // The hands never pull a foot off the ground: they rank below the feet.
+    let start = out[0].left_sole.translation.vector;
+    for f in &out {
+        let moved = (f.left_sole.translation.vector - start).norm();
+        assert!(moved < 5e-4, "left foot moved {moved} m at {} s", f.time);
     }
     // The CoM stays inside the contact hull, and ends at its centre (1 s after the clip, the
     // shaped reference has arrived).

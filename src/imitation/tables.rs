@@ -1107,9 +1107,10 @@ impl TaskTables {
     }
 
     /// Adds the hand supports of [`super::hand_support`] to every table: a point task per hand
-    /// ([`PointTarget::HandContact`]) at the end of the top level when it is the feet's
-    /// `"contact"` level, else in a `"contact"` level of their own above the others. A hand
-    /// support then ranks with the feet, above balance.
+    /// ([`PointTarget::HandContact`]) in a `"hand contact"` level of their own, right below the
+    /// feet's `"contact"` level (at the top when a table has none): a hand rests on a surface
+    /// without ever pulling a standing foot off the ground, and above balance, so the CoM moves
+    /// with the hands held.
     pub fn add_hand_supports(&mut self, profile: &BipedProfile) {
         for table in &mut self.tables {
             let tasks = Side::BOTH.map(|side| Task::Point {
@@ -1118,10 +1119,9 @@ impl TaskTables {
                 axes: Axes::XYZ,
                 target: PointTarget::HandContact(side),
             });
-            match table.levels.first_mut() {
-                Some(level) if level.name == "contact" => level.tasks.extend(tasks),
-                _ => (table.levels).insert(0, Level::of_tasks("contact", tasks.into())),
-            }
+            let feet = table.levels.first().is_some_and(|l| l.name == "contact");
+            let level = Level::of_tasks("hand contact", tasks.into());
+            table.levels.insert(usize::from(feet), level);
         }
     }
 
