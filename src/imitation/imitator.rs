@@ -61,7 +61,9 @@ impl Imitator {
         }
     }
 
-    /// Imitates one human frame: returns the robot's posture for it.
+    /// Imitates one human frame: returns the robot's posture for it. With hand supports
+    /// ([`ImitatorConfig::hand_supports`]), feed the same frame again while the output's
+    /// [`RobotFrame::awaiting_contact`] is set: the human's clock pauses while a hand is placed.
     ///
     /// # Errors
     /// [`ImitationError::TimeGoesBack`] when `frame.time` is below the previous frame's, a
