@@ -29,7 +29,7 @@
 
 use std::path::Path;
 
-use nalgebra::{Vector2, Vector3};
+use nalgebra::{Rotation2, Vector2, Vector3};
 use serde::Deserialize;
 use thiserror::Error;
 
@@ -172,9 +172,7 @@ impl SurfaceShape {
 
     /// `xy` in the rectangle's own axes, relative to its centre (m).
     fn local(&self, xy: Vector2<f64>) -> Vector2<f64> {
-        let (sin, cos) = self.yaw.sin_cos();
-        let d = xy - self.centre;
-        Vector2::new(cos * d.x + sin * d.y, -sin * d.x + cos * d.y)
+        Rotation2::new(-self.yaw) * (xy - self.centre)
     }
 
     /// How far the vertical projection of `point` lies outside the rectangle (m): 0 over the
@@ -201,8 +199,7 @@ impl SurfaceShape {
         };
         let room = (half - Vector2::repeat(margin)).sup(&Vector2::zeros());
         let local = self.local(xy).zip_map(&room, |v, r| v.clamp(-r, r));
-        let (sin, cos) = self.yaw.sin_cos();
-        self.centre + Vector2::new(cos * local.x - sin * local.y, sin * local.x + cos * local.y)
+        self.centre + Rotation2::new(self.yaw) * local
     }
 
     /// The image of the surface under the similarity `x ↦ to + scale·R(turn)·(x − from)` of the
@@ -216,10 +213,8 @@ impl SurfaceShape {
         turn: f64,
         height: f64,
     ) -> SurfaceShape {
-        let (sin, cos) = turn.sin_cos();
-        let d = (self.centre - from) * scale;
         SurfaceShape {
-            centre: to + Vector2::new(cos * d.x - sin * d.y, sin * d.x + cos * d.y),
+            centre: to + Rotation2::new(turn) * (self.centre - from) * scale,
             half_size: self.half_size.map(|h| h * scale),
             yaw: self.yaw + turn,
             height,

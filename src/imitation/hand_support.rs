@@ -10,14 +10,14 @@
 //! # Placing, pausing, holding (Algorithm 1)
 //!
 //! From `t_enter − lead` the hand is *placed*: its target becomes the point where the human will
-//! touch, mapped to the robot (below), and it goes there at the tracking speed, as a task of the
-//! contact level (above balance). It comes from above, so that it never passes through the
+//! touch, mapped to the robot (below), and it goes there at the tracking speed, as a task of a
+//! level of its own below the feet's contact level and above balance. It comes from above, so that it never passes through the
 //! surface: a hand lower than `approach_height` above the surface and not over it first rises
 //! where it is, then moves over its contact point at that height, then goes down. If the
 //! human's clock reaches `t_enter` before the hand is within `tolerance` of the point, the clock
 //! pauses there ([`RobotFrame::awaiting_contact`]: the imitator is fed the same human frame
-//! again while the robot's clock runs on) until it is, or until `max_pause` has passed. Then the contact is on: the hand is held at the point, and the
-//! point joins the feet's sole outlines in the support polygon whose area centroid becomes the
+//! again while the robot's clock runs on) until it is, or until `max_pause` has passed. Then the
+//! contact is on: the hand is held at the point, and the point joins the feet's sole outlines in the support polygon whose area centroid becomes the
 //! CoM goal (the centre of the contact hull). At `t_leave` the hand is free and follows the
 //! human again.
 //!
@@ -34,7 +34,7 @@
 //! Units: metres, seconds. The imitator allocates what the hand supports need in its constructor;
 //! stepping with them allocates nothing.
 
-use nalgebra::{Vector2, Vector3};
+use nalgebra::{Rotation2, Vector2, Vector3};
 use thiserror::Error;
 
 use super::contact_events::{
@@ -180,11 +180,6 @@ impl HandContactPlan {
     /// The contacts of `hand`, in time order.
     pub fn contacts(&self, hand: Side) -> &[PlannedContact] {
         &self.hands[hand.index()]
-    }
-
-    /// Whether no hand ever touches a surface.
-    pub fn is_empty(&self) -> bool {
-        self.hands.iter().all(Vec::is_empty)
     }
 }
 
@@ -438,10 +433,8 @@ fn placement(contact: &PlannedContact, view: &HandView, edge_margin: f64) -> Han
     let resting = k * (contact.hand.z - surface.height());
     let height = view.scaled.z - k * (h.z - contact.hand.z);
     let mapped = surface.mapped(h.xy(), view.scaled.xy(), k, view.turn, height - resting);
-    let (sin, cos) = view.turn.sin_cos();
-    let d = (contact.hand - h).xy() * k;
-    let xy = view.scaled.xy() + Vector2::new(cos * d.x - sin * d.y, sin * d.x + cos * d.y);
-    let xy = mapped.nearest_inside(xy, edge_margin);
+    let touch = view.scaled.xy() + Rotation2::new(view.turn) * (contact.hand - h).xy() * k;
+    let xy = mapped.nearest_inside(touch, edge_margin);
     HandPlacement {
         point: Vector3::new(xy.x, xy.y, height),
         surface: mapped,

@@ -485,14 +485,15 @@ impl PhaseTasks<'_> {
         point: &FramePoint,
     ) -> Result<Vector3<f64>, ImitationError> {
         let targets = &self.targets;
+        let or_current = |p: Option<Vector3<f64>>| {
+            p.map_or_else(
+                || (self.model).point_position(self.data, point.frame, &point.offset),
+                Ok,
+            )
+        };
         Ok(match target {
             // Missing references (never after the scaler) hold the current position.
-            PointTarget::Scaled(joint) => match targets.reference[joint.index()] {
-                Some(p) => p,
-                None => self
-                    .model
-                    .point_position(self.data, point.frame, &point.offset)?,
-            },
+            PointTarget::Scaled(joint) => or_current(targets.reference[joint.index()])?,
             // A lifted or lowered foot follows the shaped swing height; a foot on the ground
             // (lift 0 outside a landing) has swing height 0.
             PointTarget::Held { .. } => Vector3::new(
@@ -505,12 +506,7 @@ impl PhaseTasks<'_> {
                 let xy = targets.footstep.map_or(task.held.xy(), |f| f.xy);
                 Vector3::new(xy.x, xy.y, task.rest_height + lift)
             }
-            PointTarget::HandContact(side) => match targets.hand_contacts[side.index()] {
-                Some(p) => p,
-                None => self
-                    .model
-                    .point_position(self.data, point.frame, &point.offset)?,
-            },
+            PointTarget::HandContact(side) => or_current(targets.hand_contacts[side.index()])?,
         })
     }
 }

@@ -30,6 +30,7 @@ use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 use super::footsteps::{FootstepPlanner, GroundPose};
 use super::hand_support::{HandSupports, HandView, hand_point};
 use super::imitator::{Shared, effector_ids, ground_pose, human_stance};
+use super::metrics::CONTACT_HEIGHT;
 use super::phase::{Measurements, PhaseMachine, Settling, SupportPhase, TakeOff};
 use super::phase_solver::{Criteria, FrameTargets, PhaseSolver};
 use super::scaler::{RobotSkeleton, ScaleConfig, Scaler};
@@ -45,10 +46,6 @@ use crate::solver::{JointLimitAvoidance, JointTracking, Settings};
 use super::config::ImitatorConfig;
 use super::error::ImitationError;
 use super::output::{EFFECTORS, RobotFrame, effector_frames};
-
-/// Largest height of a sole corner above the ground (m) for the foot to count as flat on it in
-/// the contact hull of a hand support.
-const SOLE_ON_GROUND: f64 = 1e-3;
 
 /// Poubel et al.'s imitator.
 pub(crate) struct PoubelImitator {
@@ -422,6 +419,9 @@ impl PoubelImitator {
 
     /// Advances the hand supports to this frame (the scaled reference is current).
     fn update_hands(&mut self, frame: &HumanFrame, dt: f64) {
+        if self.hands.is_none() {
+            return;
+        }
         let views = Side::BOTH.map(|side| self.hand_view(frame, side));
         if let Some(hands) = &mut self.hands {
             hands.update(frame.time, dt, views);
@@ -472,7 +472,7 @@ impl PoubelImitator {
             let corners = profile.foot(side).outline.iter();
             let corners = corners.map(move |&[x, y]| sole.transform_point(&[x, y, 0.0].into()));
             (
-                corners.clone().all(|c| c.z.abs() <= SOLE_ON_GROUND),
+                corners.clone().all(|c| c.z.abs() <= CONTACT_HEIGHT),
                 corners,
             )
         });
