@@ -547,5 +547,10 @@ pub fn metrics_value(m: &ImitationMetrics, clip: &Path) -> Value {
             "queued_at_end": m.queued_steps_at_end,
         },
         "catch_up_s": m.catch_up_s,
+        "foot_lag_s": {
+            "lift": spread(&m.lift_lag),
+            "landing": spread(&m.landing_lag),
+            "human_lifts": m.human_lifts,
+        },
     })
 }

@@ -12,7 +12,9 @@ use serde_json::json;
 use taskstack::human::HumanFrame;
 use taskstack::imitation::contact_events::ContactConfig;
 use taskstack::imitation::hand_support::{HandContactPlan, HandSupportConfig};
+use taskstack::imitation::look_ahead::{FootLookAhead, FootSchedule};
 use taskstack::imitation::metrics::ImitationMetrics;
+use taskstack::imitation::support::SupportConfig;
 use taskstack::scene::Scene;
 
 use crate::Report;
@@ -57,6 +59,21 @@ pub(crate) struct ImitateArgs {
     /// placed, so joints.csv has its own time axis. Poubel et al.'s method only.
     #[arg(long, value_name = "SCENE.toml")]
     scene: Option<PathBuf>,
+    /// Offline mode: the whole clip is read first, so the robot knows when the human will lift
+    /// each foot, for how long and where it will land. It shifts its weight onto the other foot
+    /// up to --lift-lead seconds before the human lifts one (the foot itself leaves the ground with
+    /// the human's), lowers a lifted foot up to --landing-lead seconds before the human's lands, and
+    /// with --walk steps toward where the human's foot will land. Poubel et al.'s method only
+    #[arg(long)]
+    offline: bool,
+    /// Offline mode: how long before the human lifts a foot the robot starts shifting its
+    /// weight (s, ≥ 0; the robot's weight shift takes about this long)
+    #[arg(long, value_name = "SECONDS", default_value_t = FootLookAhead::DEFAULT_LIFT_LEAD, requires = "offline")]
+    lift_lead: f64,
+    /// Offline mode: how long before the human puts a foot down the robot starts lowering it
+    /// (s, ≥ 0)
+    #[arg(long, value_name = "SECONDS", default_value_t = FootLookAhead::DEFAULT_LANDING_LEAD, requires = "offline")]
+    landing_lead: f64,
     #[command(flatten)]
     options: ImitationOptions,
 }
@@ -76,9 +93,27 @@ pub(crate) fn run(args: ImitateArgs, report: Report) -> Result<ExitCode> {
         hold: args.options.hold,
         map: args.options.skeleton_map()?,
     };
-    if let Some(scene) = &args.scene {
-        let plan = hand_contacts(&clip, scene, &settings)?;
-        settings.config.hand_supports = Some(HandSupportConfig::new(plan));
+    if args.scene.is_some() || args.offline {
+        let source = open_clip(&clip, settings.map.as_ref())?;
+        let capture = source.capture();
+        let frames = (source.collect::<Result<Vec<HumanFrame>, _>>())
+            .with_context(|| format!("clip {}", clip.display()))?;
+        if let Some(scene) = &args.scene {
+            let scene = Scene::from_toml_file(scene)?;
+            let plan =
+                HandContactPlan::of_clip(&frames, &scene, &ContactConfig::for_capture(capture))
+                    .with_context(|| format!("contacts of clip {}", clip.display()))?;
+            settings.config.hand_supports = Some(HandSupportConfig::new(plan));
+        }
+        if args.offline {
+            let schedule = FootSchedule::of_clip(&frames, SupportConfig::for_capture(capture))
+                .with_context(|| format!("foot lifts of clip {}", clip.display()))?;
+            settings.config.look_ahead = Some(FootLookAhead {
+                schedule,
+                lift_lead: args.lift_lead,
+                landing_lead: args.landing_lead,
+            });
+        }
     }
     let bar = ProgressBar::hidden();
     let mut progress = |event: Progress| match event {
@@ -116,16 +151,6 @@ pub(crate) fn run(args: ImitateArgs, report: Report) -> Result<ExitCode> {
 }
 
 /// The hand contacts of `clip` with the surfaces of the scene file `scene`.
-fn hand_contacts(clip: &Path, scene: &Path, settings: &Settings) -> Result<HandContactPlan> {
-    let scene = Scene::from_toml_file(scene)?;
-    let source = open_clip(clip, settings.map.as_ref())?;
-    let config = ContactConfig::for_capture(source.capture());
-    let frames = (source.collect::<Result<Vec<HumanFrame>, _>>())
-        .with_context(|| format!("clip {}", clip.display()))?;
-    HandContactPlan::of_clip(&frames, &scene, &config)
-        .with_context(|| format!("contacts of clip {}", clip.display()))
-}
-
 fn print_summary(
     text: &mut String,
     m: &ImitationMetrics,
@@ -195,6 +220,13 @@ fn print_summary(
         "travel: scaled human {:.3} m, robot {:.3} m; steps: human {}, robot {}",
         t.scaled_human_m, t.robot_m, m.human_steps, m.robot_steps
     );
+    if m.human_lifts > 0 {
+        let _ = writeln!(
+            text,
+            "feet: robot lifted {} of the human's {} foot lifts, median {:.2} s after (landed {:.2} s after)",
+            m.lift_lag.count, m.human_lifts, m.lift_lag.median, m.landing_lag.median
+        );
+    }
     let s = &m.solve_time_us;
     let _ = writeln!(
         text,

@@ -4,6 +4,7 @@ use super::error::ImitationError;
 use super::footsteps::FootstepConfig;
 use super::hand_support::HandSupportConfig;
 use super::koenemann::KoenemannConfig;
+use super::look_ahead::FootLookAhead;
 use super::phase::PhaseConfig;
 use super::shaping::MotionLimits;
 use super::support::SupportConfig;
@@ -92,6 +93,10 @@ pub struct ImitatorConfig {
     /// Hands as supports, from a recording's contact list (see [`super::hand_support`]; Poubel
     /// et al.'s method only). `None` (default): the hands only follow the human.
     pub hand_supports: Option<HandSupportConfig>,
+    /// The offline mode's look-ahead for the feet: the recording's foot lifts, known in advance
+    /// (see [`super::look_ahead`]; Poubel et al.'s method only). `None` (default): online, the
+    /// robot reacts to the human's feet as it sees them.
+    pub look_ahead: Option<FootLookAhead>,
 }
 
 impl Default for ImitatorConfig {
@@ -114,6 +119,7 @@ impl Default for ImitatorConfig {
             solver: Settings::default(),
             initial_q: None,
             hand_supports: None,
+            look_ahead: None,
         }
     }
 }
@@ -184,6 +190,15 @@ impl ImitatorConfig {
                 return invalid("hand_supports", f64::NAN, reason);
             }
             hands.validate()?;
+        }
+        if let Some(ahead) = &self.look_ahead {
+            if matches!(self.method, ImitationMethod::Koenemann(_)) {
+                let reason = "the feet's look-ahead needs Poubel et al.'s method (support phases)";
+                return invalid("look_ahead", f64::NAN, reason);
+            }
+            if let Some((name, value)) = ahead.invalid_field() {
+                return invalid(name, value, "must be finite and >= 0 s");
+            }
         }
         Ok(())
     }

@@ -34,6 +34,7 @@
 
 use nalgebra::{Rotation2, Vector2};
 
+use super::look_ahead::{FootLift, FootLookAhead};
 use super::phase::SupportPhase;
 use super::support::HumanSupport;
 use crate::human::Side;
@@ -164,6 +165,23 @@ pub struct FootstepPlanner {
     /// Where the robot's feet stood when the current step began (left, right): the targets
     /// when the feet do not follow the human's.
     home: Option<[GroundPose; 2]>,
+    /// The human's foot lifts known in advance (offline mode).
+    ahead: Option<FootLookAhead>,
+    /// The human's lift the current step follows (looking ahead, without walking).
+    following: Option<FootLift>,
+    /// Per foot, the start (human clock, s) of the last lift of the human's that a robot step
+    /// followed, so that a step landed ahead of the human is not taken again.
+    followed: [f64; 2],
+}
+
+/// What the planner asks of the phase machine for one frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct StepRequest {
+    /// The support to work toward.
+    pub support: HumanSupport,
+    /// Whether the swing foot may leave the ground: false while the robot shifts its weight
+    /// ahead of a human lift-off that has not happened yet ([`super::look_ahead`]).
+    pub lift: bool,
 }
 
 impl FootstepPlanner {
@@ -180,7 +198,16 @@ impl FootstepPlanner {
             target: None,
             off_target: 0,
             home: None,
+            ahead: None,
+            following: None,
+            followed: [f64::NEG_INFINITY; 2],
         }
+    }
+
+    /// The planner looks ahead on the human's clock with `ahead` (see [`super::look_ahead`]).
+    pub fn with_look_ahead(mut self, ahead: FootLookAhead) -> Self {
+        self.ahead = Some(ahead);
+        self
     }
 
     /// The swing foot and its target (robot world), while the robot steps.
@@ -199,7 +226,7 @@ impl FootstepPlanner {
     /// One frame. `human` is the detected human support, `ratio` the leg ratio, `feet` the
     /// robot's sole poses (left, right; robot world) and `phase` its phase at the previous
     /// frame, `dt` the frame's time step (s). Returns the support the phase machine should work
-    /// toward.
+    /// toward and whether the swing foot may lift.
     pub fn update(
         &mut self,
         frame: &HumanFrame,
@@ -208,7 +235,8 @@ impl FootstepPlanner {
         feet: [GroundPose; 2],
         phase: SupportPhase,
         dt: f64,
-    ) -> HumanSupport {
+    ) -> StepRequest {
+        let now = frame.time;
         self.observe(frame, human, dt);
         if self.origin.is_none()
             && let [Some(l), Some(r)] = self.human
@@ -234,17 +262,32 @@ impl FootstepPlanner {
         self.off_target = usize::from(off(Side::Right)) + usize::from(off(Side::Left));
         match self.step {
             Step::Idle if phase == SupportPhase::Double => {
-                self.step = self.choose(off, error);
+                self.following = self.stance_ahead(now);
+                self.step = match self.following {
+                    Some(lift) => {
+                        self.followed[lift.foot.index()] = lift.start;
+                        Step::Swing(lift.foot, 0.0)
+                    }
+                    None => self.choose(off, error),
+                };
                 if let Step::Swing(foot, _) = self.step {
                     self.target = targets[foot.index()];
                 }
             }
+            // A followed stance that the human ends before the robot's foot is off the ground is
+            // given up (the phase machine aborts the weight shift): a foot lifted after the
+            // human's is down again would imitate nothing.
+            Step::Swing(..) if shifting(phase) && self.following.is_some_and(|l| l.end <= now) => {
+                self.step = Step::Idle;
+            }
             // Without walking the robot imitates the human's one-leg stances: if the human now
             // stands on the other leg and the robot's foot is still down, it takes the human's
             // current stance instead (the phase machine aborts the weight shift). A walking robot
-            // finishes the step it chose: its targets, not the stances, decide.
+            // finishes the step it chose: its targets, not the stances, decide. (Looking ahead,
+            // the stance is known before it starts.)
             Step::Swing(foot, _)
                 if !self.config.follow
+                    && self.ahead.is_none()
                     && shifting(phase)
                     && matches!(self.stance, Some((lifted, t))
                         if lifted == foot.other() && t >= self.config.stance_time) =>
@@ -255,7 +298,7 @@ impl FootstepPlanner {
             Step::Swing(foot, waited) => {
                 self.target = targets[foot.index()];
                 let there = error(foot).is_none_or(|(d, a)| d <= 0.005 && a <= 0.035);
-                let human_down = self.down[foot.index()];
+                let human_down = self.down[foot.index()] || self.lands_soon(foot, now);
                 let single = matches!(phase, SupportPhase::Right | SupportPhase::Left);
                 let waited = if single && human_down {
                     waited + dt
@@ -272,21 +315,69 @@ impl FootstepPlanner {
             Step::Landing if phase == SupportPhase::Double => self.step = Step::Idle,
             Step::Idle | Step::Landing => {}
         }
-        match self.step {
+        if self.step == Step::Idle {
+            self.following = None;
+        }
+        let support = match self.step {
             Step::Swing(Side::Left, _) => HumanSupport::Right,
             Step::Swing(Side::Right, _) => HumanSupport::Left,
             Step::Idle | Step::Landing => HumanSupport::Double,
+        };
+        let lift = match self.step {
+            Step::Swing(foot, _) => self.may_lift(foot, now),
+            Step::Idle | Step::Landing => true,
+        };
+        StepRequest { support, lift }
+    }
+
+    /// Whether the swing foot may leave the ground. Online, always. Looking ahead, a followed
+    /// stance lifts with the human's foot; a walking step waits for a lift of the human's foot
+    /// that is coming within the lift lead.
+    fn may_lift(&self, foot: Side, now: f64) -> bool {
+        let Some(ahead) = &self.ahead else {
+            return true;
+        };
+        let down = self.down[foot.index()];
+        if self.following.is_some() {
+            return !down;
+        }
+        let coming = ahead.schedule.lift_within(foot, now, ahead.lift_lead);
+        !(down && coming.is_some_and(|l| l.start > now))
+    }
+
+    /// Whether the human's `foot` is up at `now` and will be down within the landing lead.
+    fn lands_soon(&self, foot: Side, now: f64) -> bool {
+        let ahead = self.ahead.as_ref();
+        let lift = ahead.and_then(|a| a.schedule.lift_within(foot, now, 0.0).zip(Some(a)));
+        lift.is_some_and(|(l, a)| l.start <= now && l.end <= now + a.landing_lead)
+    }
+
+    /// Looking ahead without walking: the first human lift starting within the lift lead, not
+    /// followed yet, during which the robot, ready at the lift-off or a lift lead from now,
+    /// whichever is later, can stand on one leg at least [`FootstepConfig::stance_time`].
+    fn stance_ahead(&self, now: f64) -> Option<FootLift> {
+        let ahead = self.ahead.as_ref().filter(|_| !self.config.follow)?;
+        let worth = |f: Side| {
+            let lift = ahead.schedule.lift_within(f, now, ahead.lift_lead)?;
+            let ready = lift.start.max(now + ahead.lift_lead);
+            let followed = lift.start <= self.followed[f.index()];
+            (!followed && lift.end - ready >= self.config.stance_time).then_some(*lift)
+        };
+        match (worth(Side::Left), worth(Side::Right)) {
+            (Some(l), Some(r)) => Some(if l.start <= r.start { l } else { r }),
+            (l, r) => l.or(r),
         }
     }
 
-    /// The next step from double support: the human's one-leg stance, or the foot farthest off
-    /// its target.
+    /// The next step from double support: the human's one-leg stance (online: once it has
+    /// lasted [`FootstepConfig::stance_time`]), or the foot farthest off its target.
     fn choose(
         &self,
         off: impl Fn(Side) -> bool,
         error: impl Fn(Side) -> Option<(f64, f64)>,
     ) -> Step {
-        if let Some((lifted, t)) = self.stance
+        if self.ahead.is_none()
+            && let Some((lifted, t)) = self.stance
             && t >= self.config.stance_time
         {
             return Step::Swing(lifted, 0.0);
@@ -319,6 +410,12 @@ impl FootstepPlanner {
                 && let Some(print) = footprint(frame, foot)
             {
                 self.human[foot.index()] = Some(print);
+            }
+            // Looking ahead, a foot about to be lifted (or in the air) aims at where it lands.
+            let ahead = self.ahead.as_ref();
+            let lift = ahead.and_then(|a| a.schedule.lift_within(foot, frame.time, a.lift_lead));
+            if let Some(landing) = lift.and_then(|l| l.landing) {
+                self.human[foot.index()] = Some(landing);
             }
         }
         let lifted = match human {
@@ -360,7 +457,7 @@ impl FootstepPlanner {
 }
 
 /// The footprint of a human foot: ankle ground point and heading.
-fn footprint(frame: &HumanFrame, foot: Side) -> Option<GroundPose> {
+pub(crate) fn footprint(frame: &HumanFrame, foot: Side) -> Option<GroundPose> {
     let (ankle, toe) = match foot {
         Side::Right => (HumanJoint::RAnkle, HumanJoint::RToe),
         Side::Left => (HumanJoint::LAnkle, HumanJoint::LToe),
@@ -437,13 +534,17 @@ mod tests {
         let dt = 0.01;
         // Standing: no step.
         let start = human([0.0, -0.1], [0.0, 0.1]);
-        let s = planner.update(&start, HumanSupport::Double, 0.25, FEET, double, dt);
+        let s = planner
+            .update(&start, HumanSupport::Double, 0.25, FEET, double, dt)
+            .support;
         assert_eq!(s, HumanSupport::Double);
         assert_eq!(planner.steps_pending(), 0);
         // The left foot lands 0.4 m ahead: 0.1 m for the robot at ratio 0.25, clipped to the
         // envelope's 0.05 m ahead of the right foot.
         let moved = human([0.0, -0.1], [0.4, 0.1]);
-        let s = planner.update(&moved, HumanSupport::Double, 0.25, FEET, double, dt);
+        let s = planner
+            .update(&moved, HumanSupport::Double, 0.25, FEET, double, dt)
+            .support;
         assert_eq!(
             s,
             HumanSupport::Right,
@@ -459,25 +560,31 @@ mod tests {
         assert_eq!(planner.steps_pending(), 1);
         // Once the robot stands on the right foot with the left on its target, it lands.
         let feet = [pose(0.05, 0.1, 0.0), FEET[1]];
-        let s = planner.update(
-            &moved,
-            HumanSupport::Double,
-            0.25,
-            feet,
-            SupportPhase::Right,
-            dt,
-        );
+        let s = planner
+            .update(
+                &moved,
+                HumanSupport::Double,
+                0.25,
+                feet,
+                SupportPhase::Right,
+                dt,
+            )
+            .support;
         assert_eq!(s, HumanSupport::Double);
         assert_eq!(planner.target(), None);
         // The right foot, 1 cm behind its clipped target (0.04 m behind the left foot at most),
         // is close enough: no step.
-        let s = planner.update(&moved, HumanSupport::Double, 0.25, feet, double, dt);
+        let s = planner
+            .update(&moved, HumanSupport::Double, 0.25, feet, double, dt)
+            .support;
         assert_eq!(s, HumanSupport::Double);
         assert_eq!(planner.steps_pending(), 0);
         // The human brings the right foot up: the robot's right foot goes 0.1 m forward, which
         // is 0.05 m ahead of the left foot and within the envelope.
         let together = human([0.4, -0.1], [0.4, 0.1]);
-        let s = planner.update(&together, HumanSupport::Double, 0.25, feet, double, dt);
+        let s = planner
+            .update(&together, HumanSupport::Double, 0.25, feet, double, dt)
+            .support;
         assert_eq!(s, HumanSupport::Left);
         let (foot, target) = planner.target().unwrap();
         assert_eq!(foot, Side::Right);
@@ -502,14 +609,16 @@ mod tests {
             HumanJoint::LToe,
             Some(v(0.15 * 0.3f64.cos(), 0.1 + 0.15 * 0.3f64.sin())),
         );
-        let s = planner.update(
-            &frame,
-            HumanSupport::Double,
-            0.25,
-            FEET,
-            SupportPhase::Double,
-            0.01,
-        );
+        let s = planner
+            .update(
+                &frame,
+                HumanSupport::Double,
+                0.25,
+                FEET,
+                SupportPhase::Double,
+                0.01,
+            )
+            .support;
         assert_eq!(s, HumanSupport::Double);
         assert_eq!(planner.steps_pending(), 0);
     }
@@ -519,7 +628,8 @@ mod tests {
         // Without walking: the foot is lifted in place.
         let mut planner = FootstepPlanner::new(FootstepConfig::default(), AREA);
         let frame = human([0.0, -0.1], [0.0, 0.1]);
-        let mut step = |human, phase, dt| planner.update(&frame, human, 0.25, FEET, phase, dt);
+        let mut step =
+            |human, phase, dt| planner.update(&frame, human, 0.25, FEET, phase, dt).support;
         step(HumanSupport::Double, SupportPhase::Double, 0.01);
         let mut support = HumanSupport::Double;
         for _ in 0..29 {

@@ -28,7 +28,9 @@ use super::clearance::{ClearanceMeter, SelfClearance};
 use super::imitator::{Imitator, RobotFrame};
 use super::phase::SupportPhase;
 use super::support::HumanSupport;
-use super::travel::{HandTrace, Stance, StepCounter, Travel, TravelRecorder, robot_stance};
+use super::travel::{
+    FootTiming, HandTrace, Stance, StepCounter, Travel, TravelRecorder, robot_stance,
+};
 use crate::solver::JointBounds;
 use crate::tasks::convex_hull;
 
@@ -245,6 +247,13 @@ pub struct ImitationMetrics {
     /// How long the human's clock was paused in all while hands were placed on their contacts
     /// (s): the robot's run is that much longer than the human's.
     pub human_clock_pause: f64,
+    /// How late the robot lifted each foot after the human lifted the same foot (s; one value
+    /// per paired lift, [`super::travel`]), and `human_lifts` how many the human made.
+    pub lift_lag: Spread,
+    /// How late the robot put each foot down after the human (s), paired as `lift_lag`.
+    pub landing_lag: Spread,
+    /// The human's lifts of a foot (at least 0.2 s): the events `lift_lag` pairs.
+    pub human_lifts: usize,
     /// Travel of the scaled human and of the robot.
     pub travel: Travel,
     /// Steps (a foot off the floor ≥ 0.2 s) of the human and of the robot.
@@ -303,6 +312,9 @@ pub struct MetricsRecorder {
     travel: TravelRecorder,
     human_steps: StepCounter,
     robot_steps: StepCounter,
+    feet: FootTiming,
+    /// The human's feet off the ground at the last frame (left, right); airborne keeps them.
+    human_up: [bool; 2],
     pending: usize,
     /// Frames and last time when the clip ended ([`MetricsRecorder::mark_clip_end`]).
     clip_end: Option<(usize, f64)>,
@@ -422,6 +434,8 @@ impl MetricsRecorder {
             travel: TravelRecorder::default(),
             human_steps: StepCounter::default(),
             robot_steps: StepCounter::default(),
+            feet: FootTiming::default(),
+            human_up: [false; 2],
             pending: 0,
             clip_end: None,
         }
@@ -461,6 +475,13 @@ impl MetricsRecorder {
         self.human_steps.record(human_off, frame.time);
         self.robot_steps
             .record(!(standing[0] && standing[1]), frame.time);
+        self.human_up = match frame.human_support {
+            HumanSupport::Double => [false, false],
+            HumanSupport::Right => [true, false],
+            HumanSupport::Left => [false, true],
+            HumanSupport::Airborne => self.human_up,
+        };
+        (self.feet).record(self.human_up, standing.map(|s| !s), frame.time);
         self.pending = frame.pending_steps;
 
         self.record_supports(frame);
@@ -614,6 +635,7 @@ impl MetricsRecorder {
         let (lag_errors, hand_lag_s) = self.hands.lag_removed();
         let first_time = self.first_time.unwrap_or(self.last_time);
         let (clip_frames, clip_end) = self.clip_end.unwrap_or((self.frames, self.last_time));
+        let ((mut lift_lag, human_lifts), (mut landing_lag, _)) = self.feet.lags();
         ImitationMetrics {
             frames: self.frames,
             duration: self.last_time - first_time,
@@ -648,6 +670,9 @@ impl MetricsRecorder {
             },
             hand_lag_s,
             human_clock_pause: self.clock_pause,
+            lift_lag: Spread::of(&mut lift_lag),
+            landing_lag: Spread::of(&mut landing_lag),
+            human_lifts,
             travel: self.travel.travel(),
             human_steps: self.human_steps.steps(),
             robot_steps: self.robot_steps.steps(),

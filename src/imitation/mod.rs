@@ -19,6 +19,7 @@ pub mod footsteps;
 pub mod hand_support;
 pub mod imitator;
 pub mod koenemann;
+pub mod look_ahead;
 pub mod metrics;
 pub mod output;
 pub mod phase;

@@ -39,10 +39,14 @@
 //! |---|---|---|---|
 //! | DS | DS | DS → RS: CoM to RFoot | DS → LS: CoM to LFoot |
 //! | RS | RS → DS: Lower LFoot | RS | RS → DS: Lower LFoot |
-//! | DS → RS: CoM to RFoot | DS (abort) | done ? Lift LFoot : stay | DS (abort) |
+//! | DS → RS: CoM to RFoot | DS (abort) | done and lift ? Lift LFoot : stay | DS (abort) |
 //! | DS → RS: Lift LFoot | RS → DS: Lower LFoot | done ? RS : stay | RS → DS: Lower LFoot |
 //! | RS → DS: Lower LFoot | done ? CoM to middle : stay | DS → RS: Lift LFoot | done ? CoM to middle : stay |
 //! | RS → DS: CoM to middle | done ? DS : stay | DS → RS: CoM to RFoot | done ? DS : stay |
+//!
+//! "lift" is the lift gate of [`PhaseMachine::update_gated`] (always open for
+//! [`PhaseMachine::update`]): a robot that shifted its weight ahead of the human's lift-off
+//! ([`super::look_ahead`]) waits for it with both feet down.
 //!
 //! Why these edges:
 //! * Aborting "CoM to RFoot" goes straight back to DS: both feet are still on the ground, so the
@@ -442,10 +446,24 @@ impl PhaseMachine {
     /// Advances by one time step: `human` is the human's support in the new frame, `measured`
     /// what the robot achieved at the last solve (in the current phase). Returns the new phase.
     pub fn update(&mut self, human: HumanSupport, measured: &Measurements) -> SupportPhase {
+        self.update_gated(human, true, measured)
+    }
+
+    /// [`PhaseMachine::update`], with the swing foot allowed to leave the ground only if `lift`:
+    /// otherwise a finished "CoM to foot" step waits with the weight on the support foot (the
+    /// robot shifts its weight ahead of a human lift-off it knows is coming,
+    /// [`super::look_ahead`]).
+    pub fn update_gated(
+        &mut self,
+        human: HumanSupport,
+        lift: bool,
+        measured: &Measurements,
+    ) -> SupportPhase {
         if human != HumanSupport::Airborne {
             self.human = human;
         }
-        self.phase = next_phase(self.phase, self.human, measured, &self.config);
+        let done = Done::new(measured, &self.config, lift);
+        self.phase = next_phase(self.phase, self.human, &done);
         self.phase
     }
 }
@@ -480,20 +498,24 @@ fn single(support: Side) -> SupportPhase {
     }
 }
 
-/// End conditions of the current step, from the measurements. NaN never meets a condition.
+/// End conditions of the current step, from the measurements and the lift gate. NaN never
+/// meets a condition.
 struct Done {
     com: bool,
     lifted: bool,
     grounded: bool,
+    /// The lift gate: the swing foot may leave the ground.
+    may_lift: bool,
 }
 
 impl Done {
-    fn new(m: &Measurements, config: &PhaseConfig) -> Self {
+    fn new(m: &Measurements, config: &PhaseConfig, lift: bool) -> Self {
         let (toe, heel) = (m.swing_toe_height, m.swing_heel_height);
         let lift_goal = config.rho - config.foot_height_tolerance;
         Self {
             com: m.com_error <= config.com_tolerance
                 && (m.posture_error <= config.posture_tolerance || m.posture_settled),
+            may_lift: lift,
             lifted: toe >= lift_goal && heel >= lift_goal,
             grounded: toe.abs() <= config.foot_height_tolerance
                 && heel.abs() <= config.foot_height_tolerance,
@@ -503,13 +525,7 @@ impl Done {
 
 /// The transition function of the graph in the module docs. `human` is the last non-airborne
 /// human support (an airborne value would count as DS).
-fn next_phase(
-    phase: SupportPhase,
-    human: HumanSupport,
-    m: &Measurements,
-    config: &PhaseConfig,
-) -> SupportPhase {
-    let done = Done::new(m, config);
+fn next_phase(phase: SupportPhase, human: HumanSupport, done: &Done) -> SupportPhase {
     let wanted = human_single(human);
     match phase {
         SupportPhase::Double => match wanted {
@@ -518,10 +534,10 @@ fn next_phase(
         },
         SupportPhase::Right => after_single(Side::Right, wanted),
         SupportPhase::Left => after_single(Side::Left, wanted),
-        SupportPhase::DoubleToRight(step) => after_take_off(Side::Right, step, wanted, &done),
-        SupportPhase::DoubleToLeft(step) => after_take_off(Side::Left, step, wanted, &done),
-        SupportPhase::RightToDouble(step) => after_landing(Side::Right, step, wanted, &done),
-        SupportPhase::LeftToDouble(step) => after_landing(Side::Left, step, wanted, &done),
+        SupportPhase::DoubleToRight(step) => after_take_off(Side::Right, step, wanted, done),
+        SupportPhase::DoubleToLeft(step) => after_take_off(Side::Left, step, wanted, done),
+        SupportPhase::RightToDouble(step) => after_landing(Side::Right, step, wanted, done),
+        SupportPhase::LeftToDouble(step) => after_landing(Side::Left, step, wanted, done),
     }
 }
 
@@ -540,7 +556,7 @@ fn after_take_off(support: Side, step: TakeOff, wanted: Option<Side>, done: &Don
     let stays = wanted == Some(support);
     match step {
         TakeOff::ComToFoot if !stays => SupportPhase::Double,
-        TakeOff::ComToFoot if done.com => take_off(support, TakeOff::LiftFoot),
+        TakeOff::ComToFoot if done.com && done.may_lift => take_off(support, TakeOff::LiftFoot),
         TakeOff::LiftFoot if !stays => landing(support, Landing::LowerFoot),
         TakeOff::LiftFoot if done.lifted => single(support),
         TakeOff::ComToFoot | TakeOff::LiftFoot => take_off(support, step),

@@ -155,6 +155,10 @@ impl PoubelImitator {
             ..ScaleConfig::new(area)
         };
         let scaler = Scaler::new(RobotSkeleton::of(profile)?, scale)?;
+        let mut footsteps = FootstepPlanner::new(config.footsteps, area);
+        if let Some(ahead) = config.look_ahead.take() {
+            footsteps = footsteps.with_look_ahead(ahead);
+        }
         let tracking = JointTracking::new(q)?;
         let human_q = q.clone();
         shared.reserve_output(phases_sizes(&phases));
@@ -181,7 +185,7 @@ impl PoubelImitator {
                 swing_heel_height: 0.0,
             },
             posture_settling: Settling::new(),
-            footsteps: FootstepPlanner::new(config.footsteps, area),
+            footsteps,
             motion: config.motion,
             com_reference: None,
             swing: SwingHeight::at(0.0),
@@ -230,7 +234,7 @@ impl PoubelImitator {
         ];
         let leg_ratio = self.scaler.leg_ratio();
         let wanted = (self.footsteps).update(frame, human, leg_ratio, feet, self.phase, dt);
-        let phase = self.machine.update(wanted, &self.measurements);
+        let phase = (self.machine).update_gated(wanted.support, wanted.lift, &self.measurements);
         let changed = phase != self.phase || self.shared.previous_time.is_none();
         self.shared
             .switch_root(self.phases[phase.index()].table.model_root)?;

@@ -10,6 +10,12 @@
 //!   heading difference) and stays there.
 //! * **Steps**: episodes of at least [`MIN_STEP_TIME`] with a foot off the floor, for the human
 //!   (single-support episodes) and for the robot (a swing foot, from the plan's phases).
+//! * **Foot lag**: each human lift-off (landing) of a foot lifted at least [`MIN_STEP_TIME`] is
+//!   paired with the first robot lift-off (landing) of the same foot not yet paired, from
+//!   [`MAX_LAG`] before it up to the human's next lift-off (landing) of that foot; the lag is the
+//!   robot's time minus the human's (s, negative when the robot is early). A robot that skips a
+//!   human step leaves it unpaired. The robot's foot is off the ground from its lift to its
+//!   landing (the phases with that foot swinging).
 //! * **Hand lag**: the time shift (0 … [`MAX_LAG`]) that best aligns the robot's hands with the
 //!   scaled reference over the clip, and the errors once it is removed: a robot that follows
 //!   the right path late has a small lag-removed error and a large lag.
@@ -17,6 +23,7 @@
 use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 
 use super::footsteps::wrap;
+use crate::human::Side;
 
 /// Largest distance (m) between the robot's and the scaled human's stance at which the robot has
 /// caught up.
@@ -151,6 +158,78 @@ impl StepCounter {
     pub(crate) fn steps(&self) -> usize {
         self.steps
     }
+}
+
+/// Lift-offs and landings of each foot (times, s), in time order.
+#[derive(Debug, Clone, Default)]
+struct FootEvents {
+    /// Per foot ([`Side::index`]): whether it is off the ground, and since when.
+    up_since: [Option<f64>; 2],
+    lifts: [Vec<f64>; 2],
+    landings: [Vec<f64>; 2],
+}
+
+impl FootEvents {
+    /// `up`: which feet are off the ground at `time`. Episodes shorter than `min` are dropped.
+    fn record(&mut self, up: [bool; 2], time: f64, min: f64) {
+        for foot in Side::BOTH {
+            let i = foot.index();
+            match (up[i], self.up_since[i]) {
+                (true, None) => self.up_since[i] = Some(time),
+                (false, Some(start)) => {
+                    if time - start >= min {
+                        self.lifts[i].push(start);
+                        self.landings[i].push(time);
+                    }
+                    self.up_since[i] = None;
+                }
+                _ => {}
+            }
+        }
+    }
+}
+
+/// The robot's lag behind the human's lift-offs and landings (see the module docs).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct FootTiming {
+    human: FootEvents,
+    robot: FootEvents,
+}
+
+/// Lags (s) of the paired events, and how many human events there were.
+pub(crate) type Lags = (Vec<f64>, usize);
+
+impl FootTiming {
+    /// Which feet are off the ground at `time`, the human's and the robot's.
+    pub(crate) fn record(&mut self, human_up: [bool; 2], robot_up: [bool; 2], time: f64) {
+        self.human.record(human_up, time, MIN_STEP_TIME);
+        self.robot.record(robot_up, time, 0.0);
+    }
+
+    /// Lags of the lift-offs and of the landings.
+    pub(crate) fn lags(&self) -> (Lags, Lags) {
+        (
+            pair(&self.human.lifts, &self.robot.lifts),
+            pair(&self.human.landings, &self.robot.landings),
+        )
+    }
+}
+
+/// Pairs each human event with a robot event of the same foot (see the module docs).
+fn pair(human: &[Vec<f64>; 2], robot: &[Vec<f64>; 2]) -> Lags {
+    let mut lags = Vec::new();
+    for (human, robot) in human.iter().zip(robot) {
+        let mut next = 0;
+        for (i, &h) in human.iter().enumerate() {
+            let until = human.get(i + 1).copied().unwrap_or(f64::INFINITY);
+            let first = next + robot[next..].partition_point(|&r| r < h - MAX_LAG);
+            if let Some(&r) = robot.get(first).filter(|&&r| r < until) {
+                lags.push(r - h);
+                next = first + 1;
+            }
+        }
+    }
+    (lags, human.iter().map(Vec::len).sum())
 }
 
 /// Most lags (frames) the hand-lag search tries: [`MAX_LAG`] at up to 500 frames per second.
