@@ -14,6 +14,7 @@ use taskstack::imitation::config::ImitationMethod;
 use taskstack::imitation::footsteps::FootstepConfig;
 use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
 use taskstack::imitation::koenemann::KoenemannConfig;
+use taskstack::imitation::look_ahead::{FootLookAhead, FootSchedule};
 use taskstack::imitation::metrics::{ImitationMetrics, MetricsRecorder};
 use taskstack::imitation::phase::SupportPhase;
 use taskstack::imitation::shaping::MotionLimits;
@@ -199,6 +200,73 @@ fn walks_are_walked() {
             m.travel.robot_m > m.travel.scaled_human_m / 3.0,
             "{name}: {:?}",
             m.travel
+        );
+    }
+}
+
+/// The offline mode ([`FootLookAhead`]) on the clips with one-leg stances it can follow: the
+/// robot's foot never leaves the ground before the human's (no negative lag), its best-timed
+/// lift comes a second or more sooner after the human's lift-off than online and its
+/// best-timed landing sooner too, and the invariants hold.
+#[test]
+fn offline_mode_lifts_with_the_human() {
+    for name in [
+        "cmu_05_02_stand_arm_gestures_turn_single_leg.bvh",
+        "cmu_07_04_slow_walk.bvh",
+    ] {
+        let clip = Clip::open(clip_path(name)).unwrap();
+        let support = SupportConfig::for_capture(clip.capture());
+        let frames: Vec<HumanFrame> = clip.collect::<Result<_, _>>().unwrap();
+        let schedule = FootSchedule::of_clip(&frames, support).unwrap();
+        let offline = ImitatorConfig {
+            look_ahead: Some(FootLookAhead::new(schedule)),
+            ..ImitatorConfig::default()
+        };
+        let (ahead, _) = run_with(name, offline, HELD_FOOT_TOLERANCE);
+        let (online, _) = run(name);
+        let (a, o) = (ahead.lift_lag, online.lift_lag);
+        let (la, lo) = (ahead.landing_lag, online.landing_lag);
+        eprintln!("{name}: lift lag offline {a:?}, online {o:?}; landing lag {la:?}, {lo:?}");
+        assert!(a.count >= 1 && o.count >= 1, "{name}: {a:?} {o:?}");
+        assert!(
+            a.min >= 0.0,
+            "{name}: a foot lifted before the human's: {a:?}"
+        );
+        assert!(a.min < o.min - 1.0, "{name}: {a:?} vs {o:?}");
+        assert!(la.min < lo.min, "{name}: {la:?} vs {lo:?}");
+    }
+}
+
+#[test]
+fn offline_mode_settings_are_checked() {
+    let ahead = FootLookAhead::new(FootSchedule::default());
+    let build = |look_ahead: FootLookAhead, method| {
+        let config = ImitatorConfig {
+            look_ahead: Some(look_ahead),
+            method,
+            ..ImitatorConfig::default()
+        };
+        Imitator::new(nao::profile(), config)
+            .err()
+            .map(|e| e.to_string())
+    };
+    assert_eq!(build(ahead.clone(), ImitationMethod::Poubel), None);
+    let koenemann = ImitationMethod::Koenemann(KoenemannConfig::default());
+    assert!(build(ahead.clone(), koenemann).is_some_and(|e| e.contains("look_ahead")));
+    for (lift_lead, landing_lead, name) in [
+        (-0.1, 0.8, "look_ahead.lift_lead"),
+        (1.5, f64::NAN, "look_ahead.landing_lead"),
+        (f64::INFINITY, 0.8, "look_ahead.lift_lead"),
+    ] {
+        let bad = FootLookAhead {
+            lift_lead,
+            landing_lead,
+            ..ahead.clone()
+        };
+        let error = build(bad, ImitationMethod::Poubel);
+        assert!(
+            error.as_ref().is_some_and(|e| e.contains(name)),
+            "{error:?}"
         );
     }
 }

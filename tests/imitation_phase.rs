@@ -220,6 +220,33 @@ fn foot_put_back_down_during_the_com_shift_aborts_to_double_support() {
 }
 
 #[test]
+fn a_closed_lift_gate_holds_the_weight_on_the_stance_foot() {
+    let mut m = machine();
+    let step = TakeOff::ComToFoot;
+    // The shift runs and ends as usual, but the foot stays down while the gate is closed.
+    assert_eq!(
+        m.update_gated(H::Right, false, &FAR),
+        P::DoubleToRight(step)
+    );
+    for _ in 0..3 {
+        assert_eq!(
+            m.update_gated(H::Right, false, &COM_OK),
+            P::DoubleToRight(step)
+        );
+    }
+    // Opened: the lift starts at once.
+    let lift = P::DoubleToRight(TakeOff::LiftFoot);
+    assert_eq!(m.update_gated(H::Right, true, &COM_OK), lift);
+    // The gate only holds a take-off: a lifted foot, a landing and a recentring go on.
+    assert_eq!(m.update_gated(H::Right, false, &LIFTED), P::Right);
+    let lower = P::RightToDouble(Landing::LowerFoot);
+    assert_eq!(m.update_gated(H::Double, false, &LIFTED), lower);
+    let middle = P::RightToDouble(Landing::ComToMiddle);
+    assert_eq!(m.update_gated(H::Double, false, &DOWN), middle);
+    assert_eq!(m.update_gated(H::Double, false, &COM_OK), P::Double);
+}
+
+#[test]
 fn foot_lifted_again_while_landing_is_lifted_again() {
     let mut m = machine();
     run(

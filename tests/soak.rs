@@ -38,7 +38,9 @@ use taskstack::imitation::contact_events::ContactConfig;
 use taskstack::imitation::hand_support::{HandContactPlan, HandSupportConfig};
 use taskstack::imitation::imitator::{Imitator, ImitatorConfig, RobotFrame};
 use taskstack::imitation::koenemann::KoenemannConfig;
+use taskstack::imitation::look_ahead::{FootLookAhead, FootSchedule};
 use taskstack::imitation::metrics::{CONTACT_HEIGHT, MetricsRecorder, convex_margin};
+use taskstack::imitation::support::SupportConfig;
 use taskstack::io::clip::Clip;
 use taskstack::robots::{g1, nao};
 use taskstack::scene::Scene;
@@ -370,6 +372,37 @@ fn hand_support_step_does_not_allocate_after_warm_up() {
         after_warm_up, 0,
         "{after_warm_up} allocations in {steps} steps"
     );
+}
+
+/// Nor does the offline mode's look-ahead for the feet, through a weight shift held for the
+/// human's lift-off, a one-leg stance and an early landing (CMU 05_02): every step after the
+/// first frame.
+#[test]
+fn look_ahead_step_does_not_allocate_after_warm_up() {
+    let clip = Clip::open(
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/data/mocap/cmu_05_02_stand_arm_gestures_turn_single_leg.bvh"),
+    )
+    .unwrap();
+    let frames: Vec<HumanFrame> = clip.collect::<Result<_, _>>().unwrap();
+    let schedule = FootSchedule::of_clip(&frames, SupportConfig::optical()).unwrap();
+    let config = ImitatorConfig {
+        look_ahead: Some(FootLookAhead::new(schedule)),
+        ..ImitatorConfig::default()
+    };
+    let mut imitator = Imitator::new(nao::profile(), config).unwrap();
+    let (mut after_warm_up, mut single) = (0, 0);
+    for (i, human) in frames.iter().enumerate() {
+        let before = allocations();
+        let r = imitator.step(human).unwrap();
+        let n = allocations() - before;
+        single += usize::from(r.phase.swing_foot().is_some());
+        if i > 0 {
+            after_warm_up += n;
+        }
+    }
+    assert!(single > 100, "{single} frames with a foot swinging");
+    assert_eq!(after_warm_up, 0, "{after_warm_up} allocations");
 }
 
 /// Allocations counted on this thread over the short clips after the first (the warm-up).

@@ -68,11 +68,11 @@ pub(crate) struct ImitateArgs {
     offline: bool,
     /// Offline mode: how long before the human lifts a foot the robot starts shifting its
     /// weight (s, ≥ 0; the robot's weight shift takes about this long)
-    #[arg(long, value_name = "SECONDS", default_value_t = FootLookAhead::DEFAULT_LIFT_LEAD, requires = "offline")]
+    #[arg(long, value_name = "SECONDS", default_value_t = FootLookAhead::DEFAULT_LIFT_LEAD, requires = "offline", allow_negative_numbers = true)]
     lift_lead: f64,
     /// Offline mode: how long before the human puts a foot down the robot starts lowering it
     /// (s, ≥ 0)
-    #[arg(long, value_name = "SECONDS", default_value_t = FootLookAhead::DEFAULT_LANDING_LEAD, requires = "offline")]
+    #[arg(long, value_name = "SECONDS", default_value_t = FootLookAhead::DEFAULT_LANDING_LEAD, requires = "offline", allow_negative_numbers = true)]
     landing_lead: f64,
     #[command(flatten)]
     options: ImitationOptions,

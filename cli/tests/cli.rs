@@ -36,6 +36,9 @@ fn every_subcommand_explains_its_options_and_outputs() {
         "--skeleton",
         "--quiet",
         "--json",
+        "--offline",
+        "--lift-lead",
+        "--landing-lead",
     ] {
         assert!(
             imitate.stdout.contains(needle),
@@ -143,6 +146,46 @@ fn imitate_json_is_one_document_for_scripts_and_quiet_prints_nothing() {
     assert_eq!(quiet.code, Some(0), "{}", quiet.stderr);
     assert_eq!(quiet.stdout, "");
     assert_eq!(quiet.stderr, "");
+}
+
+/// `--offline` reads the clip first and reports the foot lags in metrics.json; its leads are
+/// checked, and need `--offline`.
+#[test]
+fn imitate_offline_reports_foot_lags_and_checks_its_leads() {
+    let dir = temp_dir("offline");
+    let clip = clip(WALK);
+    let out = dir.join("run");
+    let args = [
+        "--json",
+        "imitate",
+        s(&clip),
+        "--offline",
+        "--out",
+        s(&out),
+        "--hold",
+        "1",
+    ];
+    let run = taskstack(&args);
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    let value: Value = serde_json::from_str(&run.stdout).expect("stdout is one JSON document");
+    let lags = &value["metrics"]["foot_lag_s"];
+    assert!(
+        lags["human_lifts"].as_u64().is_some_and(|n| n > 0),
+        "{lags}"
+    );
+    assert!(lags["lift"]["count"].is_u64() && lags["landing"]["median"].is_number());
+    let bad = [
+        "imitate",
+        s(&clip),
+        "--offline",
+        "--lift-lead",
+        "-1",
+        "--out",
+        s(&out),
+    ];
+    fails(&bad, 1, &["look_ahead.lift_lead"]);
+    let online = ["imitate", s(&clip), "--landing-lead", "1", "--out", s(&out)];
+    fails(&online, 2, &["--offline"]);
 }
 
 /// Expects exit status `code` and every one of `needles` in stderr.

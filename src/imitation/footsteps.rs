@@ -338,8 +338,8 @@ impl FootstepPlanner {
             return true;
         };
         let down = self.down[foot.index()];
-        if self.following.is_some() {
-            return !down;
+        if let Some(lift) = self.following {
+            return now >= lift.start && !down;
         }
         let coming = ahead.schedule.lift_within(foot, now, ahead.lift_lead);
         !(down && coming.is_some_and(|l| l.start > now))
@@ -352,20 +352,33 @@ impl FootstepPlanner {
         lift.is_some_and(|(l, a)| l.start <= now && l.end <= now + a.landing_lead)
     }
 
-    /// Looking ahead without walking: the first human lift starting within the lift lead, not
-    /// followed yet, during which the robot, ready at the lift-off or a lift lead from now,
-    /// whichever is later, can stand on one leg at least [`FootstepConfig::stance_time`].
+    /// Looking ahead without walking: the human lift to follow now, if any (see
+    /// [`super::look_ahead`]): the earliest of each foot's first lift that starts within the
+    /// lift lead, is not followed yet, is worth following, and leaves no longer one of the other
+    /// foot out.
     fn stance_ahead(&self, now: f64) -> Option<FootLift> {
         let ahead = self.ahead.as_ref().filter(|_| !self.config.follow)?;
-        let worth = |f: Side| {
-            let lift = ahead.schedule.lift_within(f, now, ahead.lift_lead)?;
-            let ready = lift.start.max(now + ahead.lift_lead);
-            let followed = lift.start <= self.followed[f.index()];
-            (!followed && lift.end - ready >= self.config.stance_time).then_some(*lift)
+        let (schedule, lead) = (&ahead.schedule, ahead.lift_lead);
+        // The robot can stand on one leg for the stance time of it.
+        let worth = |l: &FootLift| {
+            l.start > self.followed[l.foot.index()]
+                && l.end - l.start.max(now + lead) >= self.config.stance_time
         };
-        match (worth(Side::Left), worth(Side::Right)) {
-            (Some(l), Some(r)) => Some(if l.start <= r.start { l } else { r }),
-            (l, r) => l.or(r),
+        let next = |foot: Side| {
+            let soon = schedule.lifts_after(foot, now).iter();
+            soon.take_while(|l| l.start <= now + lead)
+                .find(|l| worth(l))
+        };
+        let unrivalled = |l: &&FootLift| {
+            let busy_until = l.end + lead + ahead.landing_lead;
+            let rivals = schedule.lifts_after(l.foot.other(), now).iter();
+            !(rivals.take_while(|o| o.start < busy_until))
+                .any(|o| o.duration() > l.duration() && worth(o))
+        };
+        let [left, right] = Side::BOTH.map(|f| next(f).filter(unrivalled));
+        match (left, right) {
+            (Some(l), Some(r)) => Some(if l.start <= r.start { *l } else { *r }),
+            (l, r) => l.or(r).copied(),
         }
     }
 
@@ -497,7 +510,7 @@ mod tests {
     }
 
     /// A human frame standing with the ankles at `r` and `l` (x, y), feet pointing +x.
-    fn human(r: [f64; 2], l: [f64; 2]) -> HumanFrame {
+    pub(super) fn human(r: [f64; 2], l: [f64; 2]) -> HumanFrame {
         let mut frame = HumanFrame::new(0.0);
         let v = |x: f64, y: f64, z: f64| nalgebra::Vector3::new(x, y, z);
         frame.set(HumanJoint::RAnkle, Some(v(r[0], r[1], 0.08)));
@@ -643,5 +656,96 @@ mod tests {
         assert_eq!(support, HumanSupport::Right);
         let support = step(HumanSupport::Double, SupportPhase::Right, 0.01);
         assert_eq!(support, HumanSupport::Double);
+    }
+
+    /// Looking ahead at the left foot lifted from 1 s to `end`, landing 0.4 m ahead of where
+    /// it stood (human world); lift lead 0.5 s, landing lead 0.4 s.
+    fn looking_ahead(config: FootstepConfig, end: f64) -> FootstepPlanner {
+        let lift = FootLift {
+            foot: Side::Left,
+            start: 1.0,
+            end,
+            landing: Some(pose(0.4, 0.1, 0.0)),
+        };
+        let schedule = super::super::look_ahead::FootSchedule::from_lifts(&[lift]).unwrap();
+        FootstepPlanner::new(config, AREA).with_look_ahead(FootLookAhead {
+            schedule,
+            lift_lead: 0.5,
+            landing_lead: 0.4,
+        })
+    }
+
+    /// One update at human time `t` (standing frame) with `human`'s support and the robot in
+    /// `phase`.
+    fn at(
+        planner: &mut FootstepPlanner,
+        t: f64,
+        human: HumanSupport,
+        phase: SupportPhase,
+    ) -> StepRequest {
+        let mut frame = super::tests::human([0.0, -0.1], [0.0, 0.1]);
+        frame.time = t;
+        planner.update(&frame, human, 0.25, FEET, phase, 0.01)
+    }
+
+    #[test]
+    fn looking_ahead_the_weight_shifts_before_the_lift_and_the_foot_lowers_before_the_landing() {
+        use super::super::phase::TakeOff;
+        let (h, p) = (HumanSupport::Double, SupportPhase::Double);
+        let shift = SupportPhase::DoubleToRight(TakeOff::ComToFoot);
+        let mut planner = looking_ahead(FootstepConfig::default(), 3.0);
+        let request = |support, lift| StepRequest { support, lift };
+        assert_eq!(
+            at(&mut planner, 0.4, h, p),
+            request(h, true),
+            "not within the lead"
+        );
+        let hold = request(HumanSupport::Right, false);
+        assert_eq!(at(&mut planner, 0.6, h, p), hold, "shift, foot down");
+        assert_eq!(at(&mut planner, 0.9, h, shift), hold);
+        let (right, up) = (HumanSupport::Right, SupportPhase::Right);
+        assert_eq!(at(&mut planner, 1.0, right, shift), request(right, true));
+        assert_eq!(at(&mut planner, 2.0, right, up), request(right, true));
+        // Landing at 3 s, within 0.4 s of 2.7 s: lowered now.
+        assert_eq!(at(&mut planner, 2.7, right, up), request(h, true));
+        // Back in double support while the human's foot is still up: not followed again.
+        assert_eq!(at(&mut planner, 2.8, right, p), request(h, true));
+    }
+
+    #[test]
+    fn looking_ahead_a_stance_ended_before_the_robot_lifts_is_given_up() {
+        use super::super::phase::TakeOff;
+        let shift = SupportPhase::DoubleToRight(TakeOff::ComToFoot);
+        let (h, right) = (HumanSupport::Double, HumanSupport::Right);
+        let mut planner = looking_ahead(FootstepConfig::default(), 1.5);
+        assert_eq!(
+            at(&mut planner, 0.6, h, SupportPhase::Double).support,
+            right
+        );
+        assert_eq!(at(&mut planner, 1.2, right, shift).support, right);
+        assert_eq!(at(&mut planner, 1.5, h, shift).support, h);
+        // A stance shorter than the stance time is not followed at all.
+        let mut planner = looking_ahead(FootstepConfig::default(), 1.25);
+        for t in [0.6, 0.8, 1.0, 1.2] {
+            assert_eq!(at(&mut planner, t, h, SupportPhase::Double).support, h);
+        }
+    }
+
+    #[test]
+    fn looking_ahead_a_walking_foot_aims_where_the_human_foot_lands() {
+        let (h, p) = (HumanSupport::Double, SupportPhase::Double);
+        let mut planner = looking_ahead(walking(), 1.5);
+        at(&mut planner, 0.0, h, p);
+        // 0.4 m ahead, 0.1 m at ratio 0.25, clipped to the envelope's 0.05 m: a step before
+        // the human lifts, the foot waiting for the human's.
+        let request = at(&mut planner, 0.6, h, p);
+        assert_eq!(request.support, HumanSupport::Right);
+        assert!(!request.lift);
+        let (foot, target) = planner.target().unwrap();
+        assert_eq!(foot, Side::Left);
+        assert!(
+            (target.xy - Vector2::new(0.05, 0.1)).norm() < 1e-12,
+            "{target:?}"
+        );
     }
 }

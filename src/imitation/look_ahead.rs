@@ -14,19 +14,26 @@
 //!
 //! # What the robot does with it
 //!
-//! The [`FootstepPlanner`](super::footsteps::FootstepPlanner) looks [`FootLookAhead::lead`]
-//! seconds ahead on the human's clock:
+//! The [`FootstepPlanner`](super::footsteps::FootstepPlanner) looks ahead on the human's clock,
+//! by [`FootLookAhead::lift_lead`] for lift-offs and [`FootLookAhead::landing_lead`] for
+//! landings (durations of the robot's own weight shift and lowering):
 //!
-//! * **Weight shift before the lift-off.** A lift of the human's foot that starts within the lead
-//!   (and, without walking, lasts at least [`FootstepConfig::stance_time`]) starts the robot's
-//!   step now: the CoM moves over the other foot while the human still stands on both. The
-//!   robot's foot leaves the ground only once the human's has ([`StepRequest::lift`]), so the
-//!   robot lifts with the human instead of a weight shift later.
+//! * **Weight shift before the lift-off.** A lift of the human's foot that starts within the
+//!   lift lead starts the robot's step now: the CoM moves over the other foot while the human
+//!   still stands on both. The robot's foot leaves the ground only once the human's has
+//!   ([`StepRequest::lift`]), so the robot lifts with the human instead of a weight shift later.
+//!   Without walking, a lift is followed only if the robot, ready at the lift-off or a lift lead
+//!   from now (whichever is later), can stand on one leg for at least
+//!   [`FootstepConfig::stance_time`] of it; and not if the other foot has a longer such lift
+//!   starting before the robot could be ready again (a lift lead and a landing lead after this
+//!   one ends): a slow robot imitates the human's real one-leg stance, not the shuffle before
+//!   it. A followed stance that the human ends before the robot's foot is off the ground is
+//!   given up.
 //! * **Lowering before the landing.** A lifted foot is lowered once the human's foot will be down
-//!   within the lead, so it lands about when the human's does.
+//!   within the landing lead, so it lands about when the human's does.
 //! * **Walking toward the next footprint.** With walking on, a foot's target is the footprint
-//!   where the human's foot will land as soon as its lift is within the lead, not the one it
-//!   left: the step is planned a swing earlier.
+//!   where the human's foot will land as soon as its lift is within the lift lead, not the one
+//!   it left: the step is planned a swing earlier, and its foot waits for the human's to lift.
 //!
 //! Units: seconds, metres, radians. The schedule is built once (it allocates); looking ahead
 //! while stepping does not.
@@ -68,6 +75,18 @@ pub enum LookAheadError {
     /// The support detector's settings are invalid.
     #[error(transparent)]
     Support(#[from] SupportError),
+    /// A given lift is not a finite interval, or overlaps or precedes the foot's previous one.
+    #[error(
+        "lift {index} ({start} s to {end} s) must start after the foot's previous lift ends and end after it starts"
+    )]
+    LiftOrder {
+        /// Index of the lift in the list given.
+        index: usize,
+        /// Its start (s).
+        start: f64,
+        /// Its end (s).
+        end: f64,
+    },
     /// A frame time is not finite or does not increase.
     #[error("frame {index} has time {time} s, not after the previous frame's {previous} s")]
     TimeOrder {
@@ -137,16 +156,44 @@ impl FootSchedule {
         Ok(schedule)
     }
 
+    /// A schedule of given lifts (from another detector, or edited): per foot in time order,
+    /// each with a finite start before its end (which may be infinite), not overlapping the
+    /// foot's previous lift.
+    ///
+    /// # Errors
+    /// [`LookAheadError::LiftOrder`] names the first lift that breaks the order.
+    pub fn from_lifts(lifts: &[FootLift]) -> Result<Self, LookAheadError> {
+        let mut schedule = Self::default();
+        for (index, lift) in lifts.iter().enumerate() {
+            let foot = &mut schedule.lifts[lift.foot.index()];
+            let after = foot.last().map_or(f64::NEG_INFINITY, |l| l.end);
+            if !(lift.start.is_finite() && lift.start >= after && lift.end > lift.start) {
+                return Err(LookAheadError::LiftOrder {
+                    index,
+                    start: lift.start,
+                    end: lift.end,
+                });
+            }
+            foot.push(*lift);
+        }
+        Ok(schedule)
+    }
+
     /// The lifts of `foot`, in time order.
     pub fn lifts(&self, foot: Side) -> &[FootLift] {
         &self.lifts[foot.index()]
     }
 
+    /// The lifts of `foot` that end after `now` (s): the one under way, if any, and those to
+    /// come, in time order.
+    pub fn lifts_after(&self, foot: Side, now: f64) -> &[FootLift] {
+        let lifts = &self.lifts[foot.index()];
+        &lifts[lifts.partition_point(|l| l.end <= now)..]
+    }
+
     /// The lift of `foot` under way at `now` or starting within `lead` after it (s), if any.
     pub fn lift_within(&self, foot: Side, now: f64, lead: f64) -> Option<&FootLift> {
-        let lifts = &self.lifts[foot.index()];
-        let next = lifts.partition_point(|l| l.end <= now);
-        lifts.get(next).filter(|l| l.start <= now + lead)
+        (self.lifts_after(foot, now).first()).filter(|l| l.start <= now + lead)
     }
 }
 
@@ -189,5 +236,110 @@ impl FootLookAhead {
         ]
         .into_iter()
         .find(|(_, v)| !(v.is_finite() && *v >= 0.0))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::{Vector2, Vector3};
+
+    use super::*;
+    use crate::human::HumanJoint;
+
+    /// A human standing with the ankles 0.2 m apart who, from 0.5 s to 1.1 s, lifts the left
+    /// foot 0.2 m, carries it 0.3 m forward and puts it down there; 100 frames per second.
+    fn step_clip() -> Vec<HumanFrame> {
+        (0..200)
+            .map(|i| {
+                let t = i as f64 * 0.01;
+                let mut frame = HumanFrame::new(t);
+                let s = ((t - 0.5) / 0.6).clamp(0.0, 1.0);
+                let lift = if (0.5..1.1).contains(&t) { 0.2 } else { 0.0 };
+                let left = Vector3::new(0.3 * s, 0.1, 0.08 + lift);
+                let right = Vector3::new(0.0, -0.1, 0.08);
+                let toe = Vector3::new(0.15, 0.0, -0.06);
+                frame.set(HumanJoint::LAnkle, Some(left));
+                frame.set(HumanJoint::LToe, Some(left + toe));
+                frame.set(HumanJoint::RAnkle, Some(right));
+                frame.set(HumanJoint::RToe, Some(right + toe));
+                frame.set(HumanJoint::LHip, Some(Vector3::new(0.0, 0.1, 0.9)));
+                frame.set(HumanJoint::RHip, Some(Vector3::new(0.0, -0.1, 0.9)));
+                frame
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_step_of_the_left_foot_is_one_lift_with_its_landing() {
+        let schedule = FootSchedule::of_clip(&step_clip(), SupportConfig::optical()).unwrap();
+        assert!(schedule.lifts(Side::Right).is_empty());
+        let [lift] = schedule.lifts(Side::Left) else {
+            panic!("{schedule:?}");
+        };
+        // The detector's 30 ms dwell, on 10 ms frames.
+        assert!((0.5..=0.55).contains(&lift.start), "{lift:?}");
+        assert!((1.1..=1.15).contains(&lift.end), "{lift:?}");
+        let landing = lift.landing.unwrap();
+        assert!(
+            (landing.xy - Vector2::new(0.3, 0.1)).norm() < 1e-9,
+            "{landing:?}"
+        );
+        assert!(landing.yaw.abs() < 1e-9);
+        // Looking ahead: seen 0.2 s before it starts, and while it lasts; not after.
+        assert_eq!(schedule.lift_within(Side::Left, 0.2, 0.2), None);
+        assert_eq!(schedule.lift_within(Side::Left, 0.4, 0.2), Some(lift));
+        assert_eq!(schedule.lift_within(Side::Left, 1.0, 0.0), Some(lift));
+        assert_eq!(schedule.lift_within(Side::Left, lift.end, 1.0), None);
+    }
+
+    #[test]
+    fn frames_out_of_order_are_refused() {
+        let mut clip = step_clip();
+        clip[10].time = clip[9].time;
+        assert!(matches!(
+            FootSchedule::of_clip(&clip, SupportConfig::optical()),
+            Err(LookAheadError::TimeOrder { index: 10, .. })
+        ));
+        clip[10].time = f64::NAN;
+        assert!(FootSchedule::of_clip(&clip, SupportConfig::optical()).is_err());
+        let bad = SupportConfig {
+            height_on: f64::NAN,
+            ..SupportConfig::optical()
+        };
+        assert!(matches!(
+            FootSchedule::of_clip(&clip, bad),
+            Err(LookAheadError::Support(_))
+        ));
+    }
+
+    #[test]
+    fn given_lifts_must_be_ordered_intervals() {
+        let lift = |foot, start, end| FootLift {
+            foot,
+            start,
+            end,
+            landing: None,
+        };
+        let good = [
+            lift(Side::Left, 1.0, 2.0),
+            lift(Side::Right, 1.5, 2.5),
+            lift(Side::Left, 2.0, f64::INFINITY),
+        ];
+        let schedule = FootSchedule::from_lifts(&good).unwrap();
+        assert_eq!(schedule.lifts(Side::Left).len(), 2);
+        assert_eq!(schedule.lifts(Side::Right), &good[1..2]);
+        for (bad, index) in [
+            (vec![lift(Side::Left, 1.0, 1.0)], 0),
+            (vec![lift(Side::Left, f64::NAN, 1.0)], 0),
+            (
+                vec![lift(Side::Left, 1.0, 2.0), lift(Side::Left, 1.5, 3.0)],
+                1,
+            ),
+        ] {
+            assert!(matches!(
+                FootSchedule::from_lifts(&bad),
+                Err(LookAheadError::LiftOrder { index: i, .. }) if i == index
+            ));
+        }
     }
 }
