@@ -131,6 +131,37 @@ fn shifting(phase: SupportPhase) -> bool {
     )
 }
 
+/// The feet's targets of a frame, and where the feet are (left, right; robot world).
+struct Aims {
+    targets: [Option<GroundPose>; 2],
+    feet: [GroundPose; 2],
+    config: FootstepConfig,
+}
+
+impl Aims {
+    /// How far `foot` is from its target (m, and rad in heading), if it has one.
+    fn error(&self, foot: Side) -> Option<(f64, f64)> {
+        let target = self.targets[foot.index()]?;
+        let d = self.feet[foot.index()].relative(&target);
+        Some((d.xy.norm(), d.yaw.abs()))
+    }
+
+    /// Whether `foot` is farther from its target than a step's thresholds.
+    fn off(&self, foot: Side) -> bool {
+        let c = &self.config;
+        self.error(foot)
+            .is_some_and(|(d, a)| d > c.distance || a > c.heading)
+    }
+}
+
+/// The human's support standing on `foot` alone.
+fn single_support(foot: Side) -> HumanSupport {
+    match foot {
+        Side::Right => HumanSupport::Right,
+        Side::Left => HumanSupport::Left,
+    }
+}
+
 /// What the planner is doing.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Step {
@@ -238,6 +269,22 @@ impl FootstepPlanner {
     ) -> StepRequest {
         let now = frame.time;
         self.observe(frame, human, dt);
+        let aims = self.aims(feet, ratio);
+        self.off_target = Side::BOTH.iter().filter(|&&f| aims.off(f)).count();
+        self.advance(now, phase, dt, &aims);
+        if self.step == Step::Idle {
+            self.following = None;
+        }
+        let (support, lift) = match self.step {
+            Step::Swing(foot, _) => (single_support(foot.other()), self.may_lift(foot, now)),
+            Step::Idle | Step::Landing => (HumanSupport::Double, true),
+        };
+        StepRequest { support, lift }
+    }
+
+    /// The feet's targets this frame: where they stood when the current step began (without
+    /// walking) or the scaled human footprints (walking).
+    fn aims(&mut self, feet: [GroundPose; 2], ratio: f64) -> Aims {
         if self.origin.is_none()
             && let [Some(l), Some(r)] = self.human
         {
@@ -251,15 +298,16 @@ impl FootstepPlanner {
             Some(home) if !self.config.follow => home.map(Some),
             _ => Side::BOTH.map(|f| self.target_of(f, feet, ratio)),
         };
-        let error = |f: Side| -> Option<(f64, f64)> {
-            let t = targets[f.index()]?;
-            let d = feet[f.index()].relative(&t);
-            Some((d.xy.norm(), d.yaw.abs()))
-        };
-        let config = self.config;
-        let off =
-            |f: Side| error(f).is_some_and(|(d, a)| d > config.distance || a > config.heading);
-        self.off_target = usize::from(off(Side::Right)) + usize::from(off(Side::Left));
+        Aims {
+            targets,
+            feet,
+            config: self.config,
+        }
+    }
+
+    /// The step's state machine (see the module docs), at human time `now` with the robot in
+    /// `phase`.
+    fn advance(&mut self, now: f64, phase: SupportPhase, dt: f64, aims: &Aims) {
         match self.step {
             Step::Idle if phase == SupportPhase::Double => {
                 self.following = self.stance_ahead(now);
@@ -268,10 +316,10 @@ impl FootstepPlanner {
                         self.followed[lift.foot.index()] = lift.start;
                         Step::Swing(lift.foot, 0.0)
                     }
-                    None => self.choose(off, error),
+                    None => self.choose(aims),
                 };
                 if let Step::Swing(foot, _) = self.step {
-                    self.target = targets[foot.index()];
+                    self.target = aims.targets[foot.index()];
                 }
             }
             // A followed stance that the human ends before the robot's foot is off the ground is
@@ -293,11 +341,13 @@ impl FootstepPlanner {
                         if lifted == foot.other() && t >= self.config.stance_time) =>
             {
                 self.step = Step::Swing(foot.other(), 0.0);
-                self.target = targets[foot.other().index()];
+                self.target = aims.targets[foot.other().index()];
             }
             Step::Swing(foot, waited) => {
-                self.target = targets[foot.index()];
-                let there = error(foot).is_none_or(|(d, a)| d <= 0.005 && a <= 0.035);
+                self.target = aims.targets[foot.index()];
+                let there = aims
+                    .error(foot)
+                    .is_none_or(|(d, a)| d <= 0.005 && a <= 0.035);
                 let human_down = self.down[foot.index()] || self.lands_soon(foot, now);
                 let single = matches!(phase, SupportPhase::Right | SupportPhase::Left);
                 let waited = if single && human_down {
@@ -315,19 +365,6 @@ impl FootstepPlanner {
             Step::Landing if phase == SupportPhase::Double => self.step = Step::Idle,
             Step::Idle | Step::Landing => {}
         }
-        if self.step == Step::Idle {
-            self.following = None;
-        }
-        let support = match self.step {
-            Step::Swing(Side::Left, _) => HumanSupport::Right,
-            Step::Swing(Side::Right, _) => HumanSupport::Left,
-            Step::Idle | Step::Landing => HumanSupport::Double,
-        };
-        let lift = match self.step {
-            Step::Swing(foot, _) => self.may_lift(foot, now),
-            Step::Idle | Step::Landing => true,
-        };
-        StepRequest { support, lift }
     }
 
     /// Whether the swing foot may leave the ground. Online, always. Looking ahead, a followed
@@ -384,11 +421,7 @@ impl FootstepPlanner {
 
     /// The next step from double support: the human's one-leg stance (online: once it has
     /// lasted [`FootstepConfig::stance_time`]), or the foot farthest off its target.
-    fn choose(
-        &self,
-        off: impl Fn(Side) -> bool,
-        error: impl Fn(Side) -> Option<(f64, f64)>,
-    ) -> Step {
+    fn choose(&self, aims: &Aims) -> Step {
         if self.ahead.is_none()
             && let Some((lifted, t)) = self.stance
             && t >= self.config.stance_time
@@ -396,11 +429,11 @@ impl FootstepPlanner {
             return Step::Swing(lifted, 0.0);
         }
         let cost = |f: Side| {
-            error(f).map_or(0.0, |(d, a)| {
+            aims.error(f).map_or(0.0, |(d, a)| {
                 d / self.config.distance + a / self.config.heading
             })
         };
-        match (off(Side::Right), off(Side::Left)) {
+        match (aims.off(Side::Right), aims.off(Side::Left)) {
             (false, false) => Step::Idle,
             (true, false) => Step::Swing(Side::Right, 0.0),
             (false, true) => Step::Swing(Side::Left, 0.0),
