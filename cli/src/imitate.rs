@@ -60,18 +60,18 @@ pub(crate) struct ImitateArgs {
     #[arg(long, value_name = "SCENE.toml")]
     scene: Option<PathBuf>,
     /// Offline mode: the whole clip is read first, so the robot knows when the human will lift
-    /// each foot, for how long and where it will land. It shifts its weight onto the other foot
-    /// up to --lift-lead seconds before the human lifts one (the foot itself leaves the ground with
-    /// the human's), lowers a lifted foot up to --landing-lead seconds before the human's lands, and
-    /// with --walk steps toward where the human's foot will land. Poubel et al.'s method only
+    /// each foot, for how long and where it will land. It starts shifting its weight onto the
+    /// other foot as long before the human lifts one as its weight shift takes (the foot itself
+    /// leaves the ground with the human's), lowers a lifted foot as long before the human's lands
+    /// as its lowering takes, and with --walk steps toward where the human's foot will land. It
+    /// times its own motions as it goes; --lift-lead and --landing-lead are the first guesses.
+    /// Poubel et al.'s method only
     #[arg(long)]
     offline: bool,
-    /// Offline mode: how long before the human lifts a foot the robot starts shifting its
-    /// weight (s, ≥ 0; the robot's weight shift takes about this long)
+    /// Offline mode: the first guess of how long the robot's weight shift takes (s, ≥ 0)
     #[arg(long, value_name = "SECONDS", default_value_t = FootLookAhead::DEFAULT_LIFT_LEAD, requires = "offline", allow_negative_numbers = true)]
     lift_lead: f64,
-    /// Offline mode: how long before the human puts a foot down the robot starts lowering it
-    /// (s, ≥ 0)
+    /// Offline mode: the first guess of how long the robot's lowering of a foot takes (s, ≥ 0)
     #[arg(long, value_name = "SECONDS", default_value_t = FootLookAhead::DEFAULT_LANDING_LEAD, requires = "offline", allow_negative_numbers = true)]
     landing_lead: f64,
     #[command(flatten)]

@@ -34,7 +34,7 @@
 
 use nalgebra::{Rotation2, Vector2};
 
-use super::look_ahead::{FootLift, FootLookAhead};
+use super::look_ahead::{FootLift, FootLookAhead, FootSchedule, MotionTimes};
 use super::phase::SupportPhase;
 use super::support::HumanSupport;
 use crate::human::Side;
@@ -131,6 +131,13 @@ fn shifting(phase: SupportPhase) -> bool {
     )
 }
 
+/// What the planner looks ahead with.
+#[derive(Clone, Debug)]
+struct Ahead {
+    schedule: FootSchedule,
+    times: MotionTimes,
+}
+
 /// The feet's targets of a frame, and where the feet are (left, right; robot world).
 struct Aims {
     targets: [Option<GroundPose>; 2],
@@ -196,8 +203,8 @@ pub struct FootstepPlanner {
     /// Where the robot's feet stood when the current step began (left, right): the targets
     /// when the feet do not follow the human's.
     home: Option<[GroundPose; 2]>,
-    /// The human's foot lifts known in advance (offline mode).
-    ahead: Option<FootLookAhead>,
+    /// The human's foot lifts known in advance and the robot's own motion times (offline mode).
+    ahead: Option<Ahead>,
     /// The human's lift the current step follows (looking ahead, without walking).
     following: Option<FootLift>,
     /// Per foot, the start (human clock, s) of the last lift of the human's that a robot step
@@ -237,8 +244,17 @@ impl FootstepPlanner {
 
     /// The planner looks ahead on the human's clock with `ahead` (see [`super::look_ahead`]).
     pub fn with_look_ahead(mut self, ahead: FootLookAhead) -> Self {
-        self.ahead = Some(ahead);
+        let times = MotionTimes::new(&ahead);
+        self.ahead = Some(Ahead {
+            schedule: ahead.schedule,
+            times,
+        });
         self
+    }
+
+    /// Looking ahead, the robot's motion times learnt so far (the leads in use).
+    pub fn motion_times(&self) -> Option<&MotionTimes> {
+        self.ahead.as_ref().map(|a| &a.times)
     }
 
     /// The swing foot and its target (robot world), while the robot steps.
@@ -268,6 +284,9 @@ impl FootstepPlanner {
         dt: f64,
     ) -> StepRequest {
         let now = frame.time;
+        if let Some(ahead) = &mut self.ahead {
+            ahead.times.observe(phase, dt);
+        }
         self.observe(frame, human, dt);
         let aims = self.aims(feet, ratio);
         self.off_target = Side::BOTH.iter().filter(|&&f| aims.off(f)).count();
@@ -279,6 +298,9 @@ impl FootstepPlanner {
             Step::Swing(foot, _) => (single_support(foot.other()), self.may_lift(foot, now)),
             Step::Idle | Step::Landing => (HumanSupport::Double, true),
         };
+        if let Some(ahead) = &mut self.ahead {
+            ahead.times.requested(lift);
+        }
         StepRequest { support, lift }
     }
 
@@ -378,7 +400,7 @@ impl FootstepPlanner {
         if let Some(lift) = self.following {
             return now >= lift.start && !down;
         }
-        let coming = ahead.schedule.lift_within(foot, now, ahead.lift_lead);
+        let coming = ahead.schedule.lift_within(foot, now, ahead.times.shift);
         !(down && coming.is_some_and(|l| l.start > now))
     }
 
@@ -386,7 +408,7 @@ impl FootstepPlanner {
     fn lands_soon(&self, foot: Side, now: f64) -> bool {
         let ahead = self.ahead.as_ref();
         let lift = ahead.and_then(|a| a.schedule.lift_within(foot, now, 0.0).zip(Some(a)));
-        lift.is_some_and(|(l, a)| l.start <= now && l.end <= now + a.landing_lead)
+        lift.is_some_and(|(l, a)| l.start <= now && l.end <= now + a.times.lowering)
     }
 
     /// Looking ahead without walking: the human lift to follow now, if any (see
@@ -395,7 +417,7 @@ impl FootstepPlanner {
     /// foot out.
     fn stance_ahead(&self, now: f64) -> Option<FootLift> {
         let ahead = self.ahead.as_ref().filter(|_| !self.config.follow)?;
-        let (schedule, lead) = (&ahead.schedule, ahead.lift_lead);
+        let (schedule, lead) = (&ahead.schedule, ahead.times.shift);
         // The robot can stand on one leg for the stance time of it.
         let worth = |l: &FootLift| {
             l.start > self.followed[l.foot.index()]
@@ -407,7 +429,7 @@ impl FootstepPlanner {
                 .find(|l| worth(l))
         };
         let unrivalled = |l: &&FootLift| {
-            let busy_until = l.end + lead + ahead.landing_lead;
+            let busy_until = l.end + lead + ahead.times.lowering;
             let rivals = schedule.lifts_after(l.foot.other(), now).iter();
             !(rivals.take_while(|o| o.start < busy_until))
                 .any(|o| o.duration() > l.duration() && worth(o))
@@ -459,7 +481,7 @@ impl FootstepPlanner {
             }
             // Looking ahead, a foot about to be lifted (or in the air) aims at where it lands.
             let ahead = self.ahead.as_ref();
-            let lift = ahead.and_then(|a| a.schedule.lift_within(foot, frame.time, a.lift_lead));
+            let lift = ahead.and_then(|a| a.schedule.lift_within(foot, frame.time, a.times.shift));
             if let Some(landing) = lift.and_then(|l| l.landing) {
                 self.human[foot.index()] = Some(landing);
             }

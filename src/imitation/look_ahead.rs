@@ -14,9 +14,11 @@
 //!
 //! # What the robot does with it
 //!
-//! The [`FootstepPlanner`](super::footsteps::FootstepPlanner) looks ahead on the human's clock,
-//! by [`FootLookAhead::lift_lead`] for lift-offs and [`FootLookAhead::landing_lead`] for
-//! landings (durations of the robot's own weight shift and lowering):
+//! The [`FootstepPlanner`](super::footsteps::FootstepPlanner) looks ahead on the human's clock
+//! by how long the robot's own motions take ([`MotionTimes`]): its weight shift (the *lift
+//! lead*) for lift-offs, its lowering (the *landing lead*) for landings; first guesses
+//! [`FootLookAhead::lift_lead`] and [`FootLookAhead::landing_lead`], then the robot's last timed
+//! ones, so that no setting ties the look-ahead to one robot or one speed:
 //!
 //! * **Weight shift before the lift-off.** A lift of the human's foot that starts within the
 //!   lift lead starts the robot's step now: the CoM moves over the other foot while the human
@@ -44,6 +46,7 @@
 use thiserror::Error;
 
 use super::footsteps::{GroundPose, footprint};
+use super::phase::{Landing, SupportPhase, TakeOff};
 use super::support::{HumanSupport, SupportConfig, SupportDetector, SupportError};
 use crate::human::{HumanFrame, Side};
 
@@ -198,18 +201,20 @@ impl FootSchedule {
 }
 
 /// The feet's look-ahead of the offline mode: the recording's schedule and how far ahead the
-/// robot acts. The leads are durations of the robot's own motions, not of the human's: the
-/// defaults are what a NAO takes at a tenth of its rated leg joint speeds (Poubel et al.'s
-/// setting); a faster robot wants shorter ones.
+/// robot acts. The leads are durations of the robot's own motions, not of the human's, so they
+/// are learnt as the robot moves ([`MotionTimes`]); the values here are the first guesses, what
+/// a NAO takes at a tenth of its rated leg joint speeds (Poubel et al.'s setting).
 #[derive(Clone, Debug, PartialEq)]
 pub struct FootLookAhead {
     /// The human's foot lifts.
     pub schedule: FootSchedule,
     /// How long before the human lifts a foot the robot starts shifting its weight onto the
-    /// other (s, human clock). Default 1.5: the NAO's weight shift takes 1.5–2 s.
+    /// other (s), until it has timed a weight shift of its own. Default 1.5: the NAO's weight
+    /// shift takes 1.3–2 s.
     pub lift_lead: f64,
-    /// How long before the human puts a foot down the robot starts lowering it (s, human clock).
-    /// Default 0.8: the NAO's lowering from the lift height takes about as long.
+    /// How long before the human puts a foot down the robot starts lowering it (s), until it has
+    /// timed a lowering of its own. Default 0.8: the NAO's lowering from the lift height takes
+    /// about as long.
     pub landing_lead: f64,
 }
 
@@ -236,6 +241,87 @@ impl FootLookAhead {
         ]
         .into_iter()
         .find(|(_, v)| !(v.is_finite() && *v >= 0.0))
+    }
+}
+
+/// How long the robot's own weight shift and lowering take (s, robot clock): the leads the
+/// look-ahead uses. They start at [`FootLookAhead`]'s and become the duration of the robot's
+/// last timed weight shift ("CoM to foot") and of its last lowering ("Lower foot"). A weight shift
+/// is timed only when it, not the wait for the human's lift-off, decided when the foot lifted:
+/// the lift was allowed at least one update before the foot lifted. (Timing a held shift would
+/// lengthen the lead, which holds the next shift longer: the lead would only grow.) A shift given
+/// up after the lift was allowed (the human's stance ended first) took longer than it ran: the
+/// lift lead becomes at least that.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MotionTimes {
+    /// The weight shift's duration (s).
+    pub shift: f64,
+    /// The lowering's duration (s).
+    pub lowering: f64,
+    /// The robot's clock (s).
+    clock: f64,
+    /// The phase last observed, and since when (robot clock).
+    current: Option<(SupportPhase, f64)>,
+    /// When, in the current weight shift, the lift was first allowed (robot clock).
+    open_since: Option<f64>,
+    /// The robot clock of the last request.
+    last_request: f64,
+}
+
+impl MotionTimes {
+    /// The first guesses of `ahead`.
+    pub fn new(ahead: &FootLookAhead) -> Self {
+        Self {
+            shift: ahead.lift_lead,
+            lowering: ahead.landing_lead,
+            clock: 0.0,
+            current: None,
+            open_since: None,
+            last_request: f64::NEG_INFINITY,
+        }
+    }
+
+    /// The robot is in `phase` (the phase machine's output of the last update), `dt` (s) after
+    /// the last observation.
+    pub fn observe(&mut self, phase: SupportPhase, dt: f64) {
+        self.clock += dt;
+        let Some((previous, since)) = self.current else {
+            self.current = Some((phase, self.clock));
+            return;
+        };
+        if previous == phase {
+            return;
+        }
+        let took = self.clock - since;
+        match (
+            previous.take_off(),
+            phase.take_off(),
+            previous.landing(),
+            phase.landing(),
+        ) {
+            (Some(TakeOff::ComToFoot), Some(TakeOff::LiftFoot), ..)
+                if self.open_since.is_some_and(|t| t < self.last_request) =>
+            {
+                self.shift = took;
+            }
+            // Given up with the lift allowed: the shift takes longer than that.
+            (Some(TakeOff::ComToFoot), None, ..) if self.open_since.is_some() => {
+                self.shift = self.shift.max(took);
+            }
+            (.., Some(Landing::LowerFoot), Some(Landing::ComToMiddle)) => self.lowering = took,
+            _ => {}
+        }
+        self.current = Some((phase, self.clock));
+        self.open_since = None;
+    }
+
+    /// The planner asked the phase machine for a step with the foot allowed to lift or not.
+    pub fn requested(&mut self, lift: bool) {
+        self.last_request = self.clock;
+        let shifting = self.current.and_then(|(p, _)| p.take_off()) == Some(TakeOff::ComToFoot);
+        if lift && shifting {
+            self.open_since.get_or_insert(self.clock);
+        }
     }
 }
 
@@ -341,5 +427,53 @@ mod tests {
                 Err(LookAheadError::LiftOrder { index: i, .. }) if i == index
             ));
         }
+    }
+
+    #[test]
+    fn motion_times_are_learnt_from_unheld_shifts_and_lowerings() {
+        use crate::imitation::phase::{Landing, SupportPhase as P, TakeOff};
+        let mut times = MotionTimes::new(&FootLookAhead::new(FootSchedule::default()));
+        let guess = (times.shift, times.lowering);
+        // Runs `phase` for `seconds` in 10 ms updates with the lift allowed or not.
+        let run = |times: &mut MotionTimes, phase, seconds: f64, lift| {
+            for _ in 0..(seconds / 0.01).round() as usize {
+                times.observe(phase, 0.01);
+                times.requested(lift);
+            }
+        };
+        let (shift, lift) = (
+            P::DoubleToRight(TakeOff::ComToFoot),
+            P::DoubleToRight(TakeOff::LiftFoot),
+        );
+        // A shift held for the human's lift-off, lifting as soon as allowed: not timed.
+        run(&mut times, P::Double, 0.1, true);
+        run(&mut times, shift, 1.0, false);
+        run(&mut times, shift, 0.01, true);
+        run(&mut times, lift, 0.5, true);
+        assert_eq!((times.shift, times.lowering), guess);
+        // A shift that ends 0.7 s after it starts, the lift allowed throughout: timed.
+        run(&mut times, P::Right, 0.2, true);
+        run(&mut times, P::RightToDouble(Landing::LowerFoot), 0.45, true);
+        run(
+            &mut times,
+            P::RightToDouble(Landing::ComToMiddle),
+            0.3,
+            true,
+        );
+        run(&mut times, P::Double, 0.1, true);
+        run(&mut times, P::DoubleToLeft(TakeOff::ComToFoot), 0.7, true);
+        run(&mut times, P::DoubleToLeft(TakeOff::LiftFoot), 0.1, true);
+        assert!((times.shift - 0.7).abs() < 1e-9, "{times:?}");
+        assert!((times.lowering - 0.45).abs() < 1e-9, "{times:?}");
+        // A shift given up 1.2 s after it started, the lift allowed for its last 0.5 s: at least
+        // 1.2 s. One given up sooner changes nothing.
+        run(&mut times, P::Double, 0.1, true);
+        run(&mut times, shift, 0.7, false);
+        run(&mut times, shift, 0.5, true);
+        run(&mut times, P::Double, 0.1, true);
+        assert!((times.shift - 1.2).abs() < 1e-9, "{times:?}");
+        run(&mut times, shift, 0.3, true);
+        run(&mut times, P::Double, 0.1, true);
+        assert!((times.shift - 1.2).abs() < 1e-9, "{times:?}");
     }
 }

@@ -176,6 +176,22 @@ impl SupportPhase {
         }
     }
 
+    /// The take-off step, in a transition from DS to a single support.
+    pub const fn take_off(self) -> Option<TakeOff> {
+        match self {
+            SupportPhase::DoubleToRight(step) | SupportPhase::DoubleToLeft(step) => Some(step),
+            _ => None,
+        }
+    }
+
+    /// The landing step, in a transition from a single support to DS.
+    pub const fn landing(self) -> Option<Landing> {
+        match self {
+            SupportPhase::RightToDouble(step) | SupportPhase::LeftToDouble(step) => Some(step),
+            _ => None,
+        }
+    }
+
     /// Whether this is one of the 8 transition steps (not DS, RS or LS).
     pub const fn is_transition(self) -> bool {
         !matches!(
