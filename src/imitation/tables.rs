@@ -448,11 +448,6 @@ fn foot_frames(profile: &BipedProfile, foot: Side) -> [&str; 3] {
     [f.ankle.as_str(), f.toe.as_str(), f.heel.as_str()]
 }
 
-/// How far below its standing height the executable tables keep the torso (m). Shifting the
-/// hips over one foot with the torso upright lengthens the far leg; at the standing height both
-/// knees of a small biped with 0.1 m shanks end up straight (a singular posture the swing leg cannot lift from quickly).
-pub const TORSO_LOWERING: f64 = 0.02;
-
 /// Sideways lean of the torso over the foot the robot stands or is about to stand on in the
 /// executable tables (rad). With an upright pelvis the stance hip ends up outside the CoM and
 /// its roll servo holds the whole upper body (88 % of the rated hip-roll torque of a 5 kg biped
@@ -799,7 +794,7 @@ impl TaskTable {
                     offset: [0.0; 3],
                     axes: Axes::Z,
                     target: PointTarget::Standing {
-                        lower: TORSO_LOWERING,
+                        lower: profile.tuning.torso_lowering,
                     },
                 },
             ],

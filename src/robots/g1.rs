@@ -123,11 +123,15 @@ pub const STAND: [f64; 29] = [
 /// clips this lowers the mean hand error by 3–5 cm against 0.15 m/s, while at 0.45 m/s the arms
 /// saturate their velocity limits often enough that the uniformly scaled steps let the held
 /// foot drift by over 1 mm. The URDF's velocity limits are the motors' no-load speeds
-/// (20–37 rad/s): 10 % of them is already more than the NAO's arms get at 50 %.
+/// (20–37 rad/s): 10 % of them is already more than the NAO's arms get at 50 %. The torso is
+/// carried 0.05 m below its standing height, not the NAO's 0.02 m: with legs three times as
+/// long, at 0.02 m the free leg ended straight 22 µm above the floor on CMU 05_02 and the landing
+/// never finished.
 pub const TUNING: MotionTuning = MotionTuning {
     task_speed: 0.15,
     tracking_speed: 0.3,
     upper_body_velocity_fraction: 0.1,
+    torso_lowering: 0.05,
 };
 
 /// Where the G1 may put a foot down relative to the other sole: x ∈ [−0.10, 0.15] m, lateral

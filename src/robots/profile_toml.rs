@@ -43,6 +43,7 @@
 //! task_speed = 0.15                  # m/s
 //! tracking_speed = 0.15              # m/s, the hands
 //! upper_body_velocity_fraction = 0.5
+//! torso_lowering = 0.02              # m, the torso below its standing height
 //! ```
 //!
 //! The soles become links named `left_sole` and `right_sole` (added to the URDF text before it
@@ -86,6 +87,7 @@ struct Tuning {
     task_speed: Option<f64>,
     tracking_speed: Option<f64>,
     upper_body_velocity_fraction: Option<f64>,
+    torso_lowering: Option<f64>,
 }
 
 #[derive(Deserialize)]
@@ -282,6 +284,7 @@ fn tuning(file: Option<Tuning>) -> MotionTuning {
         tracking_speed: t.tracking_speed.unwrap_or(default.tracking_speed),
         upper_body_velocity_fraction: (t.upper_body_velocity_fraction)
             .unwrap_or(default.upper_body_velocity_fraction),
+        torso_lowering: t.torso_lowering.unwrap_or(default.torso_lowering),
     }
 }
 
