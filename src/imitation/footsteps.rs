@@ -122,13 +122,8 @@ pub(crate) fn wrap(angle: f64) -> f64 {
 }
 
 /// Whether `phase` shifts the CoM toward a foot with both feet still down.
-fn shifting(phase: SupportPhase) -> bool {
-    use super::phase::TakeOff;
-    matches!(
-        phase,
-        SupportPhase::DoubleToRight(TakeOff::ComToFoot)
-            | SupportPhase::DoubleToLeft(TakeOff::ComToFoot)
-    )
+pub(crate) fn shifting(phase: SupportPhase) -> bool {
+    phase.take_off() == Some(super::phase::TakeOff::ComToFoot)
 }
 
 /// What the planner looks ahead with.

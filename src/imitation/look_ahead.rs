@@ -45,7 +45,7 @@
 
 use thiserror::Error;
 
-use super::footsteps::{GroundPose, footprint};
+use super::footsteps::{GroundPose, footprint, shifting};
 use super::phase::{Landing, SupportPhase, TakeOff};
 use super::support::{HumanSupport, SupportConfig, SupportDetector, SupportError};
 use crate::human::{HumanFrame, Side};
@@ -318,8 +318,7 @@ impl MotionTimes {
     /// The planner asked the phase machine for a step with the foot allowed to lift or not.
     pub fn requested(&mut self, lift: bool) {
         self.last_request = self.clock;
-        let shifting = self.current.and_then(|(p, _)| p.take_off()) == Some(TakeOff::ComToFoot);
-        if lift && shifting {
+        if lift && self.current.is_some_and(|(p, _)| shifting(p)) {
             self.open_since.get_or_insert(self.clock);
         }
     }
