@@ -6,7 +6,7 @@ use taskstack::imitation::phase::{
     Landing, Measurements, PhaseConfig, PhaseError, PhaseMachine, Settling, SupportPhase, TakeOff,
 };
 use taskstack::imitation::support::HumanSupport;
-use taskstack::imitation::tables::{Gradient, GradientKind, TableError, Task, TaskTables};
+use taskstack::imitation::tables::{ComGoal, Gradient, GradientKind, TableError, Task, TaskTables};
 use taskstack::robots::nao;
 
 use HumanSupport as H;
@@ -438,6 +438,60 @@ fn paper_tables_have_table_one_row_counts() {
         assert!(table.clamping);
     }
     assert_eq!(tables.iter().count(), 11);
+}
+
+/// Walking, the CoM goes over the centre of the support sole's FSR rectangle (computed here from
+/// the NAO's sensor positions, not by the crate), and the collision level comes before balance;
+/// the tables are otherwise the executable ones.
+#[test]
+fn walking_tables_centre_the_stance_and_keep_bodies_apart_first() {
+    let profile = nao::profile();
+    let executable = TaskTables::executable(&PhaseConfig::default(), &profile);
+    let mut walking = executable.clone();
+    walking.centre_stances_for_walking(&profile);
+    let names = |t: &taskstack::imitation::tables::TaskTable| -> Vec<String> {
+        t.levels.iter().map(|l| l.name.clone()).collect()
+    };
+    // The left sole's FSRs span x ∈ [−30.25, 70.25] mm, y ∈ [−23.1, 29.9] mm.
+    let centre = |side: Side| match side {
+        Side::Left => [0.02, 0.0034],
+        Side::Right => [0.02, -0.0034],
+    };
+    for (before, after) in executable.iter().zip(walking.iter()) {
+        let level = |t: &taskstack::imitation::tables::TaskTable, name: &str| {
+            names(t).iter().position(|n| n == name)
+        };
+        assert!(level(before, "collision") > level(before, "balance"));
+        assert_eq!(level(after, "collision"), level(before, "balance"));
+        assert_eq!(level(after, "balance"), level(before, "collision"));
+        let goal = |t: &taskstack::imitation::tables::TaskTable| {
+            t.levels
+                .iter()
+                .flat_map(|l| &l.tasks)
+                .find_map(|task| match task {
+                    Task::ComXY(goal) => Some(*goal),
+                    _ => None,
+                })
+        };
+        let root = after.model_root;
+        match (goal(before), goal(after)) {
+            (Some(ComGoal::SupportPoint(_)), Some(ComGoal::SupportPoint(p))) => {
+                let c = centre(root);
+                assert!(
+                    (p[0] - c[0]).abs() < 1e-9 && (p[1] - c[1]).abs() < 1e-9,
+                    "{p:?}"
+                );
+            }
+            (Some(ComGoal::OtherPoint(_)), Some(ComGoal::OtherPoint(p))) => {
+                let c = centre(root.other());
+                assert!(
+                    (p[0] - c[0]).abs() < 1e-9 && (p[1] - c[1]).abs() < 1e-9,
+                    "{p:?}"
+                );
+            }
+            (b, a) => assert_eq!(b, a, "{}", after.phase),
+        }
+    }
 }
 
 #[test]

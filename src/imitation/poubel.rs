@@ -125,6 +125,11 @@ impl PoubelImitator {
     ) -> Result<Self, ImitationError> {
         let mut tables = match config.tables.take() {
             Some(tables) => tables,
+            None if config.footsteps.follow => {
+                let mut tables = TaskTables::executable(&config.phase, &profile);
+                tables.centre_stances_for_walking(&profile);
+                tables
+            }
             None => TaskTables::executable(&config.phase, &profile),
         };
         let outline_points = profile.feet.iter().map(|f| f.outline.len()).sum();
