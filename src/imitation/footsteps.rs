@@ -158,14 +158,6 @@ impl Aims {
     }
 }
 
-/// The human's support standing on `foot` alone.
-fn single_support(foot: Side) -> HumanSupport {
-    match foot {
-        Side::Right => HumanSupport::Right,
-        Side::Left => HumanSupport::Left,
-    }
-}
-
 /// What the planner is doing.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Step {
@@ -292,7 +284,11 @@ impl FootstepPlanner {
             self.following = None;
         }
         let (support, lift) = match self.step {
-            Step::Swing(foot, _) => (single_support(foot.other()), self.may_lift(foot, now)),
+            Step::Swing(foot, _) => {
+                let stance = foot.other();
+                let support = HumanSupport::from_feet(stance == Side::Left, stance == Side::Right);
+                (support, self.may_lift(foot, now))
+            }
             Step::Idle | Step::Landing => (HumanSupport::Double, true),
         };
         if let Some(ahead) = &mut self.ahead {
@@ -403,9 +399,12 @@ impl FootstepPlanner {
 
     /// Whether the human's `foot` is up at `now` and will be down within the landing lead.
     fn lands_soon(&self, foot: Side, now: f64) -> bool {
-        let ahead = self.ahead.as_ref();
-        let lift = ahead.and_then(|a| a.schedule.lift_within(foot, now, 0.0).zip(Some(a)));
-        lift.is_some_and(|(l, a)| l.start <= now && l.end <= now + a.times.lowering)
+        let Some(ahead) = &self.ahead else {
+            return false;
+        };
+        // A lift "within 0 s" of now is the one under way.
+        let under_way = ahead.schedule.lift_within(foot, now, 0.0);
+        under_way.is_some_and(|l| l.end <= now + ahead.times.lowering)
     }
 
     /// Looking ahead without walking: the human lift to follow now, if any (see
@@ -463,12 +462,7 @@ impl FootstepPlanner {
 
     /// Updates the human footprints and the one-leg stance from this frame.
     fn observe(&mut self, frame: &HumanFrame, human: HumanSupport, dt: f64) {
-        let down = match human {
-            HumanSupport::Double => [true, true],
-            HumanSupport::Right => [false, true],
-            HumanSupport::Left => [true, false],
-            HumanSupport::Airborne => [false, false],
-        };
+        let down = human.feet();
         self.down = down;
         for foot in Side::BOTH {
             if down[foot.index()]

@@ -131,10 +131,8 @@ impl FootSchedule {
             }
             previous = time;
             let now_up = match detector.update(frame) {
-                HumanSupport::Double => [false, false],
-                HumanSupport::Right => [true, false],
-                HumanSupport::Left => [false, true],
                 HumanSupport::Airborne => up,
+                support => support.feet().map(|down| !down),
             };
             for foot in Side::BOTH {
                 let lifts = &mut schedule.lifts[foot.index()];

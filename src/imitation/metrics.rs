@@ -476,10 +476,8 @@ impl MetricsRecorder {
         self.robot_steps
             .record(!(standing[0] && standing[1]), frame.time);
         self.human_up = match frame.human_support {
-            HumanSupport::Double => [false, false],
-            HumanSupport::Right => [true, false],
-            HumanSupport::Left => [false, true],
             HumanSupport::Airborne => self.human_up,
+            support => support.feet().map(|down| !down),
         };
         (self.feet).record(self.human_up, standing.map(|s| !s), frame.time);
         self.pending = frame.pending_steps;

@@ -65,6 +65,17 @@ impl HumanSupport {
             (false, false) => HumanSupport::Airborne,
         }
     }
+
+    /// Which feet are in support, `[left, right]` ([`Side::index`] order): the inverse of
+    /// [`HumanSupport::from_feet`].
+    pub const fn feet(self) -> [bool; 2] {
+        match self {
+            HumanSupport::Double => [true, true],
+            HumanSupport::Right => [false, true],
+            HumanSupport::Left => [true, false],
+            HumanSupport::Airborne => [false, false],
+        }
+    }
 }
 
 /// Thresholds of the support detector. Distances in metres, speeds in m/s, times in seconds.
