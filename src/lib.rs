@@ -108,6 +108,7 @@ pub mod error;
 pub mod human;
 pub mod imitation;
 pub mod io;
+pub mod locomotion;
 pub mod model;
 pub mod problem;
 pub mod robots;
