@@ -389,9 +389,18 @@ impl<W: std::io::Write> JointsWriter<W> {
 
     /// Writes the header line.
     pub fn header(&mut self, imitator: &Imitator) -> std::io::Result<()> {
+        self.header_names(imitator.variable_names())
+    }
+
+    /// Writes the header line for joints named `names` (any source of joint angles: a walk, a
+    /// user's own loop).
+    pub fn header_names<'n>(
+        &mut self,
+        names: impl IntoIterator<Item = &'n str>,
+    ) -> std::io::Result<()> {
         self.line.clear();
         self.line.push_str("time");
-        for name in imitator.variable_names() {
+        for name in names {
             self.line.push(',');
             self.line.push_str(name);
         }
@@ -401,9 +410,14 @@ impl<W: std::io::Write> JointsWriter<W> {
 
     /// Writes `frame`'s line.
     pub fn frame(&mut self, frame: &RobotFrame) -> std::io::Result<()> {
+        self.row(frame.time, &frame.q)
+    }
+
+    /// Writes one line: `time` (s) and the joint angles `q` (rad).
+    pub fn row(&mut self, time: f64, q: &[f64]) -> std::io::Result<()> {
         self.line.clear();
-        let _ = write!(self.line, "{:.6}", frame.time);
-        for q in &frame.q {
+        let _ = write!(self.line, "{time:.6}");
+        for q in q {
             let _ = write!(self.line, ",{q:.6}");
         }
         self.line.push('\n');
@@ -413,6 +427,11 @@ impl<W: std::io::Write> JointsWriter<W> {
     /// Flushes the output.
     pub fn finish(&mut self) -> std::io::Result<()> {
         self.out.flush()
+    }
+
+    /// The output, given back.
+    pub fn into_inner(self) -> W {
+        self.out
     }
 }
 

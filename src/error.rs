@@ -13,6 +13,7 @@ use crate::imitation::tables::TableError;
 use crate::io::bvh::BvhError;
 use crate::io::clip::ClipError;
 use crate::io::kinect::KinectError;
+use crate::locomotion::LocomotionError;
 use crate::model::{DhError, ModelError, UrdfError};
 use crate::problem::ProblemError;
 use crate::robots::ProfileError;
@@ -41,6 +42,9 @@ pub enum Error {
     /// [`ProfileError`].
     #[error(transparent)]
     Profile(#[from] ProfileError),
+    /// [`LocomotionError`].
+    #[error(transparent)]
+    Locomotion(#[from] LocomotionError),
     /// [`ImitationError`].
     #[error(transparent)]
     Imitation(#[from] ImitationError),

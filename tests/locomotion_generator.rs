@@ -22,7 +22,14 @@ const TIMING: StepTiming = StepTiming {
 /// The dense finite-horizon LQ: minimise `Σ_{i=1..N} Q (C x_i − r_i)² + Σ_{i=0..N} R u_i² +
 /// x_{N+1}ᵀ P x_{N+1}` over `u_0 … u_N`, which is the infinite-horizon problem with a reference
 /// that is zero after `N` ticks (the tail's optimal cost is `xᵀPx`). Returns `u_0`.
-fn dense_first_jerk(m: &CartTable, p: &Matrix3<f64>, q: f64, r: f64, x0: Vector3<f64>, refs: &[f64]) -> f64 {
+fn dense_first_jerk(
+    m: &CartTable,
+    p: &Matrix3<f64>,
+    q: f64,
+    r: f64,
+    x0: Vector3<f64>,
+    refs: &[f64],
+) -> f64 {
     let n = refs.len();
     let vars = n + 1;
     // x_i = A^i x0 + Σ_{k<i} A^{i-1-k} B u_k, as (free part, input matrix rows).
@@ -50,7 +57,10 @@ fn dense_first_jerk(m: &CartTable, p: &Matrix3<f64>, q: f64, r: f64, x0: Vector3
             gradient += inputs.transpose() * pd * DVector::from_column_slice(free.as_slice());
         }
     }
-    let u = hessian.cholesky().expect("positive definite").solve(&(-gradient));
+    let u = hessian
+        .cholesky()
+        .expect("positive definite")
+        .solve(&(-gradient));
     u[0]
 }
 
@@ -58,12 +68,18 @@ fn dense_first_jerk(m: &CartTable, p: &Matrix3<f64>, q: f64, r: f64, x0: Vector3
 fn preview_gains_equal_the_dense_finite_horizon_lq() {
     for (height, dt, horizon) in [(0.26, 0.01, 1.0), (0.68, 0.01, 1.6), (0.25, 0.02, 0.8)] {
         let model = CartTable::new(height, dt).unwrap();
-        let settings = PreviewSettings { q: 1.0, r: 1e-6, horizon };
+        let settings = PreviewSettings {
+            q: 1.0,
+            r: 1e-6,
+            horizon,
+        };
         let gains = PreviewGains::new(model, settings).unwrap();
         let n = gains.window();
         // A state and a reference that are not special: an offset CoM moving, a stepping ZMP.
         let x0 = Vector3::new(0.012, -0.05, 0.3);
-        let refs: Vec<f64> = (0..n).map(|j| 0.04 * ((j as f64 * 0.13).sin()) + 0.01).collect();
+        let refs: Vec<f64> = (0..n)
+            .map(|j| 0.04 * ((j as f64 * 0.13).sin()) + 0.01)
+            .collect();
         let dense = dense_first_jerk(&model, gains.riccati(), 1.0, 1e-6, x0, &refs);
         let preview = gains.jerk(&x0, &refs);
         assert!(
@@ -74,7 +90,8 @@ fn preview_gains_equal_the_dense_finite_horizon_lq() {
         let (a, b, c) = (model.a, model.b, model.c);
         let p = gains.riccati();
         let rhs = a.transpose() * p * a + c * c.transpose()
-            - (a.transpose() * p * b) * (b.transpose() * p * a) / (1e-6 + (b.transpose() * p * b)[0]);
+            - (a.transpose() * p * b) * (b.transpose() * p * a)
+                / (1e-6 + (b.transpose() * p * b)[0]);
         assert!((rhs - p).abs().max() <= 1e-9 * p.abs().max());
     }
 }
@@ -90,7 +107,10 @@ fn settings() -> WalkSettings {
         com_height: COM_HEIGHT,
         dt: DT,
         preview: PreviewSettings::default(),
-        swing: SwingProfile { height: 0.02, lift_share: 0.15 },
+        swing: SwingProfile {
+            height: 0.02,
+            lift_share: 0.15,
+        },
         stop_duration: 0.5,
         start_duration: 0.5,
         capacity: 16,
@@ -98,7 +118,10 @@ fn settings() -> WalkSettings {
 }
 
 fn standing() -> [GroundPose; 2] {
-    [GroundPose::new(0.0, 0.05, 0.0), GroundPose::new(0.0, -0.05, 0.0)]
+    [
+        GroundPose::new(0.0, 0.05, 0.0),
+        GroundPose::new(0.0, -0.05, 0.0),
+    ]
 }
 
 fn generator() -> PatternGenerator {
@@ -176,16 +199,30 @@ fn check_walk(states: &[WalkState]) {
         let zmp = c(k) - acceleration * (COM_HEIGHT / 9.81);
         let m = margin(&polygon(&states[k], &outlines), zmp);
         worst = worst.min(m);
-        assert!(m >= 0.005, "tick {k} (t = {:.3} s): ZMP {m:.4} m inside the support", states[k].time);
-        assert!((states[k].zmp - zmp).norm() < 1e-3, "the reported ZMP is the CoM's");
+        assert!(
+            m >= 0.005,
+            "tick {k} (t = {:.3} s): ZMP {m:.4} m inside the support",
+            states[k].time
+        );
+        assert!(
+            (states[k].zmp - zmp).norm() < 1e-3,
+            "the reported ZMP is the CoM's"
+        );
         for side in Side::BOTH {
             let on_floor = |s: &WalkState| !matches!(s.support, Support::Single { swing, .. } if swing == side);
-            let (before, now) = (states[k - 1].feet[side.index()], states[k].feet[side.index()]);
+            let (before, now) = (
+                states[k - 1].feet[side.index()],
+                states[k].feet[side.index()],
+            );
             if on_floor(&states[k - 1]) && on_floor(&states[k]) {
                 assert_eq!(before, now, "a sole on the floor moved at tick {k}");
             }
             if !on_floor(&states[k - 1]) && on_floor(&states[k]) {
-                let speed = (0..3).map(|i| (now.position[i] - before.position[i]).powi(2)).sum::<f64>().sqrt() / DT;
+                let speed = (0..3)
+                    .map(|i| (now.position[i] - before.position[i]).powi(2))
+                    .sum::<f64>()
+                    .sqrt()
+                    / DT;
                 assert!(speed < 1e-3, "a foot landed at {speed} m/s");
             }
         }
@@ -193,12 +230,19 @@ fn check_walk(states: &[WalkState]) {
     let last = states.last().unwrap();
     assert!(last.com_velocity.norm() < 1e-3, "the CoM comes to rest");
     let mid = (last.feet[0].position[0] + last.feet[1].position[0]) / 2.0;
-    assert!((last.com.x - mid - 0.02).abs() < 0.01, "the CoM rests between the feet");
+    assert!(
+        (last.com.x - mid - 0.02).abs() < 0.01,
+        "the CoM rests between the feet"
+    );
     assert!(worst < 0.05, "the check saw single support");
 }
 
 fn step(side: Side, x: f64, y: f64, yaw: f64) -> Footstep {
-    Footstep { side, target: GroundPose::new(x, y, yaw), timing: TIMING }
+    Footstep {
+        side,
+        target: GroundPose::new(x, y, yaw),
+        timing: TIMING,
+    }
 }
 
 #[test]
@@ -214,11 +258,21 @@ fn a_straight_walk_keeps_the_zmp_inside_and_arrives() {
         .collect();
     let states = walk(&mut g, &steps);
     let last = states.last().unwrap();
-    assert!((last.feet[0].position[0] - 0.48).abs() < 1e-12 && (last.feet[1].position[0] - 0.48).abs() < 1e-12);
-    assert!((last.com.x - 0.50).abs() < 0.01, "CoM over the final feet: {}", last.com.x);
+    assert!(
+        (last.feet[0].position[0] - 0.48).abs() < 1e-12
+            && (last.feet[1].position[0] - 0.48).abs() < 1e-12
+    );
+    assert!(
+        (last.com.x - 0.50).abs() < 0.01,
+        "CoM over the final feet: {}",
+        last.com.x
+    );
     // 9 steps of 0.5 s, the first from rest with a 0.5 s double support instead of 0.15 s: the
     // last foot lands at 0.35 + 9 × 0.5 = 4.85 s.
-    let end = states.iter().rposition(|s| matches!(s.support, Support::Single { .. })).unwrap();
+    let end = states
+        .iter()
+        .rposition(|s| matches!(s.support, Support::Single { .. }))
+        .unwrap();
     assert!((states[end].time - 4.85).abs() < 0.01);
 }
 
@@ -242,7 +296,10 @@ fn a_turn_in_place_and_a_side_step_keep_the_zmp_inside() {
     let steps: Vec<Footstep> = (1..=3)
         .flat_map(|i| {
             let y = -0.04 * i as f64;
-            [step(Side::Right, 0.0, y - 0.05, 0.0), step(Side::Left, 0.0, y + 0.05, 0.0)]
+            [
+                step(Side::Right, 0.0, y - 0.05, 0.0),
+                step(Side::Left, 0.0, y + 0.05, 0.0),
+            ]
         })
         .collect();
     let states = walk(&mut g, &steps);
@@ -256,7 +313,11 @@ fn an_online_queue_fed_step_by_step_walks_and_stops() {
     let mut next = 1;
     let states = run_to_rest(&mut g, |g| {
         if next <= 6 && g.queued() <= 1 {
-            let side = if next % 2 == 1 { Side::Left } else { Side::Right };
+            let side = if next % 2 == 1 {
+                Side::Left
+            } else {
+                Side::Right
+            };
             let y = if side == Side::Left { 0.05 } else { -0.05 };
             g.push(step(side, 0.05 * next as f64, y, 0.0)).unwrap();
             next += 1;
@@ -264,23 +325,39 @@ fn an_online_queue_fed_step_by_step_walks_and_stops() {
     });
     assert_eq!(next, 7);
     let singles = states.windows(2).filter(|w| {
-        !matches!(w[0].support, Support::Single { .. }) && matches!(w[1].support, Support::Single { .. })
+        !matches!(w[0].support, Support::Single { .. })
+            && matches!(w[1].support, Support::Single { .. })
     });
     assert_eq!(singles.count(), 6, "six lift-offs");
     // A step queued after the robot stopped starts from rest and is as safe.
     let more = [step(Side::Left, 0.35, 0.05, 0.0)];
     let after = walk(&mut g, &more);
-    assert!(after.iter().any(|s| matches!(s.support, Support::Single { swing: Side::Left, .. })));
+    assert!(after.iter().any(|s| matches!(
+        s.support,
+        Support::Single {
+            swing: Side::Left,
+            ..
+        }
+    )));
 }
 
 #[test]
 fn the_swing_sole_lifts_carries_and_lands_flat() {
-    let profile = SwingProfile { height: 0.03, lift_share: 0.2 };
-    let (from, to) = (GroundPose::new(0.0, 0.1, 0.0), GroundPose::new(0.08, 0.12, 0.3));
+    let profile = SwingProfile {
+        height: 0.03,
+        lift_share: 0.2,
+    };
+    let (from, to) = (
+        GroundPose::new(0.0, 0.1, 0.0),
+        GroundPose::new(0.08, 0.12, 0.3),
+    );
     let at = |tau: f64| profile.at(&from, &to, tau);
     assert_eq!(at(0.0).position, [0.0, 0.1, 0.0]);
     assert!((at(1.0).position[0] - 0.08).abs() < 1e-15 && (at(1.0).yaw - 0.3).abs() < 1e-15);
-    assert!((at(0.5).position[2] - 0.03).abs() < 1e-15, "peak at mid-swing");
+    assert!(
+        (at(0.5).position[2] - 0.03).abs() < 1e-15,
+        "peak at mid-swing"
+    );
     // No horizontal motion while the sole rises off the floor (τ ≤ lift share).
     assert_eq!(at(0.2).position[0], 0.0);
     assert!(at(0.2).position[2] > 0.005);
@@ -292,26 +369,66 @@ fn the_swing_sole_lifts_carries_and_lands_flat() {
 #[test]
 fn bad_input_is_refused_with_a_typed_error() {
     let (centres, _) = nao_centres();
-    let bad_height = WalkSettings { com_height: f64::NAN, ..settings() };
-    let err = PatternGenerator::new(bad_height, centres.clone(), standing(), Vector2::zeros()).unwrap_err();
-    assert!(matches!(err, LocomotionError::InvalidParameter { name: "com_height", .. }));
-    let bad_swing = WalkSettings { swing: SwingProfile { height: 0.02, lift_share: 0.5 }, ..settings() };
-    assert!(PatternGenerator::new(bad_swing, centres.clone(), standing(), Vector2::zeros()).is_err());
-    let err = PatternGenerator::new(settings(), centres, standing(), Vector2::new(f64::NAN, 0.0)).unwrap_err();
+    let bad_height = WalkSettings {
+        com_height: f64::NAN,
+        ..settings()
+    };
+    let err = PatternGenerator::new(bad_height, centres.clone(), standing(), Vector2::zeros())
+        .unwrap_err();
+    assert!(matches!(
+        err,
+        LocomotionError::InvalidParameter {
+            name: "com_height",
+            ..
+        }
+    ));
+    let bad_swing = WalkSettings {
+        swing: SwingProfile {
+            height: 0.02,
+            lift_share: 0.5,
+        },
+        ..settings()
+    };
+    assert!(
+        PatternGenerator::new(bad_swing, centres.clone(), standing(), Vector2::zeros()).is_err()
+    );
+    let err = PatternGenerator::new(settings(), centres, standing(), Vector2::new(f64::NAN, 0.0))
+        .unwrap_err();
     assert_eq!(err, LocomotionError::NonFinite("initial feet or CoM"));
     assert!(SoleCentres::of_outlines([&[[0.0, 0.0]], &[[0.0, 0.0]]]).is_err());
 
     let mut g = generator();
-    let nan = Footstep { target: GroundPose::new(f64::NAN, 0.0, 0.0), ..step(Side::Left, 0.0, 0.0, 0.0) };
+    let nan = Footstep {
+        target: GroundPose::new(f64::NAN, 0.0, 0.0),
+        ..step(Side::Left, 0.0, 0.0, 0.0)
+    };
     assert!(matches!(g.push(nan), Err(LocomotionError::NonFinite(_))));
-    let zero = Footstep { timing: StepTiming { double_support: 0.0, single_support: 0.3 }, ..step(Side::Left, 0.0, 0.05, 0.0) };
-    assert!(matches!(g.push(zero), Err(LocomotionError::InvalidParameter { .. })));
+    let zero = Footstep {
+        timing: StepTiming {
+            double_support: 0.0,
+            single_support: 0.3,
+        },
+        ..step(Side::Left, 0.0, 0.05, 0.0)
+    };
+    assert!(matches!(
+        g.push(zero),
+        Err(LocomotionError::InvalidParameter { .. })
+    ));
     for _ in 0..16 {
         g.push(step(Side::Left, 0.0, 0.05, 0.0)).unwrap();
     }
-    assert_eq!(g.push(step(Side::Left, 0.0, 0.05, 0.0)), Err(LocomotionError::QueueFull { capacity: 16 }));
+    assert_eq!(
+        g.push(step(Side::Left, 0.0, 0.05, 0.0)),
+        Err(LocomotionError::QueueFull { capacity: 16 })
+    );
     assert!(matches!(
-        PreviewGains::new(CartTable::new(0.25, 0.01).unwrap(), PreviewSettings { r: -1.0, ..PreviewSettings::default() }),
+        PreviewGains::new(
+            CartTable::new(0.25, 0.01).unwrap(),
+            PreviewSettings {
+                r: -1.0,
+                ..PreviewSettings::default()
+            }
+        ),
         Err(LocomotionError::InvalidParameter { name: "r", .. })
     ));
 }

@@ -13,6 +13,7 @@ mod run;
 mod solve;
 mod svg;
 mod view;
+mod walk;
 
 use std::process::ExitCode;
 
@@ -42,6 +43,7 @@ enum Command {
     Fk(fk::FkArgs),
     Solve(solve::SolveArgs),
     View(view::ViewArgs),
+    Walk(walk::WalkArgs),
 }
 
 /// How the command reports: progress and summary for people, JSON for scripts, or nothing.
@@ -71,6 +73,7 @@ fn main() -> ExitCode {
         Command::Fk(args) => fk::run(args),
         Command::Solve(args) => solve::run(args, report),
         Command::View(args) => view::run(args, report),
+        Command::Walk(args) => walk::run(args, report),
     };
     match result {
         Ok(code) => code,

@@ -3,11 +3,11 @@
 
 use nalgebra::{Vector2, Vector3};
 
+use super::LocomotionError;
 use super::footstep::{Footstep, GroundPose};
 use super::preview::{CartTable, PreviewGains, PreviewSettings, positive};
 use super::schedule::{Schedule, SoleCentres, Support};
 use super::swing::{SolePose, SwingProfile};
-use super::LocomotionError;
 use crate::human::Side;
 
 /// What a walk is made of: the pendulum, the controller and the swing.

@@ -37,19 +37,25 @@
 
 pub mod footstep;
 pub mod generator;
-// pub mod params;
+pub mod margin;
+pub mod params;
+pub mod planner;
 pub mod preview;
 pub mod schedule;
 pub mod swing;
-// pub mod walker;
+pub mod walker;
 
 use thiserror::Error;
 
 pub use footstep::{Footstep, GroundPose, StepTiming};
 pub use generator::{PatternGenerator, WalkSettings, WalkState};
+pub use margin::SupportPolygon;
+pub use params::WalkParams;
+pub use planner::{goal_feet, plan_steps};
 pub use preview::{CartTable, PreviewGains, PreviewSettings};
 pub use schedule::{SoleCentres, Support};
 pub use swing::{SolePose, SwingProfile};
+pub use walker::{WalkerFrame, WholeBodyWalker};
 
 /// Errors of the walking pattern generator and walker.
 #[derive(Debug, Clone, PartialEq, Error)]

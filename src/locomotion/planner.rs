@@ -1,0 +1,92 @@
+//! Footsteps toward a goal, within a robot's step envelope.
+//!
+//! The feet alternate; each step puts the swing sole as close to its goal placement as the
+//! envelope ([`FootArea`], relative to the stance sole) allows, so a long way becomes as many
+//! steps as it needs. The first foot to move is the one that leads toward the goal (left for a
+//! goal to the left or a left turn), and the plan ends with both soles on their goals.
+
+use super::footstep::{Footstep, GroundPose, StepTiming};
+use crate::human::Side;
+use crate::robots::{FootArea, SolePlacement};
+
+/// Both soles are on their goals within this (m, rad).
+const ARRIVED: f64 = 1e-9;
+
+/// The goal placements of both soles for the midpoint frame of `feet` moved by `motion` (in that
+/// frame: forward m, left m, turn rad): each sole keeps its offset from the midpoint.
+pub fn goal_feet(feet: &[GroundPose; 2], motion: &GroundPose) -> [GroundPose; 2] {
+    let [left, right] = feet;
+    let heading = right.yaw + super::footstep::wrap_angle(left.yaw - right.yaw) / 2.0;
+    let mid = GroundPose {
+        xy: (left.xy + right.xy) / 2.0,
+        yaw: heading,
+    };
+    let goal = mid.compose(motion);
+    feet.map(|f| goal.compose(&mid.relative(&f)))
+}
+
+/// Steps from `feet` to `goal` (`[left, right]`, world), each clipped to `envelope`, at most
+/// `max_steps`; every step takes `timing`. Empty when the feet are on their goals.
+pub fn plan_steps(
+    feet: &[GroundPose; 2],
+    goal: &[GroundPose; 2],
+    envelope: &FootArea,
+    timing: StepTiming,
+    max_steps: usize,
+) -> Vec<Footstep> {
+    let first = leading_side(feet, goal);
+    let mut steps = Vec::new();
+    let mut now = *feet;
+    let mut swing = first;
+    let mut skipped = 0;
+    while steps.len() < max_steps && !arrived(&now, goal) && skipped < 2 {
+        let stance = now[swing.other().index()];
+        let wanted = stance.relative(&goal[swing.index()]);
+        let clipped = envelope.clip(
+            swing,
+            SolePlacement {
+                xy: wanted.xy,
+                yaw: wanted.yaw,
+            },
+        );
+        let target = stance.compose(&GroundPose {
+            xy: clipped.xy,
+            yaw: clipped.yaw,
+        });
+        // A foot already where it can get waits while the other steps.
+        let stays = same(&target, &now[swing.index()]);
+        if !stays {
+            now[swing.index()] = target;
+            steps.push(Footstep {
+                side: swing,
+                target,
+                timing,
+            });
+        }
+        skipped = if stays { skipped + 1 } else { 0 };
+        swing = swing.other();
+    }
+    steps
+}
+
+/// The foot that leads toward the goal: the side the goal lies or turns toward.
+fn leading_side(feet: &[GroundPose; 2], goal: &[GroundPose; 2]) -> Side {
+    let [left, right] = feet;
+    let lateral = left.xy - right.xy; // points from the right sole to the left
+    let shift = (goal[0].xy + goal[1].xy - left.xy - right.xy) / 2.0;
+    let turn = super::footstep::wrap_angle(goal[0].yaw - left.yaw);
+    let toward_left = shift.dot(&lateral.normalize()) + 0.05 * turn;
+    if toward_left >= 0.0 {
+        Side::Left
+    } else {
+        Side::Right
+    }
+}
+
+fn arrived(now: &[GroundPose; 2], goal: &[GroundPose; 2]) -> bool {
+    now.iter().zip(goal).all(|(a, b)| same(a, b))
+}
+
+fn same(a: &GroundPose, b: &GroundPose) -> bool {
+    (a.xy - b.xy).norm() <= ARRIVED && super::footstep::wrap_angle(a.yaw - b.yaw).abs() <= ARRIVED
+}

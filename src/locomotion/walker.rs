@@ -1,0 +1,227 @@
+//! A whole robot walking a footstep queue: the pattern generator's CoM and swing sole tracked by
+//! the task-stack solver.
+//!
+//! Each tick the model is rooted at the stance sole (at the sole that last stood alone while both
+//! stand), placed where the generator put it in the world, and the driver solves, in priority
+//! order: the other sole's pose (held on the floor, or on its swing path), the CoM (x, y and the
+//! walking height), the torso upright with the feet's mean heading; the standing posture pulls
+//! the remaining freedom (the arms, the waist). A sole on the floor is the model's root or a
+//! top-level task, so it does not move in the plan.
+
+use nalgebra::{IsometryMatrix3, Rotation3, Translation3, Vector2, Vector3};
+
+use super::LocomotionError;
+use super::footstep::{Footstep, GroundPose};
+use super::generator::{PatternGenerator, WalkState};
+use super::params::WalkParams;
+use super::schedule::Support;
+use super::swing::SolePose;
+use crate::Error;
+use crate::human::Side;
+use crate::robots::BipedProfile;
+use crate::solver::driver::{DriverSettings, PositionDriver};
+use crate::solver::{JointBounds, Solver};
+use crate::tasks::{ComTask, OrientationTask, PoseTask, TaskSet};
+
+/// Gain of the pull toward the standing posture (per driver iteration).
+const POSTURE_GAIN: f64 = 0.05;
+
+/// The solver of one root: its task set and buffers.
+#[derive(Debug)]
+struct RootedStack<'p> {
+    set: TaskSet<'p>,
+    solver: Solver,
+    driver: PositionDriver,
+}
+
+/// One tick of a walk: the generator's state and the joint angles that realise it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WalkerFrame {
+    /// The pattern generator's state (world frame).
+    pub walk: WalkState,
+    /// The sole the model is rooted at.
+    pub root: Side,
+    /// Error norm of the other sole's pose task after the solve (m and rad stacked).
+    pub foot_error: f64,
+    /// Error norm of the CoM task after the solve (m).
+    pub com_error: f64,
+}
+
+/// A biped walking footsteps (see the module docs). Borrows its profile.
+#[derive(Debug)]
+pub struct WholeBodyWalker<'p> {
+    profile: &'p BipedProfile,
+    params: WalkParams,
+    generator: PatternGenerator,
+    stacks: [RootedStack<'p>; 2],
+    bounds: JointBounds,
+    q: Vec<f64>,
+    root: Side,
+    frame: WalkerFrame,
+}
+
+impl<'p> WholeBodyWalker<'p> {
+    /// The robot standing in `profile.stand` with its right sole at `right` (world) and the
+    /// settings `params` (usually [`WalkParams::for_profile`]). The first steps lower the CoM
+    /// from its standing height to the walking height over the start double support.
+    ///
+    /// # Errors
+    /// Model, task, solver and generator errors of the set-up.
+    pub fn new(
+        profile: &'p BipedProfile,
+        params: WalkParams,
+        right: GroundPose,
+    ) -> Result<Self, Error> {
+        let model = profile.model(Side::Right);
+        let mut data = model.new_data();
+        model.forward_kinematics(&mut data, &profile.stand)?;
+        let left_sole = data.frame_placement(model.frame_id(&profile.foot(Side::Left).sole)?);
+        let left_local = GroundPose::new(
+            left_sole.translation.x,
+            left_sole.translation.y,
+            left_sole.rotation.matrix()[(1, 0)].atan2(left_sole.rotation.matrix()[(0, 0)]),
+        );
+        let com = model.com(&data)?;
+        let feet = [right.compose(&left_local), right];
+        let com_xy = right.to_world([com.x, com.y]);
+        let generator =
+            PatternGenerator::new(params.settings, params.centres.clone(), feet, com_xy)?;
+        let stacks = [
+            rooted_stack(profile, Side::Left)?,
+            rooted_stack(profile, Side::Right)?,
+        ];
+        let bounds = crate::tasks::joint_bounds(model)?;
+        let state = *generator.state();
+        Ok(Self {
+            profile,
+            params,
+            generator,
+            stacks,
+            bounds,
+            q: profile.stand.clone(),
+            root: Side::Right,
+            frame: WalkerFrame {
+                walk: state,
+                root: Side::Right,
+                foot_error: 0.0,
+                com_error: 0.0,
+            },
+        })
+    }
+
+    /// The pattern generator (its queue, settings and state).
+    pub fn generator(&self) -> &PatternGenerator {
+        &self.generator
+    }
+
+    /// The derived parameters it walks with.
+    pub fn params(&self) -> &WalkParams {
+        &self.params
+    }
+
+    /// The joint angles of the last tick (rad, model variable order).
+    pub fn q(&self) -> &[f64] {
+        &self.q
+    }
+
+    /// Queues a step (see [`PatternGenerator::push`]); returns its landing time (s).
+    ///
+    /// # Errors
+    /// The generator's refusal ([`LocomotionError`]).
+    pub fn push(&mut self, step: Footstep) -> Result<f64, LocomotionError> {
+        self.generator.push(step)
+    }
+
+    /// Advances one tick: the generator, then the IK of the whole body.
+    ///
+    /// # Errors
+    /// Solver and model errors (non-finite numbers).
+    pub fn tick(&mut self) -> Result<&WalkerFrame, Error> {
+        let walk = *self.generator.tick();
+        if let Support::Single { swing, .. } = walk.support {
+            self.root = swing.other();
+        }
+        let root = self.root;
+        let root_pose = self.generator.standing_feet()[root.index()];
+        let other = walk.feet[root.other().index()];
+        let heading = mean_heading(&walk.feet);
+        let com_height = self.com_height(walk.time);
+        let stack = &mut self.stacks[root.index()];
+        let other_name = &self.profile.foot(root.other()).sole;
+        stack.set.task_mut::<PoseTask>(other_name)?.target = local_pose(&root_pose, &other);
+        let com_local = root_pose.to_local(walk.com.xy());
+        stack.set.task_mut::<ComTask>("com")?.target =
+            Vector3::new(com_local.x, com_local.y, com_height);
+        stack.set.task_mut::<OrientationTask>("torso")?.target =
+            Rotation3::from_axis_angle(&Vector3::z_axis(), heading - root_pose.yaw);
+        let report =
+            stack
+                .driver
+                .run(&mut stack.solver, &mut stack.set, &mut self.q, &self.bounds)?;
+        let errors = report.task_errors();
+        self.frame = WalkerFrame {
+            walk,
+            root,
+            foot_error: errors[0],
+            com_error: errors[1],
+        };
+        Ok(&self.frame)
+    }
+
+    /// The CoM height at `time` (m): from standing down to the walking height over the start
+    /// time, then constant.
+    fn com_height(&self, time: f64) -> f64 {
+        let share = (time / self.params.settings.start_duration).clamp(0.0, 1.0);
+        let smooth = share * share * (3.0 - 2.0 * share);
+        let (stand, walk) = (
+            self.params.standing_com_height,
+            self.params.settings.com_height,
+        );
+        stand + (walk - stand) * smooth
+    }
+}
+
+/// The task stack of the model rooted at `root`: the other sole, the CoM, the torso.
+fn rooted_stack(profile: &BipedProfile, root: Side) -> Result<RootedStack<'_>, Error> {
+    let model = profile.model(root);
+    let other = PoseTask::new(
+        model,
+        &profile.foot(root.other()).sole,
+        IsometryMatrix3::identity(),
+    )?;
+    let com = ComTask::new(model, Vector3::zeros())?;
+    let torso = OrientationTask::new(model, &profile.torso, Rotation3::identity())?.named("torso");
+    let set = TaskSet::new(model)
+        .level("foot", vec![Box::new(other)])
+        .level("com", vec![Box::new(com)])
+        .level("torso", vec![Box::new(torso)])
+        .posture_gradient(POSTURE_GAIN, &profile.stand)?;
+    let solver = Solver::new(&set.shape())?;
+    let settings = DriverSettings {
+        tolerance: 1e-7,
+        stall_tolerance: 1e-10,
+        max_iterations: 20,
+        ..DriverSettings::default()
+    };
+    let driver = PositionDriver::new(&solver, settings)?;
+    Ok(RootedStack {
+        set,
+        solver,
+        driver,
+    })
+}
+
+/// `sole` (world) in the frame of the root sole standing at `root` (m, rad).
+fn local_pose(root: &GroundPose, sole: &SolePose) -> IsometryMatrix3<f64> {
+    let xy = root.to_local(Vector2::new(sole.position[0], sole.position[1]));
+    IsometryMatrix3::from_parts(
+        Translation3::new(xy.x, xy.y, sole.position[2]),
+        Rotation3::from_axis_angle(&Vector3::z_axis(), sole.yaw - root.yaw),
+    )
+}
+
+/// The mean of the two soles' headings (rad), on the short arc.
+fn mean_heading(feet: &[SolePose; 2]) -> f64 {
+    let [l, r] = feet.map(|f| f.yaw);
+    r + super::footstep::wrap_angle(l - r) / 2.0
+}
