@@ -63,7 +63,11 @@ pub(crate) fn run(args: WalkArgs, report: Report) -> Result<ExitCode> {
     let mut walker = WholeBodyWalker::new(&profile, params, GroundPose::new(0.0, 0.0, 0.0))?;
     let start = *walker.generator().standing_feet();
     let goal = goal_feet(&start, &GroundPose::new(args.forward, args.left, args.turn));
-    let steps = plan_steps(&start, &goal, &profile.step_envelope, timing, MAX_STEPS);
+    let mut envelope = profile.step_envelope;
+    if let Some(x) = std::env::var("XENV").ok().and_then(|v| v.parse().ok()) {
+        envelope.x_max = x;
+    }
+    let steps = plan_steps(&start, &goal, &envelope, timing, MAX_STEPS);
     for step in &steps {
         walker.push(*step)?;
     }
@@ -75,8 +79,20 @@ pub(crate) fn run(args: WalkArgs, report: Report) -> Result<ExitCode> {
     joints.row(0.0, walker.q())?;
     let (mut zmp_margin, mut foot_error, mut com_error) = (f64::INFINITY, 0.0_f64, 0.0_f64);
     let mut stopped_at = None;
+    let mut plan = String::from("time,com_x,com_y,zmp_x,zmp_y,left_z,right_z\n");
     loop {
         let frame = *walker.tick()?;
+        let w = &frame.walk;
+        plan.push_str(&format!(
+            "{:.3},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6}\n",
+            w.time,
+            w.com.x,
+            w.com.y,
+            w.zmp.x,
+            w.zmp.y,
+            w.feet[0].position[2],
+            w.feet[1].position[2]
+        ));
         zmp_margin = zmp_margin.min(polygon.margin(&frame.walk, frame.walk.zmp));
         foot_error = foot_error.max(frame.foot_error);
         com_error = com_error.max(frame.com_error);
@@ -114,6 +130,7 @@ pub(crate) fn run(args: WalkArgs, report: Report) -> Result<ExitCode> {
             .with_context(|| format!("cannot write {}", args.out.join(name).display()))
     };
     write("joints.csv", &csv)?;
+    write("plan.csv", plan.as_bytes())?;
     write(
         "walk.json",
         serde_json::to_string_pretty(&summary)?.as_bytes(),

@@ -58,6 +58,8 @@ pub struct WholeBodyWalker<'p> {
     q: Vec<f64>,
     root: Side,
     frame: WalkerFrame,
+    /// Half the distance between the soles standing (m).
+    half_span: f64,
 }
 
 impl<'p> WholeBodyWalker<'p> {
@@ -92,6 +94,8 @@ impl<'p> WholeBodyWalker<'p> {
         ];
         let bounds = crate::tasks::joint_bounds(model)?;
         let state = *generator.state();
+        let half_span = (feet[0].xy - feet[1].xy).norm() / 2.0;
+
         Ok(Self {
             profile,
             params,
@@ -106,6 +110,7 @@ impl<'p> WholeBodyWalker<'p> {
                 foot_error: 0.0,
                 com_error: 0.0,
             },
+            half_span,
         })
     }
 
@@ -141,11 +146,12 @@ impl<'p> WholeBodyWalker<'p> {
         if let Support::Single { swing, .. } = walk.support {
             self.root = swing.other();
         }
+        let heading = mean_heading(&walk.feet);
         let root = self.root;
         let root_pose = self.generator.standing_feet()[root.index()];
         let other = walk.feet[root.other().index()];
-        let heading = mean_heading(&walk.feet);
         let com_height = self.com_height(walk.time);
+        let lean = self.lean(&walk, heading);
         let stack = &mut self.stacks[root.index()];
         let other_name = &self.profile.foot(root.other()).sole;
         stack.set.task_mut::<PoseTask>(other_name)?.target = local_pose(&root_pose, &other);
@@ -153,7 +159,8 @@ impl<'p> WholeBodyWalker<'p> {
         stack.set.task_mut::<ComTask>("com")?.target =
             Vector3::new(com_local.x, com_local.y, com_height);
         stack.set.task_mut::<OrientationTask>("torso")?.target =
-            Rotation3::from_axis_angle(&Vector3::z_axis(), heading - root_pose.yaw);
+            Rotation3::from_axis_angle(&Vector3::z_axis(), heading - root_pose.yaw)
+                * Rotation3::from_axis_angle(&Vector3::x_axis(), -lean);
         let report =
             stack
                 .driver
@@ -166,6 +173,19 @@ impl<'p> WholeBodyWalker<'p> {
             com_error: errors[1],
         };
         Ok(&self.frame)
+    }
+
+    /// The torso's sideways lean toward the side the CoM is on (rad, + toward the left): the
+    /// profile's lean times the CoM's offset from the line between the soles, as a share of
+    /// half their standing distance.
+    fn lean(&self, walk: &WalkState, heading: f64) -> f64 {
+        let lean_max = self.params.torso_lean;
+        let [l, r] = walk
+            .feet
+            .map(|f| Vector2::new(f.position[0], f.position[1]));
+        let mid = (l + r) / 2.0;
+        let offset = nalgebra::Rotation2::new(-heading) * (walk.com.xy() - mid);
+        lean_max * (offset.y / self.half_span).clamp(-1.0, 1.0)
     }
 
     /// The CoM height at `time` (m): from standing down to the walking height over the start
