@@ -63,11 +63,7 @@ pub(crate) fn run(args: WalkArgs, report: Report) -> Result<ExitCode> {
     let mut walker = WholeBodyWalker::new(&profile, params, GroundPose::new(0.0, 0.0, 0.0))?;
     let start = *walker.generator().standing_feet();
     let goal = goal_feet(&start, &GroundPose::new(args.forward, args.left, args.turn));
-    let mut envelope = profile.step_envelope;
-    if let Some(x) = std::env::var("XENV").ok().and_then(|v| v.parse().ok()) {
-        envelope.x_max = x;
-    }
-    let steps = plan_steps(&start, &goal, &envelope, timing, MAX_STEPS);
+    let steps = plan_steps(&start, &goal, &profile.step_envelope, timing, MAX_STEPS);
     for step in &steps {
         walker.push(*step)?;
     }
