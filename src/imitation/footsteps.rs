@@ -90,38 +90,8 @@ impl FootstepConfig {
     }
 }
 
-/// A ground pose: sole point (m) and heading (rad about z).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct GroundPose {
-    /// x, y (m).
-    pub xy: Vector2<f64>,
-    /// Heading (rad).
-    pub yaw: f64,
-}
-
-impl GroundPose {
-    /// `other` expressed in this pose's frame.
-    fn relative(&self, other: &GroundPose) -> GroundPose {
-        GroundPose {
-            xy: Rotation2::new(-self.yaw) * (other.xy - self.xy),
-            yaw: wrap(other.yaw - self.yaw),
-        }
-    }
-
-    /// A pose given in this pose's frame, back in the world.
-    fn compose(&self, local: &GroundPose) -> GroundPose {
-        GroundPose {
-            xy: self.xy + Rotation2::new(self.yaw) * local.xy,
-            yaw: wrap(self.yaw + local.yaw),
-        }
-    }
-}
-
-/// `angle` wrapped to [−π, π) (rad).
-pub(crate) fn wrap(angle: f64) -> f64 {
-    use std::f64::consts::{PI, TAU};
-    (angle + PI).rem_euclid(TAU) - PI
-}
+pub use crate::locomotion::GroundPose;
+pub(crate) use crate::locomotion::footstep::wrap_angle as wrap;
 
 /// Whether `phase` shifts the CoM toward a foot with both feet still down.
 pub(crate) fn shifting(phase: SupportPhase) -> bool {

@@ -7,7 +7,6 @@
 //!
 //! World frame: the right sole's frame at the first frame (x forward, y left, z up, metres).
 
-use faer::Mat;
 use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 
 use super::footsteps::GroundPose;
@@ -171,7 +170,7 @@ impl Shared {
         let model = profile.model(Side::Right);
         let position_bounds = crate::tasks::joint_bounds(model)?;
         let q = initial_posture(&profile, config, &position_bounds)?;
-        let legs = sole_chain_variables(&profile, &q)?;
+        let legs = profile.sole_chain_variables(&q)?;
         let upper_body = (config.upper_body_velocity_fraction)
             .unwrap_or(profile.tuning.upper_body_velocity_fraction);
         let bounds = velocity_bounds(model, &position_bounds, &legs, config, upper_body)?;
@@ -354,30 +353,6 @@ pub(crate) fn ground_pose(sole: &IsometryMatrix3<f64>) -> GroundPose {
         xy: sole.translation.vector.xy(),
         yaw: x.y.atan2(x.x),
     }
-}
-
-/// Which variables move the left sole relative to the right one (the legs, closing a loop in
-/// double support): the columns of the left sole's 6 × n Jacobian in the right-rooted model that
-/// are not zero at `q`.
-pub(crate) fn sole_chain_variables(
-    profile: &BipedProfile,
-    q: &[f64],
-) -> Result<Vec<bool>, ImitationError> {
-    let model = profile.model(Side::Right);
-    let mut data = model.new_data();
-    model.forward_kinematics(&mut data, q)?;
-    let sole = model.frame_id(&profile.foot(Side::Left).sole)?;
-    let mut jac = Mat::zeros(6, model.nv());
-    model.point_jacobian(
-        &data,
-        sole,
-        &Vector3::zeros(),
-        jac.as_mut().subrows_mut(0, 3),
-    )?;
-    model.orientation_jacobian(&data, sole, jac.as_mut().subrows_mut(3, 3))?;
-    Ok((0..model.nv())
-        .map(|k| (0..6).any(|r| jac[(r, k)] != 0.0))
-        .collect())
 }
 
 /// The human's mid-ankle ground point (xy, m) and hip heading (rad) in `frame`.

@@ -35,7 +35,7 @@ impl GroundPose {
     }
 
     /// `other` seen from this sole: its offset (m, this sole's frame) and relative yaw (rad, in
-    /// (−π, π]).
+    /// [−π, π)).
     pub fn relative(&self, other: &GroundPose) -> GroundPose {
         GroundPose {
             xy: self.to_local(other.xy),
@@ -57,14 +57,10 @@ impl GroundPose {
     }
 }
 
-/// The angle `a` (rad) wrapped into (−π, π].
+/// The angle `a` (rad) wrapped into [−π, π).
 pub fn wrap_angle(a: f64) -> f64 {
-    let wrapped = a.rem_euclid(std::f64::consts::TAU);
-    if wrapped > std::f64::consts::PI {
-        wrapped - std::f64::consts::TAU
-    } else {
-        wrapped
-    }
+    use std::f64::consts::{PI, TAU};
+    (a + PI).rem_euclid(TAU) - PI
 }
 
 /// How long a step takes (s): the double support in which the weight moves to the stance

@@ -410,6 +410,31 @@ impl BipedProfile {
             .chain(points)
     }
 
+    /// Which variables move the left sole relative to the right one (the legs, closing a loop
+    /// in double support), in model variable order: the columns of the left sole's 6 × n
+    /// Jacobian in the right-rooted model that are not zero at `q` (rad). The others (arms,
+    /// head, a waist) move only the upper body.
+    ///
+    /// # Errors
+    /// [`ProfileError::Model`] for a `q` of the wrong length or a missing sole frame.
+    pub fn sole_chain_variables(&self, q: &[f64]) -> Result<Vec<bool>, ProfileError> {
+        let model = self.model(Side::Right);
+        let mut data = model.new_data();
+        model.forward_kinematics(&mut data, q)?;
+        let sole = model.frame_id(&self.foot(Side::Left).sole)?;
+        let mut jac = faer::Mat::zeros(6, model.nv());
+        model.point_jacobian(
+            &data,
+            sole,
+            &Vector3::zeros(),
+            jac.as_mut().subrows_mut(0, 3),
+        )?;
+        model.orientation_jacobian(&data, sole, jac.as_mut().subrows_mut(3, 3))?;
+        Ok((0..model.nv())
+            .map(|k| (0..6).any(|r| jac[(r, k)] != 0.0))
+            .collect())
+    }
+
     /// Centre of the bounding rectangle of the contact area of `side` (sole frame, m): the
     /// point of the area farthest from its edges for a rectangle-like sole; where a robot
     /// standing on this foot keeps its centre of mass.
