@@ -1,0 +1,232 @@
+//! A whole robot walking: the footstep planner toward a goal and the walker's joint angles,
+//! checked through forward kinematics (independent of the walker's own task errors): soles on
+//! the floor still to 1e-6 m and rad, the CoM where the generator put it, the joint limits kept,
+//! the ZMP of the realised CoM inside the support.
+
+use nalgebra::Vector2;
+use taskstack::Side;
+use taskstack::locomotion::{
+    Footstep, GroundPose, StepTiming, SupportPolygon, WalkParams, WholeBodyWalker, goal_feet,
+    plan_steps,
+};
+use taskstack::robots::{BipedProfile, FootArea, g1, nao};
+
+/// World pose (x, y, z, yaw) of `side`'s sole from the model rooted at `root`, placed at
+/// `root_pose`.
+fn sole_in_world(
+    profile: &BipedProfile,
+    q: &[f64],
+    root: Side,
+    root_pose: &GroundPose,
+    side: Side,
+) -> ([f64; 3], f64) {
+    let model = profile.model(root);
+    let mut data = model.new_data();
+    model.forward_kinematics(&mut data, q).unwrap();
+    let sole = data.frame_placement(model.frame_id(&profile.foot(side).sole).unwrap());
+    let xy = root_pose.to_world([sole.translation.x, sole.translation.y]);
+    let r = sole.rotation.matrix();
+    (
+        [xy.x, xy.y, sole.translation.z],
+        root_pose.yaw + r[(1, 0)].atan2(r[(0, 0)]),
+    )
+}
+
+fn com_in_world(profile: &BipedProfile, q: &[f64], root: Side, root_pose: &GroundPose) -> [f64; 3] {
+    let model = profile.model(root);
+    let mut data = model.new_data();
+    model.forward_kinematics(&mut data, q).unwrap();
+    let c = model.com(&data).unwrap();
+    let xy = root_pose.to_world([c.x, c.y]);
+    [xy.x, xy.y, c.z]
+}
+
+/// Walks `motion` (forward, left m; turn rad) and checks every tick.
+fn walk_and_check(profile: &BipedProfile, motion: GroundPose) -> usize {
+    let params = WalkParams::for_profile(profile).unwrap();
+    let (dt, height) = (params.settings.dt, params.settings.com_height);
+    let mut walker =
+        WholeBodyWalker::new(profile, params.clone(), GroundPose::new(0.0, 0.0, 0.0)).unwrap();
+    let start = *walker.generator().standing_feet();
+    let goal = goal_feet(&start, &motion);
+    let steps = plan_steps(&start, &goal, &profile.step_envelope, params.timing, 100);
+    for step in &steps {
+        walker.push(*step).unwrap();
+    }
+    let outlines = Side::BOTH.map(|s| profile.foot(s).outline.as_slice());
+    let mut polygon = SupportPolygon::new(outlines);
+    let variables = profile.model(Side::Right).variables().to_vec();
+    let mut previous: Option<[([f64; 3], f64); 2]> = None;
+    let mut previous_on_floor = [true, true];
+    let mut coms: Vec<[f64; 3]> = Vec::new();
+    let mut states = Vec::new();
+    let mut ticks = 0;
+    while !walker.generator().is_stopped() || ticks < 100 {
+        let frame = *walker.tick().unwrap();
+        ticks += 1;
+        assert!(ticks < 10_000, "the walk never ends");
+        let q = walker.q();
+        for (v, &qi) in variables.iter().zip(q) {
+            assert!(
+                qi >= v.lower && qi <= v.upper,
+                "{} = {qi} outside its limits",
+                v.name
+            );
+        }
+        let root_pose = walker.generator().standing_feet()[frame.root.index()];
+        let soles = Side::BOTH.map(|s| sole_in_world(profile, q, frame.root, &root_pose, s));
+        let on_floor = walker.generator().on_floor();
+        for side in Side::BOTH {
+            let (p, yaw) = soles[side.index()];
+            let planned = frame.walk.feet[side.index()];
+            for k in 0..3 {
+                assert!(
+                    (p[k] - planned.position[k]).abs() < 1e-5,
+                    "sole off its plan"
+                );
+            }
+            if let Some(before) =
+                previous.filter(|_| on_floor[side.index()] && previous_on_floor[side.index()])
+            {
+                let (b, byaw) = before[side.index()];
+                let moved =
+                    ((p[0] - b[0]).powi(2) + (p[1] - b[1]).powi(2) + (p[2] - b[2]).powi(2)).sqrt();
+                assert!(
+                    moved <= 1e-6,
+                    "a sole on the floor moved {moved} m at t = {}",
+                    frame.walk.time
+                );
+                assert!((yaw - byaw).abs() <= 1e-6, "a sole on the floor turned");
+            }
+        }
+        previous = Some(soles);
+        previous_on_floor = on_floor;
+        let com = com_in_world(profile, q, frame.root, &root_pose);
+        assert!(
+            (Vector2::new(com[0], com[1]) - frame.walk.com.xy()).norm() < 1e-4,
+            "CoM off its plan"
+        );
+        coms.push(com);
+        states.push(frame.walk);
+    }
+    // The ZMP of the realised CoM (its second difference), at the walking height, inside the
+    // support by 5 mm at every tick once the CoM has come down to it.
+    for k in 1..coms.len() - 1 {
+        let c = |i: usize| Vector2::new(coms[i][0], coms[i][1]);
+        let zmp = c(k) - (c(k + 1) - 2.0 * c(k) + c(k - 1)) * (height / 9.81 / (dt * dt));
+        let margin = polygon.margin(&states[k], zmp);
+        assert!(
+            margin >= 0.005,
+            "ZMP {margin} m inside at t = {}",
+            states[k].time
+        );
+    }
+    // Arrived: both soles on their goals.
+    let end = walker.generator().standing_feet();
+    for side in Side::BOTH {
+        assert!((end[side.index()].xy - goal[side.index()].xy).norm() < 1e-9);
+    }
+    steps.len()
+}
+
+#[test]
+fn the_nao_walks_forward_sideways_and_turns() {
+    let profile = nao::profile();
+    assert!(walk_and_check(&profile, GroundPose::new(0.3, 0.0, 0.0)) >= 6);
+    walk_and_check(&profile, GroundPose::new(0.0, -0.12, 0.0));
+    walk_and_check(&profile, GroundPose::new(0.0, 0.0, 0.5));
+}
+
+#[test]
+fn the_g1_walks_forward() {
+    walk_and_check(&g1::profile(), GroundPose::new(0.4, 0.0, 0.0));
+}
+
+#[test]
+fn derived_settings_follow_the_robots_size() {
+    let (nao, g1) = (
+        WalkParams::for_profile(&nao::profile()).unwrap(),
+        WalkParams::for_profile(&g1::profile()).unwrap(),
+    );
+    // Step time: 6 pendulum time constants √(z_c/g), z_c the standing CoM height.
+    for p in [&nao, &g1] {
+        let tau = (p.settings.com_height / 9.81).sqrt();
+        assert!((p.timing.duration() - 6.0 * tau).abs() < 1e-12);
+        assert_eq!(p.settings.com_height, p.standing_com_height);
+    }
+    assert!(
+        nao.timing.duration() > 0.9 && nao.timing.duration() < 1.1,
+        "NAO steps about 1 s"
+    );
+    assert!(
+        g1.timing.duration() > nao.timing.duration() * 1.4,
+        "the taller robot steps more slowly"
+    );
+    assert!(g1.settings.swing.height > 2.0 * nao.settings.swing.height);
+    // The NAO's hips are 0.1 m apart (HipOffsetY 0.05): lean atan(0.05 / z_c).
+    assert!((nao.torso_lean - (0.05 / nao.settings.com_height).atan()).abs() < 1e-3);
+}
+
+fn envelope() -> FootArea {
+    nao::STEP_ENVELOPE
+}
+
+#[test]
+fn the_planner_reaches_the_goal_within_the_envelope() {
+    let timing = StepTiming {
+        double_support: 0.3,
+        single_support: 0.4,
+    };
+    let feet = [
+        GroundPose::new(0.0, 0.05, 0.0),
+        GroundPose::new(0.0, -0.05, 0.0),
+    ];
+    for (motion, first) in [
+        (GroundPose::new(0.5, 0.0, 0.0), None),
+        (GroundPose::new(-0.2, 0.0, 0.0), None),
+        (GroundPose::new(0.0, 0.15, 0.0), Some(Side::Left)),
+        (GroundPose::new(0.0, -0.15, 0.0), Some(Side::Right)),
+        (GroundPose::new(0.0, 0.0, 0.9), Some(Side::Left)),
+        (GroundPose::new(0.0, 0.0, -0.9), Some(Side::Right)),
+        (GroundPose::new(0.4, 0.2, -0.6), None),
+    ] {
+        let goal = goal_feet(&feet, &motion);
+        let steps = plan_steps(&feet, &goal, &envelope(), timing, 100);
+        if let Some(first) = first {
+            assert_eq!(
+                steps[0].side, first,
+                "the foot toward the goal leads ({motion:?})"
+            );
+        }
+        let mut now = feet;
+        for Footstep { side, target, .. } in &steps {
+            let stance = now[side.other().index()];
+            let rel = stance.relative(target);
+            let lateral = if *side == Side::Left {
+                rel.xy.y
+            } else {
+                -rel.xy.y
+            };
+            let e = envelope();
+            assert!(rel.xy.x >= e.x_min - 1e-12 && rel.xy.x <= e.x_max + 1e-12);
+            assert!(lateral >= e.lateral_min - 1e-12 && lateral <= e.lateral_max + 1e-12);
+            assert!(rel.yaw.abs() <= e.yaw_max + 1e-12);
+            now[side.index()] = *target;
+        }
+        for side in Side::BOTH {
+            assert!(
+                (now[side.index()].xy - goal[side.index()].xy).norm() < 1e-9,
+                "{motion:?}"
+            );
+        }
+    }
+    // 0.5 m at most 5 cm a step: at least 10 steps, and no step is wasted standing still.
+    let goal = goal_feet(&feet, &GroundPose::new(0.5, 0.0, 0.0));
+    let steps = plan_steps(&feet, &goal, &envelope(), timing, 100);
+    assert!(
+        steps.len() >= 10 && steps.len() <= 12,
+        "{} steps",
+        steps.len()
+    );
+    assert!(plan_steps(&feet, &feet, &envelope(), timing, 100).is_empty());
+}
