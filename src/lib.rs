@@ -6,7 +6,8 @@
 //!
 //! The layers point one way: [`solver`], [`model`], [`human`] and [`scene`] (the surfaces around
 //! the human) at the bottom; [`tasks`] (tasks named by frame) and [`robots`] (what imitation knows
-//! of a robot) above them; [`io`] (clip readers) and [`imitation`] above those; [`batch`] and [`problem`] at the edge. The
+//! of a robot) above them; [`locomotion`] (walking a queue of footsteps) above those; [`io`] (clip
+//! readers) and [`imitation`] above those; [`batch`] and [`problem`] at the edge. The
 //! `taskstack` command-line tool (the `cli/` folder of the repository) is built on this API.
 //!
 //! # Guide

@@ -10,7 +10,9 @@ use serde_json::Value;
 fn every_subcommand_explains_its_options_and_outputs() {
     let top = taskstack(&["--help"]);
     assert_eq!(top.code, Some(0), "{}", top.stderr);
-    for command in ["imitate", "batch", "contacts", "fk", "solve", "view"] {
+    for command in [
+        "imitate", "batch", "contacts", "fk", "solve", "view", "walk",
+    ] {
         assert!(
             top.stdout.contains(command),
             "top-level help lists {command}"
@@ -515,4 +517,77 @@ fn a_reader_that_closes_the_pipe_is_not_an_error() {
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert_eq!(output.status.code(), Some(0), "{stderr}");
     assert!(!stderr.contains("panicked"), "{stderr}");
+}
+
+#[test]
+fn walk_writes_a_joint_trajectory_the_plan_and_a_summary() {
+    let out = temp_dir("walk");
+    let run = taskstack(&[
+        "walk",
+        "--forward",
+        "0.2",
+        "--left",
+        "-0.05",
+        "--hold",
+        "0.5",
+        "--json",
+        "--out",
+        s(&out),
+    ]);
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    let summary: Value = serde_json::from_str(&run.stdout).unwrap();
+    assert_eq!(summary["robot"], "nao");
+    // 0.2 m forward and 0.05 m right from the midpoint between the feet.
+    assert!((summary["travel_m"].as_f64().unwrap() - 0.2f64.hypot(0.05)).abs() < 1e-9);
+    assert!(summary["steps"].as_u64().unwrap() >= 5);
+    assert!(summary["zmp_margin_min_m"].as_f64().unwrap() >= 0.005);
+    let joints = std::fs::read_to_string(out.join("joints.csv")).unwrap();
+    let mut lines = joints.lines();
+    let header = lines.next().unwrap();
+    assert!(header.starts_with("time,HeadYaw"), "{header}");
+    let rows: Vec<&str> = lines.collect();
+    let last_time: f64 = rows
+        .last()
+        .unwrap()
+        .split(',')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    let walk_time = summary["walk_time_s"].as_f64().unwrap();
+    assert!(
+        (last_time - walk_time - 0.5).abs() < 0.011,
+        "the hold follows the walk"
+    );
+    assert_eq!(
+        rows.len(),
+        (last_time / 0.01).round() as usize + 1,
+        "100 Hz from 0"
+    );
+    let plan = std::fs::read_to_string(out.join("plan.csv")).unwrap();
+    assert!(plan.starts_with("time,com_x,com_y,zmp_x,zmp_y,left_z,right_z\n"));
+    assert!(
+        std::fs::read_to_string(out.join("walk.json"))
+            .unwrap()
+            .contains("mean_speed_m_s")
+    );
+    let help = taskstack(&["walk", "--help"]);
+    for needle in [
+        "--forward",
+        "--left",
+        "--turn",
+        "--hold",
+        "joints.csv",
+        "walk.json",
+        "(m",
+        "rad",
+    ] {
+        assert!(
+            help.stdout.contains(needle),
+            "walk --help mentions {needle}"
+        );
+    }
+    fails(&["walk", "--forward", "nan"], 1, &["finite"]);
+    fails(&["walk", "--robot", "nope"], 1, &["--robot nope"]);
+    std::fs::remove_dir_all(&out).unwrap();
 }

@@ -8,6 +8,30 @@
 //! [`BipedProfile`](crate::robots::BipedProfile). [`walker::WholeBodyWalker`] turns the states
 //! into joint angles with the task-stack solver.
 //!
+//! ```
+//! use taskstack::locomotion::{GroundPose, WalkParams, WholeBodyWalker, goal_feet, plan_steps};
+//! use taskstack::robots::nao;
+//!
+//! let profile = nao::profile();
+//! let params = WalkParams::for_profile(&profile)?; // derived from the NAO's size
+//! let timing = params.timing;
+//! // The right sole at the world origin, facing x.
+//! let mut walker = WholeBodyWalker::new(&profile, params, GroundPose::new(0.0, 0.0, 0.0))?;
+//! let start = *walker.generator().standing_feet();
+//! let goal = goal_feet(&start, &GroundPose::new(0.1, 0.0, 0.0)); // 10 cm forward
+//! for step in plan_steps(&start, &goal, &profile.step_envelope, timing, 20) {
+//!     walker.push(step)?;
+//! }
+//! while !walker.generator().is_stopped() {
+//!     let frame = walker.tick()?; // every 10 ms
+//!     assert!(frame.com_error < 1e-4); // m
+//!     let _q = walker.q(); // joint angles (rad) for a robot or `JointsWriter`
+//! }
+//! let end = walker.generator().standing_feet();
+//! assert!((end[0].xy - goal[0].xy).norm() < 1e-9);
+//! # Ok::<(), taskstack::Error>(())
+//! ```
+//!
 //! # The model
 //!
 //! The robot is a cart on a table (the linear inverted pendulum with its CoM at a constant
