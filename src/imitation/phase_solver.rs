@@ -3,7 +3,7 @@
 //! at each iteration: the table's rows, written with the ready-made rows of [`crate::tasks`]
 //! toward the frame's shaped references ([`FrameTargets`]), then the gradient tasks.
 
-use faer::{Mat, MatMut};
+use faer::MatMut;
 use nalgebra::{Rotation3, Vector2, Vector3};
 
 use super::error::ImitationError;
@@ -21,6 +21,7 @@ use crate::solver::{
 };
 use crate::tasks::{
     CapsuleDistanceTask, FramePoint, InequalityTask, com_rows, orientation_rows, point_rows,
+    upright_rows,
 };
 
 /// A task of a table, resolved against a model: frame, axes, where its rows are.
@@ -88,8 +89,6 @@ pub(super) struct PhaseSolver {
     driver: PositionDriver,
     other_ankle: FrameId,
     other_sole: FrameId,
-    /// 3 × nv scratch for the orientation rows of 2-row tasks.
-    orientation_rows: Mat<f64>,
 }
 
 /// The tracked axes of `axes` in row order, padded with z.
@@ -172,7 +171,6 @@ impl PhaseSolver {
             driver,
             other_ankle: model.frame_id(&other.ankle)?,
             other_sole: model.frame_id(&other.sole)?,
-            orientation_rows: Mat::zeros(3, model.nv()),
         })
     }
 
@@ -271,7 +269,6 @@ impl PhaseSolver {
             tasks: &self.tasks,
             constraints: &self.constraints,
             targets,
-            orientation_rows: &mut self.orientation_rows,
             gradients: &self.table.gradients,
             criteria,
         };
@@ -314,7 +311,6 @@ struct PhaseTasks<'a> {
     tasks: &'a [ResolvedTask],
     constraints: &'a [ResolvedConstraint],
     targets: FrameTargets<'a>,
-    orientation_rows: &'a mut Mat<f64>,
     gradients: &'a [Gradient],
     criteria: Criteria<'a>,
 }
@@ -451,29 +447,13 @@ impl PhaseTasks<'_> {
             Task::Orientation {
                 target: OrientationTarget::Upright { lean },
                 ..
-            } => self.upright_rows(point.frame, lean, jacobian, error)?,
+            } => {
+                // The vertical leaned by `lean` rad about x (toward +y for lean > 0).
+                let up = Vector3::new(0.0, lean.sin(), lean.cos());
+                upright_rows(self.model, self.data, point.frame, &up, jacobian, error)?
+            }
             Task::ComXY(_) => unreachable!("a CoM task has no point"),
         }
-        Ok(())
-    }
-
-    /// Two rows turning the frame's z axis onto the vertical leaned by `lean` rad about x (toward
-    /// +y for lean > 0): the horizontal rows of the angular-velocity Jacobian, and the horizontal
-    /// part of the rotation vector `z × up` (rad, small-angle).
-    fn upright_rows(
-        &mut self,
-        frame: FrameId,
-        lean: f64,
-        mut jacobian: MatMut<'_, f64>,
-        error: &mut [f64],
-    ) -> Result<(), ImitationError> {
-        let rows = self.orientation_rows.as_mut();
-        self.model.orientation_jacobian(self.data, frame, rows)?;
-        jacobian.copy_from(self.orientation_rows.as_ref().subrows(0, 2));
-        let up = Vector3::new(0.0, lean.sin(), lean.cos());
-        let rotation = &self.data.frame_placement(frame).rotation;
-        let tilt = (rotation * Vector3::z()).cross(&up);
-        error[..2].copy_from_slice(&[tilt.x, tilt.y]);
         Ok(())
     }
 

@@ -180,18 +180,30 @@ impl Model {
         &self,
         data: &ModelData,
         frame: FrameId,
+        out: MatMut<'_, f64>,
+    ) -> Result<(), ModelError> {
+        self.orientation_jacobian_rows(data, frame, 3, out)
+    }
+
+    /// The first `rows` (1, 2 or 3: x; x, y; x, y, z) rows of [`Model::orientation_jacobian`],
+    /// written into a `rows`×n view (the xy rows: how fast the frame tilts).
+    pub fn orientation_jacobian_rows(
+        &self,
+        data: &ModelData,
+        frame: FrameId,
+        rows: usize,
         mut out: MatMut<'_, f64>,
     ) -> Result<(), ModelError> {
         self.check_computed(data)?;
         self.check_frame(frame)?;
-        self.check_shape(&out, 3)?;
+        self.check_shape(&out, rows.min(3))?;
         out.fill(0.0);
         let link = self.frames[frame.0].link;
         for &i in &self.chain[self.chain_start[link]..self.chain_start[link + 1]] {
             let joint = &self.joints[i - 1];
             if joint.kind == JointKind::Revolute {
                 let (k, column) = self.driven(i, data.axes[i]);
-                for r in 0..3 {
+                for r in 0..rows.min(3) {
                     out[(r, k)] += column[r];
                 }
             }

@@ -1,7 +1,8 @@
 //! Ready-made tasks for the solver, built from a [`Model`] by frame name: a frame's position
 //! ([`PositionTask`]), orientation ([`OrientationTask`]) or both ([`PoseTask`]), the centre of
 //! mass ([`ComTask`]), a joint posture ([`PostureTask`]) and a contact normal
-//! ([`ContactNormalTask`], Di Fava et al. eq. 11); inequality tasks ([`InequalityTask`]): the
+//! ([`ContactNormalTask`], Di Fava et al. eq. 11), a frame's z axis along a direction
+//! ([`UprightTask`], its heading free); inequality tasks ([`InequalityTask`]): the
 //! CoM inside a support polygon ([`ComPolygonTask`]), capsule–capsule and capsule–plane
 //! distances above a margin ([`CapsuleDistanceTask`], [`PlaneDistanceTask`]); and [`TaskSet`],
 //! which stacks them in priority levels and drives the solver with them
@@ -45,6 +46,7 @@ mod pose;
 mod position;
 mod posture;
 mod set;
+mod upright;
 
 use std::any::Any;
 use std::fmt::Debug;
@@ -66,6 +68,7 @@ pub use pose::PoseTask;
 pub use position::{FramePoint, PositionTask, point_rows};
 pub use posture::PostureTask;
 pub use set::TaskSet;
+pub use upright::{UprightTask, upright_rows};
 
 /// Errors of building or evaluating tasks.
 #[derive(Debug, Clone, PartialEq, Error)]
