@@ -3,9 +3,9 @@
 //!
 //! Each tick the model is rooted at the stance sole (at the sole that last stood alone while both
 //! stand), placed where the generator put it in the world, and the driver solves, in priority
-//! order: the other sole's pose (held on the floor, or on its swing path), the CoM (x, y and the
-//! walking height), the torso upright with the feet's mean heading; the standing posture pulls
-//! the remaining freedom (the arms, the waist). A sole on the floor is the model's root or a
+//! order: the other sole's pose (held on the floor, or on its swing path), the CoM's ground
+//! point, the torso's tilt (upright, leaning over the stance hip), the CoM's height; the
+//! standing posture pulls the remaining freedom (the arms, the waist, the torso's heading). A sole on the floor is the model's root or a
 //! top-level task, so it does not move in the plan.
 
 use nalgebra::{IsometryMatrix3, Rotation3, Translation3, Vector2, Vector3};
@@ -21,7 +21,7 @@ use crate::human::Side;
 use crate::robots::BipedProfile;
 use crate::solver::driver::{DriverSettings, PositionDriver};
 use crate::solver::{JointBounds, Solver};
-use crate::tasks::{ComTask, OrientationTask, PoseTask, TaskSet};
+use crate::tasks::{ComTask, PoseTask, TaskSet, UprightTask};
 
 /// Gain of the pull toward the standing posture (per driver iteration).
 const POSTURE_GAIN: f64 = 0.05;
@@ -156,11 +156,13 @@ impl<'p> WholeBodyWalker<'p> {
         let other_name = &self.profile.foot(root.other()).sole;
         stack.set.task_mut::<PoseTask>(other_name)?.target = local_pose(&root_pose, &other);
         let com_local = root_pose.to_local(walk.com.xy());
-        stack.set.task_mut::<ComTask>("com")?.target =
-            Vector3::new(com_local.x, com_local.y, com_height);
-        stack.set.task_mut::<OrientationTask>("torso")?.target =
-            Rotation3::from_axis_angle(&Vector3::z_axis(), heading - root_pose.yaw)
-                * Rotation3::from_axis_angle(&Vector3::x_axis(), -lean);
+        let com_target = Vector3::new(com_local.x, com_local.y, com_height);
+        stack.set.task_mut::<ComTask>("com")?.target = com_target;
+        stack.set.task_mut::<ComTask>("com height")?.target = com_target;
+        let (sin, cos) = lean.sin_cos();
+        let up = Rotation3::from_axis_angle(&Vector3::z_axis(), heading - root_pose.yaw)
+            * Vector3::new(0.0, sin, cos);
+        stack.set.task_mut::<UprightTask>("torso")?.set_up(up)?;
         let report =
             stack
                 .driver
@@ -209,12 +211,14 @@ fn rooted_stack(profile: &BipedProfile, root: Side) -> Result<RootedStack<'_>, E
         &profile.foot(root.other()).sole,
         IsometryMatrix3::identity(),
     )?;
-    let com = ComTask::new(model, Vector3::zeros())?;
-    let torso = OrientationTask::new(model, &profile.torso, Rotation3::identity())?.named("torso");
+    let com = ComTask::ground(model, [0.0, 0.0])?;
+    let height = ComTask::new(model, Vector3::zeros())?.named("com height");
+    let torso = UprightTask::new(model, &profile.torso)?.named("torso");
     let set = TaskSet::new(model)
         .level("foot", vec![Box::new(other)])
         .level("com", vec![Box::new(com)])
         .level("torso", vec![Box::new(torso)])
+        .level("com height", vec![Box::new(height)])
         .posture_gradient(POSTURE_GAIN, &profile.stand)?;
     let solver = Solver::new(&set.shape())?;
     let settings = DriverSettings {

@@ -10,9 +10,10 @@ use crate::model::{Model, ModelData, ModelError};
 
 /// The whole-body centre of mass at a target in the base frame (m): its ground projection (x, y;
 /// [`ComTask::ground`], the balance task of a robot rooted at a sole) or all of x, y, z
-/// ([`ComTask::new`]). Named `"com"`.
+/// ([`ComTask::new`]). Named `"com"` unless [`ComTask::named`] says otherwise.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ComTask {
+    name: String,
     rows: usize,
     /// Target (m, base frame); z is read only by a three-row task.
     pub target: Vector3<f64>,
@@ -40,7 +41,19 @@ impl ComTask {
         if model.total_mass() <= 0.0 {
             return Err(ModelError::NoMass.into());
         }
-        Ok(Self { rows, target })
+        Ok(Self {
+            name: "com".to_owned(),
+            rows,
+            target,
+        })
+    }
+}
+
+impl ComTask {
+    /// Another name in the stack (default `"com"`): a second CoM task at another level.
+    pub fn named(mut self, name: &str) -> Self {
+        self.name = name.to_owned();
+        self
     }
 }
 
@@ -68,7 +81,7 @@ pub fn com_rows(
 
 impl Task for ComTask {
     fn name(&self) -> &str {
-        "com"
+        &self.name
     }
 
     fn rows(&self) -> usize {
