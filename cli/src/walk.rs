@@ -42,6 +42,10 @@ pub(crate) struct WalkArgs {
     /// Turn (rad, positive to the left).
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     turn: f64,
+    /// Longest forward step (m, sole to sole); default: the robot profile's step envelope
+    /// (NAO 0.05, G1 0.15).
+    #[arg(long, value_parser = crate::options::positive)]
+    step_length: Option<f64>,
     /// Seconds to stand still after the robot has stopped.
     #[arg(long, default_value_t = 1.0, value_parser = non_negative)]
     hold: f64,
@@ -63,7 +67,12 @@ pub(crate) fn run(args: WalkArgs, report: Report) -> Result<ExitCode> {
     let mut walker = WholeBodyWalker::new(&profile, params, GroundPose::new(0.0, 0.0, 0.0))?;
     let start = *walker.generator().standing_feet();
     let goal = goal_feet(&start, &GroundPose::new(args.forward, args.left, args.turn));
-    let steps = plan_steps(&start, &goal, &profile.step_envelope, timing, MAX_STEPS);
+    let mut envelope = profile.step_envelope;
+    if let Some(length) = args.step_length {
+        envelope.x_max = length;
+        envelope.x_min = envelope.x_min.min(length);
+    }
+    let steps = plan_steps(&start, &goal, &envelope, timing, MAX_STEPS);
     for step in &steps {
         walker.push(*step)?;
     }
