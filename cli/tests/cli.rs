@@ -577,6 +577,7 @@ fn walk_writes_a_joint_trajectory_the_plan_and_a_summary() {
         "--left",
         "--turn",
         "--hold",
+        "--step-length",
         "joints.csv",
         "walk.json",
         "(m",
