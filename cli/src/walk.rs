@@ -25,8 +25,8 @@ const MAX_STEPS: usize = 200;
 /// The goal is the midpoint between the soles moved by --forward and --left (m) and turned by
 /// --turn (rad), in the robot's starting frame (x forward, y left). Writes OUT/joints.csv (time
 /// in s, joint angles in rad, 100 Hz; the format of `imitate`, playable by the physics check)
-/// and OUT/walk.json (steps, duration, speed, the smallest ZMP margin of the plan, the solver's
-/// largest foot and CoM errors).
+/// and OUT/walk.json (steps, duration, speed, the smallest margins of the plan's ZMP and CoM
+/// inside the support polygon, the solver's largest foot and CoM errors).
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]
 pub(crate) struct WalkArgs {
@@ -82,7 +82,8 @@ pub(crate) fn run(args: WalkArgs, report: Report) -> Result<ExitCode> {
     let names = profile.model(Side::Right).variables().iter();
     joints.header_names(names.map(|v| v.name.as_str()))?;
     joints.row(0.0, walker.q())?;
-    let (mut zmp_margin, mut foot_error, mut com_error) = (f64::INFINITY, 0.0_f64, 0.0_f64);
+    let (mut zmp_margin, mut com_margin) = (f64::INFINITY, f64::INFINITY);
+    let (mut foot_error, mut com_error) = (0.0_f64, 0.0_f64);
     let mut stopped_at = None;
     let mut plan = String::from("time,com_x,com_y,zmp_x,zmp_y,left_z,right_z\n");
     loop {
@@ -99,6 +100,7 @@ pub(crate) fn run(args: WalkArgs, report: Report) -> Result<ExitCode> {
             w.feet[1].position[2]
         ));
         zmp_margin = zmp_margin.min(polygon.margin(&frame.walk, frame.walk.zmp));
+        com_margin = com_margin.min(polygon.margin(&frame.walk, frame.walk.com.xy()));
         foot_error = foot_error.max(frame.foot_error);
         com_error = com_error.max(frame.com_error);
         joints.row(frame.walk.time, walker.q())?;
@@ -123,6 +125,7 @@ pub(crate) fn run(args: WalkArgs, report: Report) -> Result<ExitCode> {
         "mean_speed_m_s": (end_mid - start_mid).norm() / walk_time.max(f64::MIN_POSITIVE),
         "heading_rad": taskstack::locomotion::footstep::wrap_angle(end[1].yaw - start[1].yaw),
         "zmp_margin_min_m": zmp_margin,
+        "com_margin_min_m": com_margin,
         "foot_error_max": foot_error,
         "com_error_max_m": com_error,
         "com_height_m": walker.params().settings.com_height,
