@@ -100,10 +100,10 @@ pub struct BatchOptions {
     /// Imitator settings shared by every clip, except `support`, which each clip replaces by the
     /// defaults of its kind of source ([`SupportConfig::for_capture`] of [`Clip::capture`]: optical mocap or Kinect).
     pub imitator: ImitatorConfig,
-    /// After each clip, the human's last pose is held this long (s, frames 1/120 s apart) so
-    /// that the robot can finish the step it is taking; those frames are in the outputs too.
-    /// Default 0.
-    pub hold: f64,
+    /// After each clip, the human's last pose is held (frames 1/120 s apart) so that the robot
+    /// can finish the step it is taking; those frames are in the outputs too. Default: until
+    /// the robot has finished ([`Hold::UntilFinished`]).
+    pub hold: Hold,
 }
 
 impl Default for BatchOptions {
@@ -112,7 +112,7 @@ impl Default for BatchOptions {
             robot: nao::profile(),
             threads: 0,
             imitator: ImitatorConfig::default(),
-            hold: 0.0,
+            hold: Hold::UntilFinished,
         }
     }
 }
@@ -295,6 +295,51 @@ where
 /// Time step of the held frames after a clip (s).
 pub const HOLD_STEP: f64 = 1.0 / 120.0;
 
+/// The longest hold of [`Hold::UntilFinished`] (s).
+pub const HOLD_CAP: f64 = 60.0;
+
+/// How long [`Hold::UntilFinished`] waits with the robot finished before it ends the run (s):
+/// the CoM's last motion toward its goal settles.
+pub const SETTLE_TIME: f64 = 1.0;
+
+/// How long the human's last pose is held after a clip.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Hold {
+    /// This long (s, ≥ 0).
+    Fixed(f64),
+    /// Until the robot has finished ([`RobotFrame::has_finished`]) for [`SETTLE_TIME`], at
+    /// most [`HOLD_CAP`]: a robot still stepping toward where the human stands, or still on
+    /// one leg, is not cut off.
+    UntilFinished,
+}
+
+impl From<f64> for Hold {
+    fn from(seconds: f64) -> Self {
+        Hold::Fixed(seconds)
+    }
+}
+
+impl Hold {
+    /// Whether the hold is over after `held` frames, the robot finished for the last
+    /// `finished` of them.
+    fn is_over(self, held: u64, finished: u64) -> bool {
+        match self {
+            Hold::Fixed(seconds) => held > hold_frames(seconds),
+            Hold::UntilFinished => {
+                held > hold_frames(HOLD_CAP) || finished > hold_frames(SETTLE_TIME)
+            }
+        }
+    }
+
+    /// The most frames the hold can take.
+    pub fn max_frames(self) -> u64 {
+        hold_frames(match self {
+            Hold::Fixed(seconds) => seconds,
+            Hold::UntilFinished => HOLD_CAP,
+        })
+    }
+}
+
 /// Frames of a hold of `hold` seconds ([`HOLD_STEP`] apart): counted, not accumulated in
 /// floating point, so 0.5 s is 60 frames.
 pub fn hold_frames(hold: f64) -> u64 {
@@ -302,8 +347,8 @@ pub fn hold_frames(hold: f64) -> u64 {
 }
 
 /// Imitates every frame of `source` (read from `path`, named in errors) with `imitator`, then
-/// holds the human's last pose for `hold` seconds (frames 1/120 s apart) so that the robot
-/// can finish the step it is taking. A frame the imitator asks for again
+/// holds the human's last pose ([`Hold`]: a number of seconds, or until the robot has
+/// finished; frames 1/120 s apart) so that the robot can finish the step it is taking. A frame the imitator asks for again
 /// ([`RobotFrame::awaiting_contact`]: a hand being placed before its contact) is fed again, so
 /// the human's clock pauses while the robot's runs on. Calls `each` with every robot frame, in
 /// order; returns the
@@ -318,14 +363,14 @@ pub fn imitate_clip(
     path: &Path,
     mut source: Clip,
     imitator: &mut Imitator,
-    hold: f64,
+    hold: impl Into<Hold>,
     mut each: impl FnMut(&RobotFrame),
 ) -> Result<ImitationMetrics, BatchError> {
+    let hold = hold.into();
     let mut recorder = MetricsRecorder::new(imitator);
     let mut frame = HumanFrame::new(0.0);
     let mut last: Option<HumanFrame> = None;
-    let hold_frames = hold_frames(hold);
-    let mut held_frames = 0;
+    let (mut held_frames, mut finished_frames) = (0, 0);
     let mut clip_end = None;
     let mut again = false;
     let mut index = 0;
@@ -350,7 +395,7 @@ pub fn imitate_clip(
                 held.time
             });
             held_frames += 1;
-            if held_frames > hold_frames {
+            if hold.is_over(held_frames, finished_frames) {
                 break;
             }
             held.time = end + held_frames as f64 * HOLD_STEP;
@@ -364,6 +409,11 @@ pub fn imitate_clip(
                 source,
             })?;
         again = robot.awaiting_contact;
+        finished_frames = if robot.has_finished() && clip_end.is_some() {
+            finished_frames + 1
+        } else {
+            0
+        };
         recorder.record(robot);
         each(robot);
     }
@@ -532,6 +582,8 @@ pub fn metrics_value(m: &ImitationMetrics, clip: &Path) -> Value {
         "clip_frames": m.clip_frames,
         "clip_duration_s": m.clip_duration,
         "human_clock_pause_s": m.human_clock_pause,
+        "hold_s": m.duration - m.clip_duration,
+        "finished": m.finished,
         "human_support_changes": m.human_support_changes,
         "robot_support_changes": m.robot_support_changes,
         "robot_support_sequence": m.robot_support_sequence,

@@ -9,6 +9,7 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
+use taskstack::batch::{HOLD_CAP, Hold};
 use taskstack::human::HumanFrame;
 use taskstack::imitation::contact_events::ContactConfig;
 use taskstack::imitation::hand_support::{HandContactPlan, HandSupportConfig};
@@ -169,6 +170,17 @@ fn print_summary(
         hold_frames,
         m.duration - m.clip_duration
     );
+    if !m.finished {
+        let why = match settings.hold {
+            Hold::UntilFinished => format!("the {HOLD_CAP} s cap of --hold auto"),
+            Hold::Fixed(_) => "a longer --hold, or --hold auto, lets it finish".to_owned(),
+        };
+        let _ = writeln!(
+            text,
+            "the robot had not finished when the run ended: {} ({why})",
+            unfinished(m)
+        );
+    }
     if m.human_clock_pause > 0.0 {
         let _ = writeln!(
             text,
@@ -243,6 +255,14 @@ fn print_summary(
 
 /// The tracking table: per effector, mean and maximum distance to the scaled human (cm) in
 /// single and double support, over the clip's frames whose phase tracks it.
+/// What the robot was still doing at the end of a run.
+fn unfinished(m: &ImitationMetrics) -> String {
+    match m.queued_steps_at_end {
+        0 => "a support change under way".to_owned(),
+        n => format!("{n} step(s) still to take"),
+    }
+}
+
 fn print_tracking(text: &mut String, m: &ImitationMetrics) {
     let _ = writeln!(
         text,

@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use clap::Args;
 use taskstack::ImitatorConfig;
+use taskstack::batch::Hold;
 use taskstack::imitation::config::ImitationMethod;
 use taskstack::imitation::koenemann::{Calibration, FootRetargeting, KoenemannConfig};
 use taskstack::io::clip::Clip;
@@ -25,11 +26,14 @@ pub(crate) struct ImitationOptions {
     /// foot back where it was.
     #[arg(long)]
     pub(crate) walk: bool,
-    /// After the clip, hold the human's last pose this long (s, frames 1/120 s apart) so the
-    /// robot can finish the step it is taking; those frames are in every output. At most 3600.
-    #[arg(long, value_name = "SECONDS", default_value_t = 5.0, value_parser = hold,
+    /// After the clip, hold the human's last pose (frames 1/120 s apart) so the robot can
+    /// finish the step it is taking; those frames are in every output. `auto`: until the robot
+    /// has finished (a continuous phase, no step pending, on the feet the human stands on) for
+    /// 1 s, at most 60 s (the summary and metrics.json's `finished` say when the cap cut it
+    /// short); or SECONDS (at most 3600).
+    #[arg(long, value_name = "auto|SECONDS", default_value = "auto", value_parser = hold,
           allow_negative_numbers = true)]
-    pub(crate) hold: f64,
+    pub(crate) hold: Hold,
     /// Share of each joint's rated velocity the legs may use (0 < F ≤ 1; Poubel et al. use 0.1).
     #[arg(long, value_name = "F", default_value_t = 0.1, value_parser = fraction,
           allow_negative_numbers = true)]
@@ -206,10 +210,13 @@ fn fraction(text: &str) -> Result<f64, String> {
     }
 }
 
-fn hold(text: &str) -> Result<f64, String> {
+fn hold(text: &str) -> Result<Hold, String> {
+    if text == "auto" {
+        return Ok(Hold::UntilFinished);
+    }
     let value = number(text)?;
     if (0.0..=MAX_HOLD).contains(&value) {
-        Ok(value)
+        Ok(Hold::Fixed(value))
     } else {
         Err(format!("{value} s is not within 0–{MAX_HOLD} s"))
     }

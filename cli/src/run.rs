@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use serde_json::json;
-use taskstack::batch::{JointsWriter, hold_frames, imitate_clip, metrics_json};
+use taskstack::batch::{Hold, JointsWriter, imitate_clip, metrics_json};
 use taskstack::imitation::metrics::ImitationMetrics;
 use taskstack::imitation::support::SupportConfig;
 use taskstack::io::skeleton_map::SkeletonMap;
@@ -34,7 +34,7 @@ pub(crate) const OUTPUT_FILES: [&str; 7] = [
 pub(crate) struct Settings {
     pub(crate) profile: BipedProfile,
     pub(crate) config: ImitatorConfig,
-    pub(crate) hold: f64,
+    pub(crate) hold: Hold,
     pub(crate) map: Option<SkeletonMap>,
 }
 
@@ -55,7 +55,7 @@ pub(crate) fn imitate_into(
     progress: &mut dyn FnMut(Progress),
 ) -> Result<ImitationMetrics> {
     let source = open_clip(clip, settings.map.as_ref())?;
-    let hold_frames = hold_frames(settings.hold);
+    let hold_frames = settings.hold.max_frames();
     progress(Progress::Start(
         source.declared_frames().map(|n| n + hold_frames),
     ));

@@ -29,7 +29,7 @@ fn every_subcommand_explains_its_options_and_outputs() {
         "phases.svg",
         "joints.svg",
         "--hold",
-        "[default: 5]",
+        "[default: auto]",
         "--velocity-fraction",
         "m/s",
         "--robot",

@@ -267,6 +267,10 @@ pub struct ImitationMetrics {
     pub catch_up_s: Option<f64>,
     /// How close the paired bodies came; `None` when the profile has no self-collision pairs.
     pub self_clearance: Option<SelfClearance>,
+    /// Whether the robot had finished at the last frame ([`RobotFrame::has_finished`]): in a
+    /// continuous phase, no step pending, on the human's feet. False after a hold that ended
+    /// before the robot did (a fixed one too short, or the cap of an automatic one).
+    pub finished: bool,
 }
 
 /// Accumulates [`ImitationMetrics`] frame by frame.
@@ -286,6 +290,7 @@ pub struct MetricsRecorder {
     last_time: f64,
     /// The last frame's robot clock minus its human clock (s).
     clock_pause: f64,
+    finished: bool,
     last_q: Vec<f64>,
     last_human: Option<HumanSupport>,
     human_changes: usize,
@@ -408,6 +413,7 @@ impl MetricsRecorder {
             first_time: None,
             last_time: 0.0,
             clock_pause: 0.0,
+            finished: true,
             last_q: Vec::new(),
             last_human: None,
             human_changes: 0,
@@ -486,6 +492,7 @@ impl MetricsRecorder {
         self.first_time.get_or_insert(frame.time);
         self.last_time = frame.time;
         self.clock_pause = frame.time - frame.human_time;
+        self.finished = frame.has_finished();
         self.last_q.clear();
         self.last_q.extend_from_slice(&frame.q);
         self.times.record(frame.micros);
@@ -668,6 +675,7 @@ impl MetricsRecorder {
             },
             hand_lag_s,
             human_clock_pause: self.clock_pause,
+            finished: self.finished,
             lift_lag: Spread::of(&mut lift_lag),
             landing_lag: Spread::of(&mut landing_lag),
             human_lifts,

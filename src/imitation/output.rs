@@ -93,6 +93,19 @@ pub struct RobotFrame {
 }
 
 impl RobotFrame {
+    /// Whether the robot has done what the human asks of its feet: it is in a continuous phase
+    /// (DS, RS or LS, not a transition step), no step is pending, and it stands on the feet the
+    /// human stands on (any, while the human is airborne).
+    pub fn has_finished(&self) -> bool {
+        let same_support = match self.human_support {
+            HumanSupport::Double => self.phase == SupportPhase::Double,
+            HumanSupport::Right => self.phase == SupportPhase::Right,
+            HumanSupport::Left => self.phase == SupportPhase::Left,
+            HumanSupport::Airborne => true,
+        };
+        !self.phase.is_transition() && self.pending_steps == 0 && same_support
+    }
+
     /// The frame before the first step: posture `q` with the right sole at the world origin
     /// and the left sole at `left_sole`; room for `[tasks, levels]` task errors and level
     /// reports (the largest table's), so that stepping never allocates.
