@@ -204,9 +204,12 @@ fn check_walk(states: &[WalkState]) {
             "tick {k} (t = {:.3} s): ZMP {m:.4} m inside the support",
             states[k].time
         );
+        // The central difference is the model's c̈ plus T·Δu/6 where the jerk u jumps.
         assert!(
             (states[k].zmp - zmp).norm() < 1e-3,
-            "the reported ZMP is the CoM's"
+            "the reported ZMP is the CoM's: {} m off at t = {:.3} s",
+            (states[k].zmp - zmp).norm(),
+            states[k].time
         );
         for side in Side::BOTH {
             let on_floor = |s: &WalkState| !matches!(s.support, Support::Single { swing, .. } if swing == side);
@@ -431,4 +434,31 @@ fn bad_input_is_refused_with_a_typed_error() {
         ),
         Err(LocomotionError::InvalidParameter { name: "r", .. })
     ));
+}
+
+#[test]
+fn cancelled_steps_are_not_taken_and_the_walk_stops_safely() {
+    let mut g = generator();
+    for i in 1..=6 {
+        let side = if i % 2 == 1 { Side::Left } else { Side::Right };
+        let y = if side == Side::Left { 0.05 } else { -0.05 };
+        g.push(step(side, 0.05 * i as f64, y, 0.0)).unwrap();
+    }
+    // The first step (from rest: 0.5 s double support) lands at 0.85 s, the second swings from
+    // 1.0 to 1.35 s. Cancelled at 1.2 s: the second step finishes, the third (toward whose
+    // stance the CoM is already heading) is kept, the other three are dropped, and the robot
+    // stops where the third step put its feet.
+    let mut cancelled = 0;
+    let states = run_to_rest(&mut g, |g| {
+        if cancelled == 0 && g.state().time >= 1.2 {
+            cancelled = g.cancel_pending();
+        }
+    });
+    assert_eq!(cancelled, 3);
+    let last = states.last().unwrap();
+    assert!(
+        (last.feet[0].position[0] - 0.15).abs() < 1e-12
+            && (last.feet[1].position[0] - 0.10).abs() < 1e-12
+    );
+    assert_eq!(g.planned_feet(), g.standing_feet());
 }

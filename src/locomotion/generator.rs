@@ -174,6 +174,13 @@ impl PatternGenerator {
         Ok(self.schedule.push(step, self.state.time)?.land)
     }
 
+    /// Drops the queued steps that have not begun, but the one after a step under way (the
+    /// CoM is already on its way to that stance): the walk then stops in double support.
+    /// Returns how many were dropped.
+    pub fn cancel_pending(&mut self) -> usize {
+        self.schedule.cancel_pending(self.state.time)
+    }
+
     /// Steps queued and not yet landed.
     pub fn queued(&self) -> usize {
         self.schedule.steps().len()

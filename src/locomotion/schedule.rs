@@ -181,6 +181,22 @@ impl Schedule {
         Ok(timed)
     }
 
+    /// Drops the queued steps whose double support has not begun by `now` (s), but the one
+    /// after a step under way: a robot moving toward its next stance needs it to stop inside
+    /// its support. Returns how many were dropped.
+    pub(super) fn cancel_pending(&mut self, now: f64) -> usize {
+        let before = self.steps.len();
+        let begun = self.steps.iter().take_while(|s| s.start <= now).count();
+        let under_way = begun > 0 && self.steps[begun - 1].land > now;
+        self.steps
+            .truncate((begun + usize::from(under_way)).min(before));
+        self.planned = self.feet;
+        for step in &self.steps {
+            self.planned[step.step.side.index()] = step.step.target;
+        }
+        before - self.steps.len()
+    }
+
     /// Drops the steps that landed before `now` (s), moving their feet.
     pub(super) fn retire(&mut self, now: f64) {
         while let Some(first) = self.steps.front().copied() {
