@@ -41,8 +41,9 @@ fn com_in_world(profile: &BipedProfile, q: &[f64], root: Side, root_pose: &Groun
     [xy.x, xy.y, c.z]
 }
 
-/// Walks `motion` (forward, left m; turn rad) and checks every tick.
-fn walk_and_check(profile: &BipedProfile, motion: GroundPose) -> usize {
+/// Walks `motion` (forward, left m; turn rad), checks every tick and returns the realised CoM's
+/// smallest margin inside the support polygon (m).
+fn walk_and_check(profile: &BipedProfile, motion: GroundPose) -> f64 {
     let params = WalkParams::for_profile(profile).unwrap();
     let (dt, height) = (params.settings.dt, params.settings.com_height);
     let mut walker =
@@ -111,6 +112,7 @@ fn walk_and_check(profile: &BipedProfile, motion: GroundPose) -> usize {
     }
     // The ZMP of the realised CoM (its second difference), at the walking height, inside the
     // support by 5 mm at every tick once the CoM has come down to it.
+    let mut com_margin = f64::INFINITY;
     for k in 1..coms.len() - 1 {
         let c = |i: usize| Vector2::new(coms[i][0], coms[i][1]);
         let zmp = c(k) - (c(k + 1) - 2.0 * c(k) + c(k - 1)) * (height / 9.81 / (dt * dt));
@@ -120,19 +122,21 @@ fn walk_and_check(profile: &BipedProfile, motion: GroundPose) -> usize {
             "ZMP {margin} m inside at t = {}",
             states[k].time
         );
+        com_margin = com_margin.min(polygon.margin(&states[k], c(k)));
     }
     // Arrived: both soles on their goals.
     let end = walker.generator().standing_feet();
     for side in Side::BOTH {
         assert!((end[side.index()].xy - goal[side.index()].xy).norm() < 1e-9);
     }
-    steps.len()
+    assert!(steps.len() >= 2);
+    com_margin
 }
 
 #[test]
 fn the_nao_walks_forward_sideways_and_turns() {
     let profile = nao::profile();
-    assert!(walk_and_check(&profile, GroundPose::new(0.3, 0.0, 0.0)) >= 6);
+    walk_and_check(&profile, GroundPose::new(0.3, 0.0, 0.0));
     walk_and_check(&profile, GroundPose::new(0.0, -0.12, 0.0));
     walk_and_check(&profile, GroundPose::new(0.0, 0.0, 0.5));
 }
@@ -148,19 +152,31 @@ fn derived_settings_follow_the_robots_size() {
         WalkParams::for_profile(&nao::profile()).unwrap(),
         WalkParams::for_profile(&g1::profile()).unwrap(),
     );
-    // Step time: 6 pendulum time constants √(z_c/g), z_c the standing CoM height.
-    for p in [&nao, &g1] {
+    // Sole widths from the outlines: NAO FSR rectangle 53 mm, G1 contact spheres 50 mm.
+    for (p, profile, sole_width) in [(&nao, nao::profile(), 0.053), (&g1, g1::profile(), 0.05)] {
+        // Single support 3 pendulum time constants √(z_c/g), z_c the standing CoM height;
+        // double support 3 or more, in halves.
         let tau = (p.settings.com_height / 9.81).sqrt();
-        assert!((p.timing.duration() - 6.0 * tau).abs() < 1e-12);
         assert_eq!(p.settings.com_height, p.standing_com_height);
+        assert!((p.timing.single_support - 3.0 * tau).abs() < 1e-12);
+        let halves = p.timing.double_support / tau * 2.0;
+        assert!(halves >= 6.0 - 1e-9 && (halves - halves.round()).abs() < 1e-9);
+        // A straight walk of the envelope's longest steps keeps the planned CoM inside the
+        // support by 15 % of the sole width, checked here through FK.
+        let asked = 0.15 * sole_width;
+        let margin = walk_and_check(&profile, GroundPose::new(0.3, 0.0, 0.0));
+        assert!(
+            margin >= asked - 2e-4,
+            "CoM {margin} m inside, asked {asked}"
+        );
     }
     assert!(
-        nao.timing.duration() > 0.9 && nao.timing.duration() < 1.1,
-        "NAO steps about 1 s"
+        (nao.timing.duration() - 1.0).abs() < 0.01,
+        "NAO steps of 1 s: 3 + 3 time constants"
     );
     assert!(
-        g1.timing.duration() > nao.timing.duration() * 1.4,
-        "the taller robot steps more slowly"
+        g1.timing.double_support > 1.5 * g1.timing.single_support,
+        "the G1's wide stance"
     );
     assert!(g1.settings.swing.height > 2.0 * nao.settings.swing.height);
     // The NAO's hips are 0.1 m apart (HipOffsetY 0.05): lean atan(0.05 / z_c).

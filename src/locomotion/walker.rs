@@ -13,7 +13,7 @@ use nalgebra::{IsometryMatrix3, Rotation3, Translation3, Vector2, Vector3};
 use super::LocomotionError;
 use super::footstep::{Footstep, GroundPose};
 use super::generator::{PatternGenerator, WalkState};
-use super::params::WalkParams;
+use super::params::{WalkParams, standing_feet};
 use super::schedule::Support;
 use super::swing::SolePose;
 use crate::Error;
@@ -74,28 +74,16 @@ impl<'p> WholeBodyWalker<'p> {
         params: WalkParams,
         right: GroundPose,
     ) -> Result<Self, Error> {
-        let model = profile.model(Side::Right);
-        let mut data = model.new_data();
-        model.forward_kinematics(&mut data, &profile.stand)?;
-        let left_sole = data.frame_placement(model.frame_id(&profile.foot(Side::Left).sole)?);
-        let left_local = GroundPose::new(
-            left_sole.translation.x,
-            left_sole.translation.y,
-            left_sole.rotation.matrix()[(1, 0)].atan2(left_sole.rotation.matrix()[(0, 0)]),
-        );
-        let com = model.com(&data)?;
-        let feet = [right.compose(&left_local), right];
-        let com_xy = right.to_world([com.x, com.y]);
+        let (feet, com_xy) = standing_feet(profile, &right)?;
         let generator =
             PatternGenerator::new(params.settings, params.centres.clone(), feet, com_xy)?;
         let stacks = [
             rooted_stack(profile, Side::Left)?,
             rooted_stack(profile, Side::Right)?,
         ];
-        let bounds = crate::tasks::joint_bounds(model)?;
+        let bounds = crate::tasks::joint_bounds(profile.model(Side::Right))?;
         let state = *generator.state();
         let half_span = (feet[0].xy - feet[1].xy).norm() / 2.0;
-
         Ok(Self {
             profile,
             params,
