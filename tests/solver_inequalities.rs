@@ -329,6 +329,38 @@ fn qp(
     matches!(solver.solution.status, SolverStatus::Solved).then(|| solver.solution.x.clone())
 }
 
+/// Per level, the squared equality residual plus the squared inequality violation of `x` (the
+/// quantity each level of the lexicographic problem minimises).
+fn level_costs(problem: &Problem, x: &[f64]) -> Vec<f64> {
+    let dot = |row: &[f64]| row.iter().zip(x).map(|(a, b)| a * b).sum::<f64>();
+    (problem.levels.iter())
+        .map(|level| {
+            let equalities = level
+                .equalities
+                .iter()
+                .map(|(row, b)| (dot(row) - b).powi(2));
+            let violations = (level.inequalities.iter())
+                .map(|(row, lo, hi)| (lo - dot(row)).max(dot(row) - hi).max(0.0).powi(2));
+            equalities.chain(violations).sum()
+        })
+        .collect()
+}
+
+/// Whether `ours`, inside the joint intervals, is lexicographically better than `reference` by
+/// more than `tol` at the first level where their costs differ: the reference (an interior-point
+/// solver at 1e-10 tolerances, each level's optimum fixed as a constraint) then traded a higher
+/// level's exactness for a lower one's, and the difference of the solutions is the reference's
+/// inaccuracy (seed 4502148433111797730: level 1 violated by 4e-6 for a 4e-5 gain at level 2).
+fn lexicographically_better(problem: &Problem, ours: &[f64], reference: &[f64], tol: f64) -> bool {
+    let (a, b) = (level_costs(problem, ours), level_costs(problem, reference));
+    let inside = (ours.iter().enumerate())
+        .all(|(i, &v)| v >= problem.lo[i] - 1e-12 && v <= problem.hi[i] + 1e-12);
+    inside
+        && (a.iter().zip(&b))
+            .find(|(a, b)| (*a - *b).abs() > tol)
+            .is_some_and(|(a, b)| a < b)
+}
+
 fn norm(v: &[f64]) -> f64 {
     v.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
@@ -347,7 +379,8 @@ proptest! {
         let expected = expected.unwrap();
         let error = norm(&ours.iter().zip(&expected).map(|(a, b)| a - b).collect::<Vec<_>>());
         prop_assert!(
-            error <= 1e-5 * (1.0 + norm(&expected)),
+            error <= 1e-5 * (1.0 + norm(&expected))
+                || lexicographically_better(&problem, &ours, &expected, 1e-12),
             "ours {ours:?}\nreference {expected:?}\n{problem:?}\n{:?}", solver.report()
         );
     }
