@@ -78,7 +78,7 @@ pub(crate) fn imitate_into(
     let title = clip
         .file_stem()
         .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
-    let mut view = ViewWriter::new(view_file, &imitator, &title)?;
+    let mut view = ViewWriter::new(view_file, imitator.profile(), &title)?;
     let mut plots = PlotRecorder::new(&imitator);
     joints.header(&imitator)?;
 

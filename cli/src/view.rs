@@ -1,6 +1,6 @@
-//! `view.html`: a self-contained 3D viewer of an imitation run (the robot drawn from its model's
-//! links, the scaled human, the floor, the support polygon, the CoM ground projection, the
-//! phases), written while the clip is imitated; and the `view` command that opens it.
+//! `view.html`: a self-contained 3D viewer of an imitation run or a walk (the robot drawn from
+//! its model's links, the scaled human, the floor, the support polygon, the CoM ground
+//! projection, the phases), written as the frames come; and the `view` command that opens it.
 //!
 //! The file is the page template (`viewer.html`) with the run's data spliced in as compact JSON:
 //! positions in integer millimetres, at most [`VIEW_RATE`] frames per second, so a 60 s clip
@@ -18,7 +18,8 @@ use taskstack::imitation::metrics::CONTACT_HEIGHT;
 use taskstack::imitation::phase::SupportPhase;
 use taskstack::imitation::support::HumanSupport;
 use taskstack::model::{FrameId, Model, ModelData};
-use taskstack::{Imitator, IsometryMatrix3, RobotFrame, Vector3};
+use taskstack::robots::BipedProfile;
+use taskstack::{IsometryMatrix3, RobotFrame, Vector3};
 
 use crate::Report;
 
@@ -53,9 +54,8 @@ pub(crate) struct ViewWriter<W: Write> {
 
 impl<W: Write> ViewWriter<W> {
     /// Writes the page and the run's constant data (robot segments, sole outlines, human
-    /// skeleton) for `imitator`'s robot; `title` names the run.
-    pub(crate) fn new(mut out: W, imitator: &Imitator, title: &str) -> Result<Self> {
-        let profile = imitator.profile();
+    /// skeleton) for the robot of `profile`; `title` names the run.
+    pub(crate) fn new(mut out: W, profile: &BipedProfile, title: &str) -> Result<Self> {
         let model = profile.model(Side::Right).clone();
         let mut data = model.new_data();
         let right_sole = model.frame_id(&profile.foot(Side::Right).sole)?;
@@ -98,13 +98,33 @@ impl<W: Write> ViewWriter<W> {
     /// `[time ms, phase, human support, robot points, human points, left sole, right sole,
     /// CoM xy, grounded bits]`, lengths in mm in the world frame.
     pub(crate) fn frame(&mut self, r: &RobotFrame) -> Result<()> {
+        let reference = (r.reference.iter())
+            .map(|p| p.map(|p| r.world_t_root.transform_point(&p.into()).coords));
+        let frame = ViewFrame {
+            time: r.time,
+            phase: r.phase,
+            human_support: r.human_support,
+            q: &r.q,
+            soles: [&r.left_sole, &r.right_sole],
+            com: r.com,
+        };
+        self.frame_of(&frame, reference)
+    }
+
+    /// Adds `r` if it is due at [`VIEW_RATE`], with the scaled human's joints `reference`
+    /// (world frame, m; [`HumanJoint::ALL`] order, `None` where missing or no human).
+    pub(crate) fn frame_of(
+        &mut self,
+        r: &ViewFrame<'_>,
+        reference: impl Iterator<Item = Option<Vector3<f64>>>,
+    ) -> Result<()> {
         if r.time < self.next_time {
             return Ok(());
         }
         // 1 % early, so that frames 1/120 s apart are kept every fourth, not fifth.
         self.next_time = r.time + 0.99 / VIEW_RATE;
-        self.model.forward_kinematics(&mut self.data, &r.q)?;
-        let world_t_base = r.right_sole * self.data.frame_placement(self.right_sole).inverse();
+        self.model.forward_kinematics(&mut self.data, r.q)?;
+        let world_t_base = r.soles[1] * self.data.frame_placement(self.right_sole).inverse();
         let phase = r.phase.index();
         let line = &mut self.line;
         line.clear();
@@ -123,22 +143,19 @@ impl<W: Write> ViewWriter<W> {
         }
         line.push_str("],[");
         let mut first = true;
-        for reference in &r.reference {
+        for reference in reference {
             if !first {
                 line.push(',');
             }
             first = false;
             match reference {
-                Some(p) => {
-                    let w = r.world_t_root.transform_point(&(*p).into()).coords;
-                    push_xyz(line, &w);
-                }
+                Some(w) => push_xyz(line, &w),
                 None => line.push_str("null,null,null"),
             }
         }
         line.push(']');
         let mut grounded = 0;
-        for (i, sole) in [&r.left_sole, &r.right_sole].into_iter().enumerate() {
+        for (i, sole) in r.soles.into_iter().enumerate() {
             line.push_str(",[");
             let mut first = true;
             let mut on_ground = true;
@@ -162,14 +179,35 @@ impl<W: Write> ViewWriter<W> {
 
     /// Closes the data (the clip's last time `clip_end`, s, after which the human holds its
     /// pose; the run's `summary`) and writes the rest of the page.
-    pub(crate) fn finish(mut self, clip_end: f64, summary: serde_json::Value) -> Result<()> {
+    pub(crate) fn finish(self, clip_end: f64, summary: serde_json::Value) -> Result<()> {
+        self.into_inner(clip_end, summary).map(drop)
+    }
+
+    /// [`ViewWriter::finish`], giving the output back.
+    pub(crate) fn into_inner(mut self, clip_end: f64, summary: serde_json::Value) -> Result<W> {
         let tail = json!({ "clip_end_ms": (clip_end * 1000.0).round(),
                            "summary": summary, "frames": self.written });
         let (_, rest) = split_template()?;
         write!(self.out, "];\nconst TAIL = {tail};\n{rest}")?;
         self.out.flush()?;
-        Ok(())
+        Ok(self.out)
     }
+}
+
+/// One frame of a run for the viewer: what [`ViewWriter::frame_of`] draws besides the human.
+pub(crate) struct ViewFrame<'a> {
+    /// The run's clock (s).
+    pub(crate) time: f64,
+    /// The robot's phase.
+    pub(crate) phase: SupportPhase,
+    /// The human's support (what the human timeline shows).
+    pub(crate) human_support: HumanSupport,
+    /// Joint angles (rad, model variable order).
+    pub(crate) q: &'a [f64],
+    /// World placements of the soles, `[left, right]`.
+    pub(crate) soles: [&'a IsometryMatrix3<f64>; 2],
+    /// Whole-body CoM (m, world).
+    pub(crate) com: Vector3<f64>,
 }
 
 /// What is drawn of the robot: the link origins and named frames whose world positions each
@@ -266,7 +304,7 @@ fn human_support_index(support: HumanSupport) -> u8 {
 /// start). The page needs no network: everything is in the one file.
 #[derive(Debug, Args)]
 pub(crate) struct ViewArgs {
-    /// An output folder of `imitate` (it holds view.html).
+    /// An output folder of `imitate` or `walk` (it holds view.html).
     #[arg(value_name = "OUT_DIR")]
     out: PathBuf,
     /// Only print the page's path; do not start a browser.

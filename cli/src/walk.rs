@@ -1,20 +1,30 @@
 //! `taskstack walk`: a robot walks to a goal with the pattern generator and the whole-body
 //! solver.
 
-use std::path::PathBuf;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use serde_json::json;
 use taskstack::batch::JointsWriter;
+use taskstack::human::HumanJoint;
 use taskstack::human::Side;
+use taskstack::imitation::phase::SupportPhase;
+use taskstack::imitation::support::HumanSupport;
+use taskstack::locomotion::footstep::wrap_angle;
 use taskstack::locomotion::{
-    GroundPose, SupportPolygon, WalkParams, WholeBodyWalker, goal_feet, plan_steps,
+    GroundPose, Support, SupportPolygon, WalkParams, WalkerFrame, WholeBodyWalker, goal_feet,
+    plan_steps,
 };
+use taskstack::nalgebra::Translation3;
+use taskstack::robots::BipedProfile;
+use taskstack::{IsometryMatrix3, Rotation3, Vector3};
 
 use crate::Report;
 use crate::options::{non_negative, robot_profile};
+use crate::view::{ViewFrame, ViewWriter};
 
 /// Most steps a walk plans.
 const MAX_STEPS: usize = 200;
@@ -24,8 +34,9 @@ const MAX_STEPS: usize = 200;
 ///
 /// The goal is the midpoint between the soles moved by --forward and --left (m) and turned by
 /// --turn (rad), in the robot's starting frame (x forward, y left). Writes OUT/joints.csv (time
-/// in s, joint angles in rad, 100 Hz; the format of `imitate`, playable by the physics check)
-/// and OUT/walk.json (steps, duration, speed, the smallest margins of the plan's ZMP and CoM
+/// in s, joint angles in rad, 100 Hz; the format of `imitate`, playable by the physics check),
+/// OUT/plan.csv (the plan's CoM, ZMP and sole heights, m), OUT/view.html (the 3D viewer) and
+/// OUT/walk.json (steps, duration, speed, the smallest margins of the plan's ZMP and CoM
 /// inside the support polygon, the solver's largest foot and CoM errors).
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]
@@ -76,34 +87,11 @@ pub(crate) fn run(args: WalkArgs, report: Report) -> Result<ExitCode> {
     for step in &steps {
         walker.push(*step)?;
     }
-    let outlines = Side::BOTH.map(|s| profile.foot(s).outline.as_slice());
-    let mut polygon = SupportPolygon::new(outlines);
-    let mut joints = JointsWriter::new(Vec::new());
-    let names = profile.model(Side::Right).variables().iter();
-    joints.header_names(names.map(|v| v.name.as_str()))?;
-    joints.row(0.0, walker.q())?;
-    let (mut zmp_margin, mut com_margin) = (f64::INFINITY, f64::INFINITY);
-    let (mut foot_error, mut com_error) = (0.0_f64, 0.0_f64);
+    let mut recorder = Recorder::new(&profile, walker.q())?;
     let mut stopped_at = None;
-    let mut plan = String::from("time,com_x,com_y,zmp_x,zmp_y,left_z,right_z\n");
     loop {
         let frame = *walker.tick()?;
-        let w = &frame.walk;
-        plan.push_str(&format!(
-            "{:.3},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6}\n",
-            w.time,
-            w.com.x,
-            w.com.y,
-            w.zmp.x,
-            w.zmp.y,
-            w.feet[0].position[2],
-            w.feet[1].position[2]
-        ));
-        zmp_margin = zmp_margin.min(polygon.margin(&frame.walk, frame.walk.zmp));
-        com_margin = com_margin.min(polygon.margin(&frame.walk, frame.walk.com.xy()));
-        foot_error = foot_error.max(frame.foot_error);
-        com_error = com_error.max(frame.com_error);
-        joints.row(frame.walk.time, walker.q())?;
+        recorder.record(&frame, walker.q())?;
         let time = frame.walk.time;
         if walker.generator().is_stopped() && stopped_at.is_none() {
             stopped_at = Some(time);
@@ -113,50 +101,124 @@ pub(crate) fn run(args: WalkArgs, report: Report) -> Result<ExitCode> {
         }
     }
     let end = walker.generator().standing_feet();
-    let start_mid = (start[0].xy + start[1].xy) / 2.0;
-    let end_mid = (end[0].xy + end[1].xy) / 2.0;
+    let travel = ((end[0].xy + end[1].xy) - (start[0].xy + start[1].xy)).norm() / 2.0;
     let walk_time = stopped_at.unwrap_or(0.0);
     let summary = json!({
         "robot": profile.name,
         "steps": steps.len(),
         "step_duration_s": timing.duration(),
         "walk_time_s": walk_time,
-        "travel_m": (end_mid - start_mid).norm(),
-        "mean_speed_m_s": (end_mid - start_mid).norm() / walk_time.max(f64::MIN_POSITIVE),
-        "heading_rad": taskstack::locomotion::footstep::wrap_angle(end[1].yaw - start[1].yaw),
-        "zmp_margin_min_m": zmp_margin,
-        "com_margin_min_m": com_margin,
-        "foot_error_max": foot_error,
-        "com_error_max_m": com_error,
+        "travel_m": travel,
+        "mean_speed_m_s": travel / walk_time.max(f64::MIN_POSITIVE),
+        "heading_rad": wrap_angle(end[1].yaw - start[1].yaw),
+        "zmp_margin_min_m": recorder.zmp_margin,
+        "com_margin_min_m": recorder.com_margin,
+        "foot_error_max": recorder.foot_error,
+        "com_error_max_m": recorder.com_error,
         "com_height_m": walker.params().settings.com_height,
     });
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("cannot create {}", args.out.display()))?;
-    let csv = joints.into_inner();
-    let write = |name: &str, bytes: &[u8]| {
-        std::fs::write(args.out.join(name), bytes)
-            .with_context(|| format!("cannot write {}", args.out.join(name).display()))
-    };
-    write("joints.csv", &csv)?;
-    write("plan.csv", plan.as_bytes())?;
-    write(
-        "walk.json",
-        serde_json::to_string_pretty(&summary)?.as_bytes(),
-    )?;
+    let zmp_margin = recorder.zmp_margin;
+    recorder.write(&args.out, walk_time, &summary)?;
     if report.json {
         crate::output(&format!("{summary}\n"))?;
     } else if report.human() {
         crate::output(&format!(
-            "{}: {} steps of {:.2} s, {:.3} m in {:.2} s ({:.3} m/s), ZMP >= {:.1} mm inside the support\nwrote {}\n",
+            "{}: {} steps of {:.2} s, {travel:.3} m in {walk_time:.2} s ({:.3} m/s), ZMP >= {:.1} mm inside the support\nwrote {}\n",
             profile.name,
             steps.len(),
             timing.duration(),
-            (end_mid - start_mid).norm(),
-            walk_time,
-            (end_mid - start_mid).norm() / walk_time.max(f64::MIN_POSITIVE),
+            travel / walk_time.max(f64::MIN_POSITIVE),
             zmp_margin * 1e3,
             args.out.display()
         ))?;
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The outputs of a walk, built as the ticks come, and the plan's margins and solver errors.
+struct Recorder {
+    polygon: SupportPolygon,
+    joints: JointsWriter<Vec<u8>>,
+    plan: String,
+    view: ViewWriter<Vec<u8>>,
+    zmp_margin: f64,
+    com_margin: f64,
+    foot_error: f64,
+    com_error: f64,
+}
+
+impl Recorder {
+    /// Starts the outputs with the robot standing in `q` at time 0.
+    fn new(profile: &BipedProfile, q: &[f64]) -> Result<Self> {
+        let outlines = Side::BOTH.map(|s| profile.foot(s).outline.as_slice());
+        let mut joints = JointsWriter::new(Vec::new());
+        let names = profile.model(Side::Right).variables().iter();
+        joints.header_names(names.map(|v| v.name.as_str()))?;
+        joints.row(0.0, q)?;
+        let title = format!("{} walking", profile.name);
+        Ok(Self {
+            polygon: SupportPolygon::new(outlines),
+            joints,
+            plan: String::from("time,com_x,com_y,zmp_x,zmp_y,left_z,right_z\n"),
+            view: ViewWriter::new(Vec::new(), profile, &title)?,
+            zmp_margin: f64::INFINITY,
+            com_margin: f64::INFINITY,
+            foot_error: 0.0,
+            com_error: 0.0,
+        })
+    }
+
+    /// One tick: the joints `q` (rad) that realise `frame`.
+    fn record(&mut self, frame: &WalkerFrame, q: &[f64]) -> Result<()> {
+        let w = &frame.walk;
+        let [left, right] = w.feet.map(|f| f.position);
+        let _ = writeln!(
+            self.plan,
+            "{:.3},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6}",
+            w.time, w.com.x, w.com.y, w.zmp.x, w.zmp.y, left[2], right[2]
+        );
+        self.zmp_margin = self.zmp_margin.min(self.polygon.margin(w, w.zmp));
+        self.com_margin = self.com_margin.min(self.polygon.margin(w, w.com.xy()));
+        self.foot_error = self.foot_error.max(frame.foot_error);
+        self.com_error = self.com_error.max(frame.com_error);
+        self.joints.row(w.time, q)?;
+        let soles = w.feet.map(|f| {
+            IsometryMatrix3::from_parts(
+                Translation3::from(Vector3::from(f.position)),
+                Rotation3::from_axis_angle(&Vector3::z_axis(), f.yaw),
+            )
+        });
+        let phase = match w.support {
+            Support::Double => SupportPhase::Double,
+            Support::Single { swing, .. } => swing.pick(SupportPhase::Right, SupportPhase::Left),
+        };
+        let view = ViewFrame {
+            time: w.time,
+            phase,
+            human_support: HumanSupport::Airborne,
+            q,
+            soles: [&soles[0], &soles[1]],
+            com: w.com,
+        };
+        self.view
+            .frame_of(&view, std::iter::repeat_n(None, HumanJoint::COUNT))
+    }
+
+    /// Writes `joints.csv`, `plan.csv`, `view.html` and `walk.json` (`summary`) into `out`;
+    /// the viewer marks the frames after `walk_end` (s) as the hold.
+    fn write(self, out: &Path, walk_end: f64, summary: &serde_json::Value) -> Result<()> {
+        std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
+        let write = |name: &str, bytes: &[u8]| {
+            std::fs::write(out.join(name), bytes)
+                .with_context(|| format!("cannot write {}", out.join(name).display()))
+        };
+        let view = self.view.into_inner(walk_end, summary.clone())?;
+        write("joints.csv", &self.joints.into_inner())?;
+        write("plan.csv", self.plan.as_bytes())?;
+        write("view.html", &view)?;
+        write(
+            "walk.json",
+            serde_json::to_string_pretty(summary)?.as_bytes(),
+        )
+    }
 }

@@ -564,6 +564,8 @@ fn walk_writes_a_joint_trajectory_the_plan_and_a_summary() {
         (last_time / 0.01).round() as usize + 1,
         "100 Hz from 0"
     );
+    let view = std::fs::read_to_string(out.join("view.html")).unwrap();
+    assert!(view.contains("const FRAMES") && view.contains("nao walking"));
     let plan = std::fs::read_to_string(out.join("plan.csv")).unwrap();
     assert!(plan.starts_with("time,com_x,com_y,zmp_x,zmp_y,left_z,right_z\n"));
     assert!(
@@ -579,6 +581,8 @@ fn walk_writes_a_joint_trajectory_the_plan_and_a_summary() {
         "--hold",
         "--step-length",
         "joints.csv",
+        "plan.csv",
+        "view.html",
         "walk.json",
         "(m",
         "rad",
