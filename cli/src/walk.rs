@@ -26,8 +26,9 @@ use crate::Report;
 use crate::options::{non_negative, robot_profile};
 use crate::view::{ViewFrame, ViewWriter};
 
-/// Most steps a walk plans.
-const MAX_STEPS: usize = 200;
+/// Most steps a walk plans (a NAO walks 50 m in them; the summary's travel says when the goal
+/// was farther).
+const MAX_STEPS: usize = 1000;
 
 /// Walk to a goal: footsteps within the robot's step envelope, a CoM from ZMP preview control,
 /// joint angles from the whole-body solver.
@@ -84,16 +85,21 @@ pub(crate) fn run(args: WalkArgs, report: Report) -> Result<ExitCode> {
         envelope.x_min = envelope.x_min.min(length);
     }
     let steps = plan_steps(&start, &goal, &envelope, timing, MAX_STEPS);
-    for step in &steps {
-        walker.push(*step)?;
-    }
+    // The generator's queue is bounded: steps are fed as they land.
+    let capacity = walker.generator().settings().capacity;
+    let mut pending = steps.iter();
     let mut recorder = Recorder::new(&profile, walker.q())?;
     let mut stopped_at = None;
     loop {
+        while walker.generator().queued() < capacity
+            && let Some(step) = pending.next()
+        {
+            walker.push(*step)?;
+        }
         let frame = *walker.tick()?;
         recorder.record(&frame, walker.q())?;
         let time = frame.walk.time;
-        if walker.generator().is_stopped() && stopped_at.is_none() {
+        if walker.generator().is_stopped() && pending.len() == 0 && stopped_at.is_none() {
             stopped_at = Some(time);
         }
         if stopped_at.is_some_and(|t| time >= t + args.hold) {

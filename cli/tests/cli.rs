@@ -592,6 +592,21 @@ fn walk_writes_a_joint_trajectory_the_plan_and_a_summary() {
             "walk --help mentions {needle}"
         );
     }
+    // A walk longer than the generator's queue (64 steps): 81 steps of at most 5 cm.
+    let long = taskstack(&[
+        "walk",
+        "--forward",
+        "4",
+        "--hold",
+        "0",
+        "--json",
+        "--out",
+        s(&out),
+    ]);
+    assert_eq!(long.code, Some(0), "{}", long.stderr);
+    let summary: Value = serde_json::from_str(&long.stdout).unwrap();
+    assert!(summary["steps"].as_u64().unwrap() > 64);
+    assert!((summary["travel_m"].as_f64().unwrap() - 4.0).abs() < 1e-9);
     fails(&["walk", "--forward", "nan"], 1, &["finite"]);
     fails(&["walk", "--robot", "nope"], 1, &["--robot nope"]);
     std::fs::remove_dir_all(&out).unwrap();
