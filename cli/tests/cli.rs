@@ -77,7 +77,8 @@ fn every_subcommand_explains_its_options_and_outputs() {
 
 #[test]
 fn imitate_writes_every_output_and_reports_clip_and_hold_apart() {
-    let out = temp_dir("imitate").join("run");
+    let dir = temp_dir("imitate");
+    let out = dir.join("run");
     let clip = clip(KINECT);
     let run = taskstack(&["imitate", s(&clip), "--out", s(&out), "--hold", "0.5"]);
     assert_eq!(run.code, Some(0), "{}", run.stderr);
@@ -436,7 +437,8 @@ fn contacts_lists_the_hands_landing_on_the_stool() {
         "{}",
         table.stdout
     );
-    let bad = temp_dir("contacts").join("bad.toml");
+    let dir = temp_dir("contacts");
+    let bad = dir.join("bad.toml");
     std::fs::write(
         &bad,
         "[[surface]]\nname = \"t\"\nheight = 0.7\nsize = [0.5, -1.0]\n",
@@ -609,5 +611,4 @@ fn walk_writes_a_joint_trajectory_the_plan_and_a_summary() {
     assert!((summary["travel_m"].as_f64().unwrap() - 4.0).abs() < 1e-9);
     fails(&["walk", "--forward", "nan"], 1, &["finite"]);
     fails(&["walk", "--robot", "nope"], 1, &["--robot nope"]);
-    std::fs::remove_dir_all(&out).unwrap();
 }

@@ -43,7 +43,8 @@ fn the_viewer_draws_and_plays_in_a_headless_browser() {
         eprintln!("viewer test skipped: no chromium, chromium-browser or google-chrome on PATH");
         return;
     };
-    let out = temp_dir("viewer").join("run");
+    let dir = temp_dir("viewer");
+    let out = dir.join("run");
     let run = taskstack(&[
         "-q",
         "imitate",

@@ -45,14 +45,31 @@ pub fn taskstack_with_input(args: &[&str], input: &str) -> Run {
     finish(child.wait_with_output().expect("taskstack finishes"))
 }
 
-/// A new empty folder under the system's temporary folder.
-pub fn temp_dir(name: &str) -> PathBuf {
+/// A new empty folder under the system's temporary folder, removed with everything in it when
+/// the guard is dropped (tests clean up what they write, pass or fail).
+pub fn temp_dir(name: &str) -> TempDir {
     static COUNT: AtomicUsize = AtomicUsize::new(0);
     let n = COUNT.fetch_add(1, Ordering::Relaxed);
     let dir = std::env::temp_dir().join(format!("taskstack-cli-{}-{name}-{n}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).expect("temporary folder");
-    dir
+    TempDir(dir)
+}
+
+/// See [`temp_dir`].
+pub struct TempDir(PathBuf);
+
+impl std::ops::Deref for TempDir {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
 }
 
 /// A bundled clip of the crate (`tests/data/mocap/NAME`).
