@@ -32,7 +32,7 @@ use super::travel::{
     FootTiming, HandTrace, Stance, StepCounter, Travel, TravelRecorder, robot_stance,
 };
 use crate::solver::JointBounds;
-use crate::tasks::convex_hull;
+use crate::tasks::{convex_hull, hull_margin};
 
 /// A foot is on the ground when its outline points are at most this high (m).
 pub const CONTACT_HEIGHT: f64 = 1e-3;
@@ -371,17 +371,7 @@ pub fn convex_margin(points: &[Vector2<f64>], p: Vector2<f64>) -> f64 {
     let mut corners: Vec<[f64; 2]> = points.iter().map(|v| [v.x, v.y]).collect();
     let mut hull = Vec::with_capacity(corners.len());
     convex_hull(&mut corners, &mut hull);
-    let n = hull.len();
-    if n < 3 {
-        return f64::NEG_INFINITY;
-    }
-    (0..n)
-        .map(|i| {
-            let (a, b) = (Vector2::from(hull[i]), Vector2::from(hull[(i + 1) % n]));
-            let edge = b - a;
-            edge.perp(&(p - a)) / edge.norm()
-        })
-        .fold(f64::INFINITY, f64::min)
+    hull_margin(&hull, p)
 }
 
 /// The angle of a rotation, accurate near zero (`acos` of the trace loses half the digits).

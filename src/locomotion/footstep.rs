@@ -63,6 +63,11 @@ pub fn wrap_angle(a: f64) -> f64 {
     (a + PI).rem_euclid(TAU) - PI
 }
 
+/// The heading halfway between headings `a` and `b` (rad), on the short arc.
+pub fn mean_heading(a: f64, b: f64) -> f64 {
+    b + wrap_angle(a - b) / 2.0
+}
+
 /// How long a step takes (s): the double support in which the weight moves to the stance
 /// foot, then the single support in which the other foot swings to its new place.
 #[derive(Debug, Clone, Copy, PartialEq)]

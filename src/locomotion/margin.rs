@@ -6,7 +6,7 @@ use super::footstep::GroundPose;
 use super::generator::WalkState;
 use super::schedule::Support;
 use crate::human::Side;
-use crate::tasks::convex_hull;
+use crate::tasks::{convex_hull, hull_margin};
 
 /// The support polygon of a [`WalkState`]: the convex hull of the outlines of the soles on the
 /// floor. Buffers are allocated once; [`SupportPolygon::margin`] allocates nothing.
@@ -45,14 +45,6 @@ impl SupportPolygon {
             self.points.extend(corners);
         }
         convex_hull(&mut self.points, &mut self.hull);
-        let n = self.hull.len();
-        (0..n)
-            .map(|i| {
-                let (a, b) = (self.hull[i], self.hull[(i + 1) % n]);
-                let edge = Vector2::new(b[0] - a[0], b[1] - a[1]);
-                let inward = Vector2::new(-edge.y, edge.x) / edge.norm();
-                inward.dot(&(point - Vector2::new(a[0], a[1])))
-            })
-            .fold(f64::INFINITY, f64::min)
+        hull_margin(&self.hull, point)
     }
 }

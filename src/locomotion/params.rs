@@ -36,7 +36,7 @@ use super::schedule::SoleCentres;
 use super::swing::SwingProfile;
 use crate::human::{HumanJoint, Side};
 use crate::model::ModelData;
-use crate::robots::{BipedProfile, ProfileError, RobotPoint};
+use crate::robots::{BipedProfile, ProfileError, RobotPoint, outline_bounds};
 use nalgebra::Vector3;
 
 /// Pendulum time constants in a step's double support, at least (see the module docs).
@@ -198,8 +198,8 @@ pub(super) fn standing_feet(
 
 /// Width of a sole outline across the foot (m).
 fn width(outline: &[[f64; 2]]) -> f64 {
-    let ys = outline.iter().map(|c| c[1]);
-    ys.clone().fold(f64::NEG_INFINITY, f64::max) - ys.fold(f64::INFINITY, f64::min)
+    let [lo, hi] = outline_bounds(outline);
+    hi[1] - lo[1]
 }
 
 /// The hip points `[left, right]` standing (m, right sole frame), from the profile's point map

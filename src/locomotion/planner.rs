@@ -5,7 +5,7 @@
 //! steps as it needs. The first foot to move is the one that leads toward the goal (left for a
 //! goal to the left or a left turn), and the plan ends with both soles on their goals.
 
-use super::footstep::{Footstep, GroundPose, StepTiming};
+use super::footstep::{Footstep, GroundPose, StepTiming, mean_heading};
 use crate::human::Side;
 use crate::robots::{FootArea, SolePlacement};
 
@@ -16,7 +16,7 @@ const ARRIVED: f64 = 1e-9;
 /// frame: forward m, left m, turn rad): each sole keeps its offset from the midpoint.
 pub fn goal_feet(feet: &[GroundPose; 2], motion: &GroundPose) -> [GroundPose; 2] {
     let [left, right] = feet;
-    let heading = right.yaw + super::footstep::wrap_angle(left.yaw - right.yaw) / 2.0;
+    let heading = mean_heading(left.yaw, right.yaw);
     let mid = GroundPose {
         xy: (left.xy + right.xy) / 2.0,
         yaw: heading,

@@ -14,6 +14,7 @@ use nalgebra::Vector2;
 use super::LocomotionError;
 use super::footstep::{Footstep, GroundPose};
 use crate::human::Side;
+use crate::robots::outline_bounds;
 
 /// The contact area of each sole (sole frame, m), `[left, right]`: its centre is where the ZMP
 /// reference sits in single support.
@@ -38,14 +39,7 @@ impl SoleCentres {
                     reason: "needs three or more finite corners (m)",
                 });
             }
-            let mut lo = [f64::INFINITY; 2];
-            let mut hi = [f64::NEG_INFINITY; 2];
-            for corner in outline {
-                for k in 0..2 {
-                    lo[k] = lo[k].min(corner[k]);
-                    hi[k] = hi[k].max(corner[k]);
-                }
-            }
+            let [lo, hi] = outline_bounds(outline);
             Ok([0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])])
         };
         Ok(Self {

@@ -5,13 +5,13 @@
 //! stand), placed where the generator put it in the world, and the driver solves, in priority
 //! order: the other sole's pose (held on the floor, or on its swing path), the CoM's ground
 //! point, the torso's tilt (upright, leaning over the stance hip), the CoM's height; the
-//! standing posture pulls the remaining freedom (the arms, the waist, the torso's heading). A sole on the floor is the model's root or a
-//! top-level task, so it does not move in the plan.
+//! standing posture pulls the remaining freedom (the arms, the waist, the torso's heading). A
+//! sole on the floor is the model's root or a top-level task, so it does not move in the plan.
 
 use nalgebra::{IsometryMatrix3, Rotation3, Translation3, Vector2, Vector3};
 
 use super::LocomotionError;
-use super::footstep::{Footstep, GroundPose};
+use super::footstep::{Footstep, GroundPose, mean_heading};
 use super::generator::{PatternGenerator, WalkState};
 use super::params::{WalkParams, standing_feet};
 use super::schedule::Support;
@@ -134,7 +134,7 @@ impl<'p> WholeBodyWalker<'p> {
         if let Support::Single { swing, .. } = walk.support {
             self.root = swing.other();
         }
-        let heading = mean_heading(&walk.feet);
+        let heading = mean_heading(walk.feet[0].yaw, walk.feet[1].yaw);
         let root = self.root;
         let root_pose = self.generator.standing_feet()[root.index()];
         let other = walk.feet[root.other().index()];
@@ -191,7 +191,10 @@ impl<'p> WholeBodyWalker<'p> {
     }
 }
 
-/// The task stack of the model rooted at `root`: the other sole, the CoM, the torso.
+/// The task stack of the model rooted at `root`: the other sole, the CoM's ground point, the
+/// torso's tilt, the CoM's height. The torso's heading is left free: held too, it took a
+/// freedom the NAO's coupled hips need, the CoM task then swung the arms, and turning walks
+/// fell in physics. The height comes last: the legs alone cannot always keep it.
 fn rooted_stack(profile: &BipedProfile, root: Side) -> Result<RootedStack<'_>, Error> {
     let model = profile.model(root);
     let other = PoseTask::new(
@@ -230,10 +233,4 @@ fn local_pose(root: &GroundPose, sole: &SolePose) -> IsometryMatrix3<f64> {
         Translation3::new(xy.x, xy.y, sole.position[2]),
         Rotation3::from_axis_angle(&Vector3::z_axis(), sole.yaw - root.yaw),
     )
-}
-
-/// The mean of the two soles' headings (rad), on the short arc.
-fn mean_heading(feet: &[SolePose; 2]) -> f64 {
-    let [l, r] = feet.map(|f| f.yaw);
-    r + super::footstep::wrap_angle(l - r) / 2.0
 }

@@ -10,6 +10,6 @@ pub mod self_collision;
 
 pub use profile::{
     BipedProfile, FootArea, FootFrames, HumanJointAngles, JointAnglesFactory, MotionTuning,
-    ProfileError, RobotPoint, SolePlacement,
+    ProfileError, RobotPoint, SolePlacement, outline_bounds,
 };
 pub use self_collision::{BodyCapsule, FramePoint, SelfCollision};

@@ -439,13 +439,7 @@ impl BipedProfile {
     /// point of the area farthest from its edges for a rectangle-like sole; where a robot
     /// standing on this foot keeps its centre of mass.
     pub fn sole_centre(&self, side: Side) -> [f64; 2] {
-        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-        for corner in &self.foot(side).outline {
-            for k in 0..2 {
-                lo[k] = lo[k].min(corner[k]);
-                hi[k] = hi[k].max(corner[k]);
-            }
-        }
+        let [lo, hi] = outline_bounds(&self.foot(side).outline);
         [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])]
     }
 
@@ -468,4 +462,16 @@ impl BipedProfile {
         };
         [x, y]
     }
+}
+
+/// The bounding rectangle `[lower, upper]` corners of a sole outline (sole frame, m).
+pub fn outline_bounds(outline: &[[f64; 2]]) -> [[f64; 2]; 2] {
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for corner in outline {
+        for k in 0..2 {
+            lo[k] = lo[k].min(corner[k]);
+            hi[k] = hi[k].max(corner[k]);
+        }
+    }
+    [lo, hi]
 }

@@ -3,6 +3,7 @@
 use std::any::Any;
 
 use faer::MatMut;
+use nalgebra::Vector2;
 
 use super::inequality::InequalityTask;
 use super::{TaskError, finite_target};
@@ -145,6 +146,22 @@ impl InequalityTask for ComPolygonTask {
     fn as_any_mut(&mut self) -> &mut dyn Any {
         self
     }
+}
+
+/// Signed distance (m) of `p` to the boundary of the counter-clockwise convex polygon `hull`
+/// (as [`convex_hull`] writes it): positive inside; −∞ for fewer than three vertices.
+pub fn hull_margin(hull: &[[f64; 2]], p: Vector2<f64>) -> f64 {
+    let n = hull.len();
+    if n < 3 {
+        return f64::NEG_INFINITY;
+    }
+    (0..n)
+        .map(|i| {
+            let (a, b) = (Vector2::from(hull[i]), Vector2::from(hull[(i + 1) % n]));
+            let edge = b - a;
+            edge.perp(&(p - a)) / edge.norm()
+        })
+        .fold(f64::INFINITY, f64::min)
 }
 
 /// The convex hull of `points` (m), counter-clockwise seen from above without repeated or

@@ -59,7 +59,7 @@ use crate::model::{Model, ModelData, ModelError};
 use crate::solver::{JointBounds, SolverError};
 
 pub use com::{ComTask, com_rows};
-pub use com_polygon::{ComPolygonTask, convex_hull};
+pub use com_polygon::{ComPolygonTask, convex_hull, hull_margin};
 pub use contact_normal::ContactNormalTask;
 pub use distance::{Capsule, CapsuleDistanceTask, PlaneDistanceTask, closest_segment_parameters};
 pub use inequality::InequalityTask;
