@@ -26,6 +26,12 @@ pub(crate) struct ImitationOptions {
     /// foot back where it was.
     #[arg(long)]
     pub(crate) walk: bool,
+    /// Experimental: walk with the walking pattern generator (implies `--walk`): dynamic steps
+    /// of the robot's own timing (NAO: 0.5 s double + 0.5 s single support) instead of one
+    /// quasi-static step at a time. Not yet physically executable (the physics judge's NAO
+    /// falls on the bundled clips); for development.
+    #[arg(long)]
+    pub(crate) dynamic_walk: bool,
     /// After the clip, hold the human's last pose (frames 1/120 s apart) so the robot can
     /// finish the step it is taking; those frames are in every output. `auto`: until the robot
     /// has finished (a continuous phase, no step pending, on the feet the human stands on) for
@@ -145,7 +151,8 @@ impl ImitationOptions {
             iterations_per_frame: self.iterations as usize,
             ..ImitatorConfig::default()
         };
-        config.footsteps.follow = self.walk;
+        config.footsteps.follow = self.walk || self.dynamic_walk;
+        config.footsteps.dynamic = self.dynamic_walk;
         config
     }
 }

@@ -56,6 +56,11 @@ pub struct ImitatorConfig {
     /// balance level sees the arms' effect on the CoM and the solver slows the arms down when
     /// the legs cannot compensate). Set it to `velocity_fraction` for one fraction everywhere.
     pub upper_body_velocity_fraction: Option<f64>,
+    /// Fraction of each leg joint's rated velocity while the robot walks
+    /// ([`super::walking`]): the walk's timing is the pattern generator's, and a swing leg
+    /// that lags its plan lands late. Default 1 (the NAO's swing knee reaches 0.97–1.0 of its
+    /// rated speed in 5 cm steps of 1 s); `velocity_fraction` still bounds the support phases.
+    pub walking_velocity_fraction: f64,
     /// Speed and acceleration bounds of the CoM reference and of the swing foot (see
     /// [`super::shaping`]).
     pub motion: MotionLimits,
@@ -110,6 +115,7 @@ impl Default for ImitatorConfig {
             phase: PhaseConfig::default(),
             velocity_fraction: 0.1,
             upper_body_velocity_fraction: None,
+            walking_velocity_fraction: 1.0,
             motion: MotionLimits::default(),
             iterations_per_frame: 1,
             max_task_speed: None,
@@ -140,6 +146,11 @@ impl ImitatorConfig {
             (
                 "velocity_fraction",
                 Some(self.velocity_fraction),
+                "must be finite and > 0",
+            ),
+            (
+                "walking_velocity_fraction",
+                Some(self.walking_velocity_fraction),
                 "must be finite and > 0",
             ),
             (

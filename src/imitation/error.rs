@@ -7,6 +7,7 @@ use super::phase::PhaseError;
 use super::scaler::ScaleError;
 use super::support::SupportError;
 use super::tables::TableError;
+use crate::locomotion::LocomotionError;
 use crate::model::ModelError;
 use crate::robots::ProfileError;
 use crate::solver::SolverError;
@@ -37,6 +38,9 @@ pub enum ImitationError {
     /// Invalid phase-machine configuration.
     #[error(transparent)]
     Phase(#[from] PhaseError),
+    /// The walking pattern generator refused a step or its settings.
+    #[error(transparent)]
+    Locomotion(#[from] LocomotionError),
     /// Invalid support-detection configuration.
     #[error(transparent)]
     Support(#[from] SupportError),

@@ -119,9 +119,13 @@ impl Imitator {
     }
 
     /// The joint bounds the output respects: position limits, and the rated velocities times
-    /// the velocity fraction (legs) or the upper-body velocity fraction (the other joints).
+    /// the velocity fraction (legs; the walking velocity fraction when the feet follow the
+    /// human's) or the upper-body velocity fraction (the other joints).
     pub fn bounds(&self) -> &JointBounds {
-        &self.shared().bounds
+        match &self.0 {
+            Method::Poubel(p) => p.bounds(),
+            Method::Koenemann(k) => &k.shared.bounds,
+        }
     }
 
     /// Feet not on their targets (the scaled human footprints) after the last frame: the steps
@@ -173,7 +177,13 @@ impl Shared {
         let legs = profile.sole_chain_variables(&q)?;
         let upper_body = (config.upper_body_velocity_fraction)
             .unwrap_or(profile.tuning.upper_body_velocity_fraction);
-        let bounds = velocity_bounds(model, &position_bounds, &legs, config, upper_body)?;
+        let bounds = velocity_bounds(
+            model,
+            &position_bounds,
+            &legs,
+            config.velocity_fraction,
+            upper_body,
+        )?;
         let mut data = profile.models.each_ref().map(Model::new_data);
         let soles = sole_frames(&profile)?;
         let right = Side::Right.index();
@@ -304,13 +314,13 @@ pub(crate) fn initial_posture(
     Ok(q)
 }
 
-/// `position` with the velocity limits of `config`: the model's rated velocities times the
-/// velocity fraction on the legs (`legs[k]`), times the `upper_body` fraction elsewhere.
+/// `position` with velocity limits: the model's rated velocities times `leg_fraction` on the
+/// legs (`legs[k]`), times the `upper_body` fraction elsewhere.
 pub(crate) fn velocity_bounds(
     model: &Model,
     position: &JointBounds,
     legs: &[bool],
-    config: &ImitatorConfig,
+    leg_fraction: f64,
     upper_body: f64,
 ) -> Result<JointBounds, SolverError> {
     let velocity: Vec<f64> = model
@@ -318,7 +328,7 @@ pub(crate) fn velocity_bounds(
         .iter()
         .zip(legs)
         .map(|(v, &leg)| match leg {
-            true => v.velocity * config.velocity_fraction,
+            true => v.velocity * leg_fraction,
             false => v.velocity * upper_body,
         })
         .collect();

@@ -30,3 +30,4 @@ pub mod shaping;
 pub mod support;
 pub mod tables;
 pub mod travel;
+pub mod walking;

@@ -6,8 +6,9 @@ use super::hand_support::HandPlacement;
 use super::phase::SupportPhase;
 use super::support::HumanSupport;
 use crate::human::{HumanJoint, Side};
+use crate::locomotion::WalkState;
 use crate::robots::BipedProfile;
-use crate::solver::driver::StopReason;
+use crate::solver::driver::{DriverReport, StopReason};
 use crate::solver::{LevelReport, SolveReport};
 
 /// The effectors whose positions each [`RobotFrame`] reports and whose tracking the metrics
@@ -90,6 +91,9 @@ pub struct RobotFrame {
     /// Feet not on their targets after this frame: the steps the robot still has to take
     /// (0, 1 or 2).
     pub pending_steps: usize,
+    /// The walking pattern generator's state while the robot walks ([`super::walking`]):
+    /// the planned CoM, ZMP and soles (world frame); `None` while it stands.
+    pub walk: Option<WalkState>,
 }
 
 impl RobotFrame {
@@ -103,7 +107,7 @@ impl RobotFrame {
             HumanSupport::Left => self.phase == SupportPhase::Left,
             HumanSupport::Airborne => true,
         };
-        !self.phase.is_transition() && self.pending_steps == 0 && same_support
+        !self.phase.is_transition() && self.pending_steps == 0 && same_support && self.walk.is_none()
     }
 
     /// The frame before the first step: posture `q` with the right sole at the world origin
@@ -141,7 +145,18 @@ impl RobotFrame {
             leg_ratio: 1.0,
             effectors: [Vector3::zeros(); 4],
             pending_steps: 0,
+            walk: None,
         }
+    }
+
+    /// Copies the driver's stop reason and task errors, then the solve's levels and clamped
+    /// joints.
+    pub(super) fn record(&mut self, driver: &DriverReport, solve: &SolveReport) {
+        self.stop = driver.stop;
+        let errors = driver.task_errors();
+        self.task_count = errors.len().min(self.task_errors.len());
+        self.task_errors[..self.task_count].copy_from_slice(&errors[..self.task_count]);
+        self.record_solve(solve);
     }
 
     /// Copies the per-level outcome and the clamped joints of a solve.

@@ -70,6 +70,12 @@ pub(super) struct FrameTargets<'a> {
     pub(super) tracking_step: f64,
     /// The hands' contact points (`[left, right]`) while they are placed or held as supports.
     pub(super) hand_contacts: [Option<Vector3<f64>>; 2],
+    /// The walk's up direction of the torso (unit): the target of
+    /// [`OrientationTarget::Leaning`].
+    pub(super) up: Vector3<f64>,
+    /// How far (m) below the table's own `Standing` targets the points go this frame: the walk
+    /// raises the torso from the support phases' height to standing over its start.
+    pub(super) lowering: f64,
 }
 
 /// The gradient criteria of the imitator, shared by every phase.
@@ -185,7 +191,7 @@ impl PhaseSolver {
     }
 
     /// The last solve's report (levels, clamped joints).
-    pub(super) fn report(&self) -> &SolveReport {
+    pub(super) fn solve_report(&self) -> &SolveReport {
         self.solver.report()
     }
 
@@ -200,6 +206,25 @@ impl PhaseSolver {
                 task.held_yaw = x.y.atan2(x.x);
             }
         }
+    }
+
+    /// How far (m) the table's `Standing` points are below their standing heights in `data`
+    /// (the largest; 0 without one).
+    pub(super) fn below_standing(&self, data: &ModelData) -> f64 {
+        let standing = self.tasks.iter().filter_map(|t| match (&t.task, &t.point) {
+            (
+                Task::Point {
+                    target: PointTarget::Standing { .. },
+                    ..
+                },
+                Some(p),
+            ) => {
+                let now = data.frame_placement(p.frame).transform_point(&p.offset.into());
+                Some(t.standing.z - now.z)
+            }
+            _ => None,
+        });
+        standing.fold(0.0, f64::max)
     }
 
     /// The lift (m) of the table's held point, the swing foot's, if it has one.
@@ -261,7 +286,7 @@ impl PhaseSolver {
         q: &mut [f64],
         bounds: &JointBounds,
         settings: DriverSettings,
-    ) -> Result<&DriverReport, ImitationError> {
+    ) -> Result<(), ImitationError> {
         self.driver.set_settings(settings)?;
         let mut tasks = PhaseTasks {
             model,
@@ -272,7 +297,13 @@ impl PhaseSolver {
             gradients: &self.table.gradients,
             criteria,
         };
-        self.driver.run(&mut self.solver, &mut tasks, q, bounds)
+        self.driver.run(&mut self.solver, &mut tasks, q, bounds)?;
+        Ok(())
+    }
+
+    /// The last run's driver outcome (iterations, stop reason, task errors).
+    pub(super) fn driver_report(&self) -> &DriverReport {
+        self.driver.report()
     }
 }
 
@@ -452,6 +483,17 @@ impl PhaseTasks<'_> {
                 let up = Vector3::new(0.0, lean.sin(), lean.cos());
                 upright_rows(self.model, self.data, point.frame, &up, jacobian, error)?
             }
+            Task::Orientation {
+                target: OrientationTarget::Leaning,
+                ..
+            } => upright_rows(
+                self.model,
+                self.data,
+                point.frame,
+                &self.targets.up,
+                jacobian,
+                error,
+            )?,
             Task::ComXY(_) => unreachable!("a CoM task has no point"),
         }
         Ok(())
@@ -481,12 +523,18 @@ impl PhaseTasks<'_> {
                 task.held.y,
                 task.rest_height + targets.swing_lift,
             ),
-            PointTarget::Standing { lower } => task.standing - Vector3::z() * lower,
+            PointTarget::Standing { lower } => {
+                task.standing - Vector3::z() * (lower + targets.lowering)
+            }
             PointTarget::Footstep { lift } => {
                 let xy = targets.footstep.map_or(task.held.xy(), |f| f.xy);
                 Vector3::new(xy.x, xy.y, task.rest_height + lift)
             }
             PointTarget::HandContact(side) => or_current(targets.hand_contacts[side.index()])?,
+            PointTarget::Planned => {
+                let xy = targets.footstep.map_or(task.held.xy(), |f| f.xy);
+                Vector3::new(xy.x, xy.y, task.rest_height + targets.swing_lift)
+            }
         })
     }
 }

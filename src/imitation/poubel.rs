@@ -27,9 +27,9 @@ use std::time::Instant;
 
 use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 
-use super::footsteps::{FootstepPlanner, GroundPose};
+use super::footsteps::{FootstepPlanner, GroundPose, StepRequest};
 use super::hand_support::{HandSupports, HandView, hand_point};
-use super::imitator::{Shared, effector_ids, ground_pose, human_stance};
+use super::imitator::{Shared, effector_ids, ground_pose, human_stance, velocity_bounds};
 use super::metrics::CONTACT_HEIGHT;
 use super::phase::{Measurements, PhaseMachine, Settling, SupportPhase, TakeOff};
 use super::phase_solver::{Criteria, FrameTargets, PhaseSolver};
@@ -37,11 +37,12 @@ use super::scaler::{RobotSkeleton, ScaleConfig, Scaler};
 use super::shaping::{ComReference, MotionLimits, SwingHeight};
 use super::support::{HumanSupport, SupportDetector};
 use super::tables::{PointTarget, Task, TaskTable, TaskTables};
+use super::walking::follower::WalkFollower;
 use crate::human::{HumanFrame, Side};
 use crate::model::FrameId;
 use crate::robots::{BipedProfile, HumanJointAngles};
 use crate::solver::driver::DriverSettings;
-use crate::solver::{JointLimitAvoidance, JointTracking, Settings};
+use crate::solver::{JointBounds, JointLimitAvoidance, JointTracking, Settings};
 
 use super::config::ImitatorConfig;
 use super::error::ImitationError;
@@ -79,6 +80,10 @@ pub(crate) struct PoubelImitator {
     swing: SwingHeight,
     /// Hands as supports, when configured.
     hands: Option<HandSupports>,
+    /// The walk, when the feet follow the human's ([`super::walking`]).
+    walk: Option<WalkFollower>,
+    /// Whether the next support-phase frame takes its held targets afresh (after a walk).
+    rehold: bool,
 }
 
 impl std::fmt::Debug for PoubelImitator {
@@ -164,6 +169,22 @@ impl PoubelImitator {
         if let Some(ahead) = config.look_ahead.take() {
             footsteps = footsteps.with_look_ahead(ahead);
         }
+        let walk = match config.footsteps.follow && config.footsteps.dynamic {
+            true => {
+                let upper_body = (config.upper_body_velocity_fraction)
+                    .unwrap_or(tuning.upper_body_velocity_fraction);
+                let bounds = velocity_bounds(
+                    model,
+                    &position_bounds,
+                    &shared.legs,
+                    config.walking_velocity_fraction,
+                    upper_body,
+                )?;
+                let footsteps = &config.footsteps;
+                Some(WalkFollower::new(profile, q, config.solver, area, footsteps, bounds)?)
+            }
+            false => None,
+        };
         let tracking = JointTracking::new(q)?;
         let human_q = q.clone();
         shared.reserve_output(phases_sizes(&phases));
@@ -195,8 +216,18 @@ impl PoubelImitator {
             com_reference: None,
             swing: SwingHeight::at(0.0),
             hands,
+            walk,
+            rehold: false,
             shared,
         })
+    }
+
+    /// The joint bounds the output respects: the walk's when the robot may walk (faster legs),
+    /// else the support phases'.
+    pub(crate) fn bounds(&self) -> &JointBounds {
+        self.walk
+            .as_ref()
+            .map_or(&self.shared.bounds, WalkFollower::bounds)
     }
 
     /// The task table of `phase`.
@@ -238,9 +269,34 @@ impl PoubelImitator {
             ground_pose(&self.shared.output.right_sole),
         ];
         let leg_ratio = self.scaler.leg_ratio();
-        let wanted = (self.footsteps).update(frame, human, leg_ratio, feet, self.phase, dt);
+        if self.walk.as_ref().is_some_and(WalkFollower::is_walking) {
+            self.footsteps.watch(frame, human, leg_ratio, feet, dt);
+            self.step_walking(frame, human, dt)?;
+        } else {
+            let wanted = (self.footsteps).update(frame, human, leg_ratio, feet, self.phase, dt);
+            if self.may_start_walking(wanted) {
+                self.start_walking(frame.time, feet)?;
+                self.step_walking(frame, human, dt)?;
+            } else {
+                self.step_phases(frame, human, wanted, dt)?;
+            }
+        }
+        self.shared.previous_time = Some(frame.time);
+        self.shared.output.micros = start.elapsed().as_secs_f64() * 1e6;
+        Ok(&self.shared.output)
+    }
+
+    /// A frame of the support phases (Poubel's method): the phase machine, the phase's table.
+    fn step_phases(
+        &mut self,
+        frame: &HumanFrame,
+        human: HumanSupport,
+        wanted: StepRequest,
+        dt: f64,
+    ) -> Result<(), ImitationError> {
         let phase = (self.machine).update_gated(wanted.support, wanted.lift, &self.measurements);
-        let changed = phase != self.phase || self.shared.previous_time.is_none();
+        let changed = phase != self.phase || self.shared.previous_time.is_none() || self.rehold;
+        self.rehold = false;
         self.shared
             .switch_root(self.phases[phase.index()].table.model_root)?;
         self.scale(frame, human)?;
@@ -252,10 +308,87 @@ impl PoubelImitator {
         self.solve(phase, com_target, dt)?;
         self.measure(phase, changed, goal_distance, dt);
         self.write_output(frame, human, phase)?;
+        self.shared.output.walk = None;
         self.phase = phase;
-        self.shared.previous_time = Some(frame.time);
-        self.shared.output.micros = start.elapsed().as_secs_f64() * 1e6;
-        Ok(&self.shared.output)
+        Ok(())
+    }
+
+    /// Whether a walk starts this frame: the robot may walk, stands in double support with no
+    /// step of the support phases planned, and a foot is off the scaled human's footprint.
+    fn may_start_walking(&self, wanted: StepRequest) -> bool {
+        self.walk.is_some()
+            && self.phase == SupportPhase::Double
+            && wanted.support == HumanSupport::Double
+            && self.footsteps.is_idle()
+            && self.footsteps.steps_pending() > 0
+    }
+
+    /// Starts the walk at the human's time `time` (s) from the soles at `feet` (`[left,
+    /// right]`, world), the current CoM and torso height.
+    fn start_walking(&mut self, time: f64, feet: [GroundPose; 2]) -> Result<(), ImitationError> {
+        let now = time + self.shared.paused;
+        let com = self.shared.output.com.xy();
+        let root = self.shared.root;
+        if let Some(walk) = &mut self.walk {
+            walk.start(now, feet, com, root, &self.shared.data[root.index()])?;
+        }
+        Ok(())
+    }
+
+    /// A walking frame: the generator advanced toward the scaled human's footprints, the model
+    /// rooted at the stance sole, the walking table solved. Back to the support phases (in
+    /// DS) once the walk is over.
+    fn step_walking(
+        &mut self,
+        frame: &HumanFrame,
+        human: HumanSupport,
+        dt: f64,
+    ) -> Result<(), ImitationError> {
+        let Some(walk) = &mut self.walk else {
+            return Ok(());
+        };
+        let now = frame.time + self.shared.paused;
+        let over = walk.advance(now, self.footsteps.goals(self.scaler.leg_ratio()))?;
+        self.shared.switch_root(walk.root())?;
+        self.scale(frame, human)?;
+        let Some(walk) = &mut self.walk else {
+            return Ok(());
+        };
+        let planned = walk.targets(&self.shared.world_t_root, now);
+        let targets = FrameTargets {
+            reference: &self.shared.output.reference,
+            com: planned.com,
+            swing_lift: planned.swing_lift,
+            footstep: Some(planned.footstep),
+            tracking_step: self.max_tracking_speed * walk.iteration_dt(dt),
+            hand_contacts: [None; 2],
+            up: planned.up,
+            lowering: planned.lowering,
+        };
+        let criteria = Criteria {
+            limits: &self.limits,
+            tracking: &self.tracking,
+        };
+        let root = self.shared.root;
+        let (model, data) = (
+            self.shared.profile.model(root),
+            &mut self.shared.data[root.index()],
+        );
+        walk.solve(model, data, targets, criteria, &mut self.shared.q, dt)?;
+        let solver = walk.solver();
+        (self.shared.output).record(solver.driver_report(), solver.solve_report());
+        let phase = if over {
+            self.rehold = true;
+            self.com_reference = None;
+            SupportPhase::Double
+        } else {
+            walk.phase()
+        };
+        let state = (!over).then(|| *walk.state());
+        self.write_output(frame, human, phase)?;
+        self.shared.output.walk = state;
+        self.phase = phase;
+        Ok(())
     }
 
     /// Scales the human frame into the root frame (`output.reference`) and sets the
@@ -327,6 +460,8 @@ impl PoubelImitator {
             footstep: self.footstep_in_root(),
             tracking_step: self.max_tracking_speed * step_dt,
             hand_contacts: self.hand_contacts(),
+            up: Vector3::z(),
+            lowering: 0.0,
         };
         let criteria = Criteria {
             limits: &self.limits,
@@ -335,7 +470,7 @@ impl PoubelImitator {
         let model = self.shared.profile.model(self.shared.root);
         let data = &mut self.shared.data[self.shared.root.index()];
         let ps = &mut self.phases[phase.index()];
-        let report = ps.run(
+        ps.run(
             model,
             data,
             targets,
@@ -344,12 +479,7 @@ impl PoubelImitator {
             &self.shared.bounds,
             settings,
         )?;
-        let out = &mut self.shared.output;
-        out.stop = report.stop;
-        let errors = report.task_errors();
-        out.task_count = errors.len().min(out.task_errors.len());
-        out.task_errors[..out.task_count].copy_from_slice(&errors[..out.task_count]);
-        out.record_solve(ps.report());
+        (self.shared.output).record(ps.driver_report(), ps.solve_report());
         Ok(())
     }
 

@@ -198,6 +198,10 @@ pub enum PointTarget {
     /// a support ([`super::hand_support`]); the task has no effect (zero rows) while the hand
     /// is free.
     HandContact(Side),
+    /// Where the walking pattern generator puts the frame this frame ([`super::walking`]): the
+    /// planned sole's ground point, at the frame's rest height plus the planned swing height. A
+    /// sole on the floor or on its swing path.
+    Planned,
 }
 
 /// Target of a [`Task::Orientation`].
@@ -218,6 +222,10 @@ pub enum OrientationTarget {
     /// Flat with the heading of the target footprint of the step the robot is taking (3 rows;
     /// the heading held when no step is planned).
     Footstep,
+    /// The frame's z axis along the walk's planned up direction (2 rows, as `Upright`): a torso
+    /// leaning over the stance hip as far as the walking pattern generator's CoM is from the
+    /// middle of the feet ([`super::walking`]).
+    Leaning,
 }
 
 /// One tracked task of an equality level.
@@ -264,7 +272,7 @@ impl Task {
             } => format!("{frame}.rot"),
             Task::Orientation {
                 frame,
-                target: OrientationTarget::Upright { .. },
+                target: OrientationTarget::Upright { .. } | OrientationTarget::Leaning,
             } => format!("{frame}.upright"),
         }
     }
@@ -279,7 +287,7 @@ impl Task {
                 ..
             } => 3,
             Task::Orientation {
-                target: OrientationTarget::Upright { .. },
+                target: OrientationTarget::Upright { .. } | OrientationTarget::Leaning,
                 ..
             } => 2,
         }
@@ -510,7 +518,7 @@ fn outer_edge(profile: &BipedProfile, foot: Side) -> [f64; 3] {
 
 /// The "collision" level of the executable tables: every self-collision pair of the profile
 /// kept at its margin; none when the profile has no pairs.
-fn self_collision_level(profile: &BipedProfile) -> Option<Level> {
+pub(super) fn self_collision_level(profile: &BipedProfile) -> Option<Level> {
     let collision = &profile.self_collision;
     let constraints: Vec<Constraint> = (collision.pairs.iter())
         .map(|[first, second]| Constraint::Distance {
@@ -989,6 +997,7 @@ impl fmt::Display for PointCell<'_> {
                 write!(f, "{coords} over the footstep + {}", mm(lift))
             }
             PointTarget::HandContact(_) => write!(f, "{coords} on its contact, while a support"),
+            PointTarget::Planned => write!(f, "{coords} as the walk plans"),
         }
     }
 }
@@ -1026,6 +1035,9 @@ impl fmt::Display for TaskTable {
                             }
                             OrientationTarget::Upright { lean } => {
                                 format!("z({frame}) leaning {lean:.2} rad about x")
+                            }
+                            OrientationTarget::Leaning => {
+                                format!("z({frame}) leaning as the walk plans")
                             }
                         });
                     }

@@ -83,6 +83,22 @@ pub struct WalkState {
     pub support: Support,
 }
 
+impl WalkState {
+    /// Standing at `feet` with the CoM at rest above `com_xy` at height `com_height` (m).
+    fn at_rest(feet: [GroundPose; 2], com_xy: Vector2<f64>, com_height: f64) -> Self {
+        WalkState {
+            time: 0.0,
+            com: Vector3::new(com_xy.x, com_xy.y, com_height),
+            com_velocity: Vector2::zeros(),
+            com_acceleration: Vector2::zeros(),
+            zmp: com_xy,
+            zmp_reference: com_xy,
+            feet: feet.map(|f| SolePose::on_floor(&f)),
+            support: Support::Double,
+        }
+    }
+}
+
 /// ZMP preview control over a queue of footsteps (see the module docs of
 /// [`crate::locomotion`]). Allocates its buffers in [`PatternGenerator::new`]; `push` and `tick`
 /// allocate nothing.
@@ -111,9 +127,6 @@ impl PatternGenerator {
         com_xy: Vector2<f64>,
     ) -> Result<Self, LocomotionError> {
         settings.validate()?;
-        if !feet.iter().all(GroundPose::is_finite) || !com_xy.iter().all(|v| v.is_finite()) {
-            return Err(LocomotionError::NonFinite("initial feet or CoM"));
-        }
         let model = CartTable::new(settings.com_height, settings.dt)?;
         let gains = PreviewGains::new(model, settings.preview)?;
         let window = gains.window();
@@ -124,28 +137,39 @@ impl PatternGenerator {
             settings.stop_duration,
             settings.start_duration,
         );
-        let axes = [
-            Vector3::new(com_xy.x, 0.0, 0.0),
-            Vector3::new(com_xy.y, 0.0, 0.0),
-        ];
-        let state = WalkState {
-            time: 0.0,
-            com: Vector3::new(com_xy.x, com_xy.y, settings.com_height),
-            com_velocity: Vector2::zeros(),
-            com_acceleration: Vector2::zeros(),
-            zmp: com_xy,
-            zmp_reference: com_xy,
-            feet: feet.map(|f| SolePose::on_floor(&f)),
-            support: Support::Double,
-        };
-        Ok(Self {
+        let mut generator = Self {
             settings,
             gains,
             schedule,
-            axes,
+            axes: [Vector3::zeros(); 2],
             reference: [vec![0.0; window], vec![0.0; window]],
-            state,
-        })
+            state: WalkState::at_rest(feet, com_xy, settings.com_height),
+        };
+        generator.restart(feet, com_xy)?;
+        Ok(generator)
+    }
+
+    /// Starts over at time 0, the queue empty, the soles standing at `feet` (`[left, right]`,
+    /// world) and the CoM at rest above `com_xy` (m, world); allocates nothing, so a walk can
+    /// start from wherever a robot stands.
+    ///
+    /// # Errors
+    /// [`LocomotionError::NonFinite`] for a non-finite pose or CoM (the generator is unchanged).
+    pub fn restart(
+        &mut self,
+        feet: [GroundPose; 2],
+        com_xy: Vector2<f64>,
+    ) -> Result<(), LocomotionError> {
+        if !feet.iter().all(GroundPose::is_finite) || !com_xy.iter().all(|v| v.is_finite()) {
+            return Err(LocomotionError::NonFinite("initial feet or CoM"));
+        }
+        self.schedule.restart(feet);
+        self.axes = [
+            Vector3::new(com_xy.x, 0.0, 0.0),
+            Vector3::new(com_xy.y, 0.0, 0.0),
+        ];
+        self.state = WalkState::at_rest(feet, com_xy, self.settings.com_height);
+        Ok(())
     }
 
     /// The settings it was built with.

@@ -75,7 +75,7 @@ pub use footstep::{Footstep, GroundPose, StepTiming};
 pub use generator::{PatternGenerator, WalkSettings, WalkState};
 pub use margin::SupportPolygon;
 pub use params::WalkParams;
-pub use planner::{goal_feet, plan_steps};
+pub use planner::{StepPlan, goal_feet, plan_steps};
 pub use preview::{CartTable, PreviewGains, PreviewSettings};
 pub use schedule::{SoleCentres, Support};
 pub use swing::{SolePose, SwingProfile};

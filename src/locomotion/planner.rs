@@ -34,39 +34,68 @@ pub fn plan_steps(
     timing: StepTiming,
     max_steps: usize,
 ) -> Vec<Footstep> {
-    let first = leading_side(feet, goal);
     let mut steps = Vec::new();
-    let mut now = *feet;
-    let mut swing = first;
-    let mut skipped = 0;
-    while steps.len() < max_steps && !arrived(&now, goal) && skipped < 2 {
-        let stance = now[swing.other().index()];
-        let wanted = stance.relative(&goal[swing.index()]);
-        let clipped = envelope.clip(
-            swing,
-            SolePlacement {
-                xy: wanted.xy,
-                yaw: wanted.yaw,
-            },
-        );
-        let target = stance.compose(&GroundPose {
-            xy: clipped.xy,
-            yaw: clipped.yaw,
-        });
-        // A foot already where it can get waits while the other steps.
-        let stays = same(&target, &now[swing.index()]);
-        if !stays {
-            now[swing.index()] = target;
-            steps.push(Footstep {
-                side: swing,
-                target,
-                timing,
-            });
-        }
-        skipped = if stays { skipped + 1 } else { 0 };
-        swing = swing.other();
-    }
+    let plan = StepPlan {
+        envelope,
+        timing,
+        first: None,
+        max_steps,
+    };
+    plan.fill(feet, goal, &mut steps);
     steps
+}
+
+/// How [`StepPlan::fill`] plans: the envelope, the timing of every step, the foot to move
+/// first (`None`: the one that leads toward the goal) and the most steps.
+#[derive(Debug, Clone, Copy)]
+pub struct StepPlan<'a> {
+    /// Where a sole may go relative to the stance sole.
+    pub envelope: &'a FootArea,
+    /// The timing of every step.
+    pub timing: StepTiming,
+    /// The foot to move first; `None`: the side the goal lies or turns toward.
+    pub first: Option<Side>,
+    /// The most steps planned.
+    pub max_steps: usize,
+}
+
+impl StepPlan<'_> {
+    /// Clears `steps` and fills it with the steps from `feet` to `goal` (`[left, right]`,
+    /// world) as [`plan_steps`] does; allocates nothing when `steps` has room for
+    /// `max_steps`.
+    pub fn fill(&self, feet: &[GroundPose; 2], goal: &[GroundPose; 2], steps: &mut Vec<Footstep>) {
+        steps.clear();
+        let mut now = *feet;
+        let mut swing = self.first.unwrap_or_else(|| leading_side(feet, goal));
+        let mut skipped = 0;
+        while steps.len() < self.max_steps && !arrived(&now, goal) && skipped < 2 {
+            let stance = now[swing.other().index()];
+            let wanted = stance.relative(&goal[swing.index()]);
+            let clipped = self.envelope.clip(
+                swing,
+                SolePlacement {
+                    xy: wanted.xy,
+                    yaw: wanted.yaw,
+                },
+            );
+            let target = stance.compose(&GroundPose {
+                xy: clipped.xy,
+                yaw: clipped.yaw,
+            });
+            // A foot already where it can get waits while the other steps.
+            let stays = same(&target, &now[swing.index()]);
+            if !stays {
+                now[swing.index()] = target;
+                steps.push(Footstep {
+                    side: swing,
+                    target,
+                    timing: self.timing,
+                });
+            }
+            skipped = if stays { skipped + 1 } else { 0 };
+            swing = swing.other();
+        }
+    }
 }
 
 /// The foot that leads toward the goal: the side the goal lies or turns toward.

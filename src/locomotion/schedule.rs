@@ -128,6 +128,14 @@ impl Schedule {
         }
     }
 
+    /// Empties the queue with the soles standing at `feet`, as if new (no allocation).
+    pub(super) fn restart(&mut self, feet: [GroundPose; 2]) {
+        self.feet = feet;
+        self.planned = feet;
+        self.steps.clear();
+        self.previous = None;
+    }
+
     pub(super) fn feet(&self) -> &[GroundPose; 2] {
         &self.feet
     }

@@ -174,6 +174,11 @@ impl PositionDriver {
         &self.settings
     }
 
+    /// The outcome of the last [`PositionDriver::run`].
+    pub fn report(&self) -> &DriverReport {
+        &self.report
+    }
+
     /// Replaces the settings (e.g. a new `dt` for a frame that came late).
     pub fn set_settings(&mut self, settings: DriverSettings) -> Result<(), SolverError> {
         settings.validate()?;

@@ -1,0 +1,295 @@
+//! The walk of the imitation: the human's footprints become footsteps of the pattern generator,
+//! and each frame the whole body tracks the generator's CoM and soles ([`super::walking_table`]).
+
+use nalgebra::{IsometryMatrix3, Rotation2, Rotation3, Vector2, Vector3};
+
+use crate::human::Side;
+use crate::imitation::error::ImitationError;
+use crate::imitation::footsteps::{FootstepConfig, GroundPose};
+use crate::imitation::phase::SupportPhase;
+use crate::imitation::phase_solver::{Criteria, FrameTargets, PhaseSolver};
+use crate::locomotion::footstep::{mean_heading, wrap_angle};
+use crate::locomotion::{Footstep, PatternGenerator, StepPlan, Support, WalkParams, WalkState};
+use crate::model::{Model, ModelData};
+use crate::robots::{BipedProfile, FootArea};
+use crate::solver::driver::DriverSettings;
+use crate::solver::{JointBounds, Settings};
+
+/// Steps queued ahead of the robot: the generator previews about one and a half steps, so two
+/// queued steps are all it looks at; more would commit the robot to footprints the human may
+/// still change.
+const QUEUE_AHEAD: usize = 2;
+
+/// Most solver iterations per frame: the walk's references move smoothly, so a few Gauss–Newton
+/// steps meet the feet and the CoM to the solver's precision.
+const ITERATIONS: usize = 2;
+
+/// The robot's walk toward the scaled human's footprints (see the module docs).
+#[derive(Debug)]
+pub(in crate::imitation) struct WalkFollower {
+    generator: PatternGenerator,
+    params: WalkParams,
+    /// The walking table's solver of each root, `[left, right]`.
+    solvers: [PhaseSolver; 2],
+    /// The joint bounds of a walking frame: the legs at the walking velocity fraction.
+    bounds: JointBounds,
+    envelope: FootArea,
+    /// A foot closer to its goal than this (m, rad) does not step.
+    near: (f64, f64),
+    /// The robot's time (s) when the walk started; `None` while standing.
+    started: Option<f64>,
+    /// How far below standing the torso was at the start (m): raised over the first double
+    /// support.
+    start_lowering: f64,
+    root: Side,
+    /// The steps planned this frame (room for [`QUEUE_AHEAD`]).
+    planned: Vec<Footstep>,
+    /// Half the distance between the soles at the start (m): the torso leans fully when the
+    /// CoM is this far from their middle.
+    half_span: f64,
+}
+
+impl WalkFollower {
+    /// A follower for `profile` standing in `q`: the generator's settings from the profile
+    /// ([`WalkParams::for_profile`]), steps within `envelope`, a foot within `config`'s
+    /// distance and heading of its goal left where it is; `bounds` the walking frames' joint
+    /// bounds.
+    pub(in crate::imitation) fn new(
+        profile: &BipedProfile,
+        q: &[f64],
+        settings: Settings,
+        envelope: FootArea,
+        config: &FootstepConfig,
+        bounds: JointBounds,
+    ) -> Result<Self, ImitationError> {
+        let params = WalkParams::for_profile(profile)?;
+        let origin = GroundPose::new(0.0, 0.0, 0.0);
+        let generator = PatternGenerator::new(
+            params.settings,
+            params.centres.clone(),
+            [origin; 2],
+            Vector2::zeros(),
+        )
+        ?;
+        let solver = |root| {
+            let table = super::walking_table(root, profile);
+            let inequalities = table.levels.iter().any(|l| !l.constraints.is_empty());
+            let settings = Settings {
+                scale_to_fit: !inequalities,
+                ..settings
+            };
+            PhaseSolver::new(&table, profile, q, settings)
+        };
+        Ok(Self {
+            generator,
+            params,
+            solvers: [solver(Side::Left)?, solver(Side::Right)?],
+            bounds,
+            envelope,
+            near: (config.distance, config.heading),
+            started: None,
+            start_lowering: 0.0,
+            root: Side::Right,
+            planned: Vec::with_capacity(QUEUE_AHEAD),
+            half_span: 0.0,
+        })
+    }
+
+    /// Whether the robot is walking.
+    pub(in crate::imitation) fn is_walking(&self) -> bool {
+        self.started.is_some()
+    }
+
+    /// The joint bounds of walking frames.
+    pub(in crate::imitation) fn bounds(&self) -> &JointBounds {
+        &self.bounds
+    }
+
+    /// The sole the model is rooted at: the stance sole.
+    pub(in crate::imitation) fn root(&self) -> Side {
+        self.root
+    }
+
+    /// The walk at the last frame.
+    pub(in crate::imitation) fn state(&self) -> &WalkState {
+        self.generator.state()
+    }
+
+    /// The walking table's solver of the current root.
+    pub(in crate::imitation) fn solver(&self) -> &PhaseSolver {
+        &self.solvers[self.root.index()]
+    }
+
+    /// The support phase the walk is in.
+    pub(in crate::imitation) fn phase(&self) -> SupportPhase {
+        match self.generator.state().support {
+            Support::Double => SupportPhase::Double,
+            Support::Single { swing: Side::Left, .. } => SupportPhase::Right,
+            Support::Single { swing: Side::Right, .. } => SupportPhase::Left,
+        }
+    }
+
+    /// Starts a walk at robot time `now` (s) from the soles at `feet` (`[left, right]`, world)
+    /// with the CoM above `com_xy` (world), the model rooted at `root` in the posture whose
+    /// forward kinematics `data` holds.
+    pub(in crate::imitation) fn start(
+        &mut self,
+        now: f64,
+        feet: [GroundPose; 2],
+        com_xy: Vector2<f64>,
+        root: Side,
+        data: &ModelData,
+    ) -> Result<(), ImitationError> {
+        let lowering = self.solvers[root.index()].below_standing(data).max(0.0);
+        (self.generator)
+            .restart(feet, com_xy)
+            ?;
+        self.started = Some(now);
+        self.root = root;
+        self.start_lowering = lowering;
+        self.half_span = (feet[0].xy - feet[1].xy).norm() / 2.0;
+        Ok(())
+    }
+
+    /// Queues the steps toward `goals` (`[left, right]`, world) the generator does not have
+    /// yet and runs it to robot time `now` (s). Returns whether the walk is over: every step
+    /// landed, the CoM at rest, nothing left to step to. Allocates nothing.
+    pub(in crate::imitation) fn advance(
+        &mut self,
+        now: f64,
+        goals: Option<[GroundPose; 2]>,
+    ) -> Result<bool, ImitationError> {
+        let Some(started) = self.started else {
+            return Ok(true);
+        };
+        if let Some(goals) = goals {
+            self.refill(&goals)?;
+        }
+        let dt = self.params.settings.dt;
+        while self.generator.state().time + 0.5 * dt <= now - started {
+            self.generator.tick();
+        }
+        if let Support::Single { swing, .. } = self.generator.state().support {
+            self.root = swing.other();
+        }
+        let over = self.generator.is_stopped() && self.planned.is_empty();
+        if over {
+            self.started = None;
+        }
+        Ok(over)
+    }
+
+    /// Plans up to [`QUEUE_AHEAD`] queued steps from where the queue ends toward `goals`; a
+    /// foot near its goal stays. The feet alternate after the last queued step.
+    fn refill(&mut self, goals: &[GroundPose; 2]) -> Result<(), ImitationError> {
+        self.planned.clear();
+        let queued = self.generator.queued();
+        if queued >= QUEUE_AHEAD {
+            return Ok(());
+        }
+        let from = *self.generator.planned_feet();
+        let goal = [0, 1].map(|i| match self.is_near(&from[i], &goals[i]) {
+            true => from[i],
+            false => goals[i],
+        });
+        let last = self.generator.queued_steps().last().map(|(_, _, s)| s.side);
+        let plan = StepPlan {
+            envelope: &self.envelope,
+            timing: self.params.timing,
+            first: last.map(Side::other),
+            max_steps: QUEUE_AHEAD - queued,
+        };
+        plan.fill(&from, &goal, &mut self.planned);
+        for step in &self.planned {
+            self.generator.push(*step)?;
+        }
+        Ok(())
+    }
+
+    fn is_near(&self, a: &GroundPose, b: &GroundPose) -> bool {
+        (a.xy - b.xy).norm() <= self.near.0 && wrap_angle(a.yaw - b.yaw).abs() <= self.near.1
+    }
+
+    /// The walk's part of a frame's targets in the frame of the root sole placed at
+    /// `world_t_root`: the CoM's ground point, the other sole's planned footprint and height,
+    /// the torso's up direction and lowering.
+    pub(in crate::imitation) fn targets(&self, world_t_root: &IsometryMatrix3<f64>, now: f64) -> WalkTargets {
+        let walk = self.generator.state();
+        let to_root = |p: Vector3<f64>| world_t_root.inverse_transform_point(&p.into()).coords;
+        let root_yaw = crate::imitation::imitator::ground_pose(world_t_root).yaw;
+        let sole = walk.feet[self.root.other().index()];
+        let [x, y, z] = sole.position;
+        let heading = mean_heading(walk.feet[0].yaw, walk.feet[1].yaw);
+        let (sin, cos) = self.lean(walk, heading).sin_cos();
+        let up = Rotation3::from_axis_angle(&Vector3::z_axis(), heading - root_yaw)
+            * Vector3::new(0.0, sin, cos);
+        let elapsed = self.started.map_or(0.0, |s| now - s);
+        let share = (elapsed / self.params.settings.start_duration).clamp(0.0, 1.0);
+        WalkTargets {
+            com: to_root(Vector3::new(walk.com.x, walk.com.y, 0.0)).xy(),
+            footstep: GroundPose {
+                xy: to_root(Vector3::new(x, y, 0.0)).xy(),
+                yaw: wrap_angle(sole.yaw - root_yaw),
+            },
+            swing_lift: z,
+            up,
+            lowering: self.start_lowering * (1.0 - share * share * (3.0 - 2.0 * share)),
+        }
+    }
+
+    /// The torso's sideways lean toward the side the CoM is on (rad, + toward the left): the
+    /// walk's lean times the CoM's offset from the middle of the soles, as a share of half
+    /// their distance at the start.
+    fn lean(&self, walk: &WalkState, heading: f64) -> f64 {
+        let [l, r] = walk.feet.map(|f| Vector2::new(f.position[0], f.position[1]));
+        let offset = Rotation2::new(-heading) * (walk.com.xy() - (l + r) / 2.0);
+        let share = offset.y / self.half_span.max(f64::EPSILON);
+        self.params.torso_lean * share.clamp(-1.0, 1.0)
+    }
+
+    /// The time step (s) of one solver iteration of a frame of `dt` seconds.
+    pub(in crate::imitation) fn iteration_dt(&self, dt: f64) -> f64 {
+        dt / ITERATIONS as f64
+    }
+
+    /// One frame of IK from `q` (updated in place) toward `targets`, within the walking bounds
+    /// over the frame's time step `dt` (s).
+    #[allow(clippy::too_many_arguments)] // the frame's inputs, each from a different owner
+    pub(in crate::imitation) fn solve(
+        &mut self,
+        model: &Model,
+        data: &mut ModelData,
+        targets: FrameTargets<'_>,
+        criteria: Criteria<'_>,
+        q: &mut [f64],
+        dt: f64,
+    ) -> Result<(), ImitationError> {
+        let step_dt = self.iteration_dt(dt);
+        let settings = DriverSettings {
+            gain: 1.0 / step_dt,
+            dt: step_dt,
+            max_iterations: ITERATIONS,
+            tolerance: 1e-7,
+            stall_tolerance: 1e-10,
+            max_task_error: f64::INFINITY,
+            max_joint_step: f64::INFINITY,
+        };
+        let solver = &mut self.solvers[self.root.index()];
+        solver.run(model, data, targets, criteria, q, &self.bounds, settings)
+    }
+}
+
+/// What the walk asks of a frame, in the root sole's frame (m, rad).
+#[derive(Debug, Clone, Copy)]
+pub(in crate::imitation) struct WalkTargets {
+    /// The CoM's ground point.
+    pub(in crate::imitation) com: Vector2<f64>,
+    /// The other sole's ground point and heading.
+    pub(in crate::imitation) footstep: GroundPose,
+    /// The other sole's height above the floor.
+    pub(in crate::imitation) swing_lift: f64,
+    /// The torso's up direction.
+    pub(in crate::imitation) up: Vector3<f64>,
+    /// How far below standing the torso is.
+    pub(in crate::imitation) lowering: f64,
+}

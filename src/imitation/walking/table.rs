@@ -1,0 +1,92 @@
+//! The task table of a walking frame: what the whole body does while the pattern generator
+//! walks it.
+
+use crate::human::{HumanJoint, Side};
+use crate::imitation::phase::SupportPhase;
+use crate::imitation::tables::{
+    Axes, ComGoal, Gradient, GradientKind, Level, OrientationTarget, PointTarget, Task, TaskTable,
+    self_collision_level,
+};
+use crate::robots::BipedProfile;
+
+/// The walking table of the model rooted at `root` (the stance sole; the sole that last stood
+/// alone while both stand), highest priority first:
+///
+/// 1. **foot**: the other sole's position and orientation as the walk plans them (on the floor,
+///    or on its swing path), 6 rows: a sole on the floor does not move;
+/// 2. **collision**: the profile's self-collision pairs (the swing foot passes the stance leg);
+/// 3. **balance**: the CoM's ground point on the generator's CoM;
+/// 4. **torso**: the torso's tilt, leaning over the stance hip as the walk plans;
+/// 5. **height**: the torso at its standing height (the cart-table's CoM height);
+/// 6. **tracking**: both hands on the scaled human's.
+///
+/// Then the paper's gradients (joint limits, the human's joint angles). The legs carry levels
+/// 1–5; the arms follow the human below them, so a hand out of reach never moves a foot or the
+/// CoM.
+pub fn walking_table(root: Side, profile: &BipedProfile) -> TaskTable {
+    let free_sole = &profile.foot(root.other()).sole;
+    let point = |frame: &str, axes, target| Task::Point {
+        frame: frame.to_owned(),
+        offset: [0.0; 3],
+        axes,
+        target,
+    };
+    let level = Level::of_tasks;
+    let mut levels = vec![level(
+        "foot",
+        vec![
+            point(free_sole, Axes::XYZ, PointTarget::Planned),
+            Task::Orientation {
+                frame: free_sole.clone(),
+                target: OrientationTarget::Footstep,
+            },
+        ],
+    )];
+    levels.extend(self_collision_level(profile));
+    let middle = ComGoal::BetweenPoints {
+        support: profile.sole_centre(root),
+        other: profile.sole_centre(root.other()),
+    };
+    levels.push(level("balance", vec![Task::ComXY(middle)]));
+    levels.push(level(
+        "torso",
+        vec![Task::Orientation {
+            frame: profile.torso.clone(),
+            target: OrientationTarget::Leaning,
+        }],
+    ));
+    levels.push(level(
+        "height",
+        vec![point(
+            &profile.torso,
+            Axes::Z,
+            PointTarget::Standing { lower: 0.0 },
+        )],
+    ));
+    levels.push(level(
+        "tracking",
+        vec![
+            point(&profile.hands[0], Axes::XYZ, PointTarget::Scaled(HumanJoint::LHand)),
+            point(&profile.hands[1], Axes::XYZ, PointTarget::Scaled(HumanJoint::RHand)),
+        ],
+    ));
+    TaskTable {
+        phase: match root {
+            Side::Right => SupportPhase::Right,
+            Side::Left => SupportPhase::Left,
+        },
+        model_root: root,
+        levels,
+        gradients: vec![
+            Gradient {
+                kind: GradientKind::JointLimits,
+                kappa: -0.10,
+            },
+            Gradient {
+                kind: GradientKind::HumanJoints,
+                kappa: -0.02,
+            },
+        ],
+        clamping: true,
+    }
+}
