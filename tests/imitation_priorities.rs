@@ -58,6 +58,7 @@ fn filled(
             let mut jac = l.jacobian_mut().subrows_mut(row, rows);
             match task {
                 Task::ComXY(_) => model.com_jacobian_rows(&data, 2, jac).unwrap(),
+                Task::ComHeight => model.com_jacobian_axes(&data, &[Axis::Z], jac).unwrap(),
                 Task::Point {
                     frame,
                     offset,

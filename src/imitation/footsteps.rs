@@ -41,6 +41,10 @@ use crate::human::Side;
 use crate::human::{HumanFrame, HumanJoint};
 use crate::robots::{FootArea, SolePlacement};
 
+/// How long after a human foot lands its footprint is still taken (s): the heel strikes first,
+/// the sole is flat a moment later.
+const LANDING_SETTLE: f64 = 0.2;
+
 /// When the robot steps.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FootstepConfig {
@@ -104,6 +108,7 @@ impl FootstepConfig {
 }
 
 pub use crate::locomotion::GroundPose;
+use crate::locomotion::footstep::mean_heading;
 pub(crate) use crate::locomotion::footstep::wrap_angle as wrap;
 
 /// Whether `phase` shifts the CoM toward a foot with both feet still down.
@@ -160,6 +165,12 @@ pub struct FootstepPlanner {
     config: FootstepConfig,
     /// The human's last footprint of each foot (left, right), human world.
     human: [Option<GroundPose>; 2],
+    /// Each human foot's footprint where it last landed (left, right; human world): taken over
+    /// the first [`LANDING_SETTLE`] seconds on the ground, then kept while the foot stays
+    /// down, so a foot pivoting or rolling in place is no step.
+    landed: [Option<GroundPose>; 2],
+    /// How long each human foot has been on the ground (s).
+    down_for: [f64; 2],
     /// The starting footprints (left, right) of the human and of the robot, and the heading
     /// difference of the starting stances (robot − human, rad).
     origin: Option<([GroundPose; 2], [GroundPose; 2], f64)>,
@@ -201,6 +212,8 @@ impl FootstepPlanner {
             config,
             area,
             human: [None; 2],
+            landed: [None; 2],
+            down_for: [0.0; 2],
             origin: None,
             stance: None,
             down: [true; 2],
@@ -300,7 +313,8 @@ impl FootstepPlanner {
         self.step == Step::Idle
     }
 
-    /// The scaled human footprints (`[left, right]`, robot world), not clipped: the goals of
+    /// Where the human's feet stand, scaled and in the robot's world (`[left, right]`; walking
+    /// dynamically, where they last landed, see `scaled_footprint`), not clipped: the goals of
     /// a walk. `None` before both human feet have been seen on the ground.
     pub(crate) fn goals(&self, ratio: f64) -> Option<[GroundPose; 2]> {
         let [left, right] = Side::BOTH.map(|f| self.scaled_footprint(f, ratio));
@@ -485,10 +499,15 @@ impl FootstepPlanner {
         let down = human.feet();
         self.down = down;
         for foot in Side::BOTH {
-            if down[foot.index()]
+            let i = foot.index();
+            self.down_for[i] = if down[i] { self.down_for[i] + dt } else { 0.0 };
+            if down[i]
                 && let Some(print) = footprint(frame, foot)
             {
-                self.human[foot.index()] = Some(print);
+                self.human[i] = Some(print);
+                if self.landed[i].is_none() || self.down_for[i] <= LANDING_SETTLE {
+                    self.landed[i] = Some(print);
+                }
             }
             // Looking ahead, a foot about to be lifted (or in the air) aims at where it lands.
             let ahead = self.ahead.as_ref();
@@ -528,12 +547,28 @@ impl FootstepPlanner {
         }))
     }
 
-    /// The human's last footprint of `foot`, scaled by `ratio` and moved into the robot's world
-    /// (see the module docs); `None` before the starting stances are known.
+    /// Walking dynamically, where the foot last landed, turned as much as the human's mean foot
+    /// heading turned since the start (a toe-out of the human's walk that was not there at the
+    /// start does not splay the robot's feet); else the foot's last footprint.
     fn scaled_footprint(&self, foot: Side, ratio: f64) -> Option<GroundPose> {
+        if !(self.config.follow && self.config.dynamic) {
+            return self.scaled(self.human[foot.index()]?, foot, ratio);
+        }
+        let ([left, right], (human0, _, _)) = (self.landed, self.origin?);
+        let start = mean_heading(human0[0].yaw, human0[1].yaw);
+        let turned = wrap(mean_heading(left?.yaw, right?.yaw) - start);
+        let print = GroundPose {
+            yaw: human0[foot.index()].yaw + turned,
+            ..self.landed[foot.index()]?
+        };
+        self.scaled(print, foot, ratio)
+    }
+
+    /// `print`, a footprint of the human's `foot`, scaled by `ratio` and moved into the robot's
+    /// world (see the module docs); `None` before the starting stances are known.
+    fn scaled(&self, print: GroundPose, foot: Side, ratio: f64) -> Option<GroundPose> {
         let (human0, robot0, turn) = self.origin?;
         let (h0, r0) = (human0[foot.index()], robot0[foot.index()]);
-        let print = self.human[foot.index()]?;
         Some(GroundPose {
             xy: r0.xy + Rotation2::new(turn) * ((print.xy - h0.xy) * ratio),
             yaw: wrap(r0.yaw + print.yaw - h0.yaw),

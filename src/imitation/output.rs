@@ -107,7 +107,10 @@ impl RobotFrame {
             HumanSupport::Left => self.phase == SupportPhase::Left,
             HumanSupport::Airborne => true,
         };
-        !self.phase.is_transition() && self.pending_steps == 0 && same_support && self.walk.is_none()
+        !self.phase.is_transition()
+            && self.pending_steps == 0
+            && same_support
+            && self.walk.is_none()
     }
 
     /// The frame before the first step: posture `q` with the right sole at the world origin

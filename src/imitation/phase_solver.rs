@@ -73,9 +73,8 @@ pub(super) struct FrameTargets<'a> {
     /// The walk's up direction of the torso (unit): the target of
     /// [`OrientationTarget::Leaning`].
     pub(super) up: Vector3<f64>,
-    /// How far (m) below the table's own `Standing` targets the points go this frame: the walk
-    /// raises the torso from the support phases' height to standing over its start.
-    pub(super) lowering: f64,
+    /// The CoM's height above the root sole (m): the target of [`Task::ComHeight`].
+    pub(super) com_height: f64,
 }
 
 /// The gradient criteria of the imitator, shared by every phase.
@@ -128,6 +127,7 @@ impl PhaseSolver {
             for task in &l.tasks {
                 let (point, axes) = match task {
                     Task::ComXY(_) => (None, Axes::XY),
+                    Task::ComHeight => (None, Axes::Z),
                     Task::Point {
                         frame,
                         offset,
@@ -206,25 +206,6 @@ impl PhaseSolver {
                 task.held_yaw = x.y.atan2(x.x);
             }
         }
-    }
-
-    /// How far (m) the table's `Standing` points are below their standing heights in `data`
-    /// (the largest; 0 without one).
-    pub(super) fn below_standing(&self, data: &ModelData) -> f64 {
-        let standing = self.tasks.iter().filter_map(|t| match (&t.task, &t.point) {
-            (
-                Task::Point {
-                    target: PointTarget::Standing { .. },
-                    ..
-                },
-                Some(p),
-            ) => {
-                let now = data.frame_placement(p.frame).transform_point(&p.offset.into());
-                Some(t.standing.z - now.z)
-            }
-            _ => None,
-        });
-        standing.fold(0.0, f64::max)
     }
 
     /// The lift (m) of the table's held point, the swing foot's, if it has one.
@@ -440,7 +421,14 @@ impl PhaseTasks<'_> {
         let (model, data) = (self.model, &*self.data);
         let Some(point) = &task.point else {
             let com = self.targets.com;
-            return Ok(com_rows(model, data, &[com.x, com.y], jacobian, error)?);
+            match task.task {
+                Task::ComHeight => {
+                    model.com_jacobian_axes(data, &[Axis::Z], jacobian)?;
+                    error[0] = self.targets.com_height - model.com(data)?.z;
+                }
+                _ => com_rows(model, data, &[com.x, com.y], jacobian, error)?,
+            }
+            return Ok(());
         };
         match task.task {
             // A free hand's support task: no rows.
@@ -494,7 +482,7 @@ impl PhaseTasks<'_> {
                 jacobian,
                 error,
             )?,
-            Task::ComXY(_) => unreachable!("a CoM task has no point"),
+            Task::ComXY(_) | Task::ComHeight => unreachable!("a CoM task has no point"),
         }
         Ok(())
     }
@@ -523,9 +511,7 @@ impl PhaseTasks<'_> {
                 task.held.y,
                 task.rest_height + targets.swing_lift,
             ),
-            PointTarget::Standing { lower } => {
-                task.standing - Vector3::z() * (lower + targets.lowering)
-            }
+            PointTarget::Standing { lower } => task.standing - Vector3::z() * lower,
             PointTarget::Footstep { lift } => {
                 let xy = targets.footstep.map_or(task.held.xy(), |f| f.xy);
                 Vector3::new(xy.x, xy.y, task.rest_height + lift)

@@ -181,7 +181,14 @@ impl PoubelImitator {
                     upper_body,
                 )?;
                 let footsteps = &config.footsteps;
-                Some(WalkFollower::new(profile, q, config.solver, area, footsteps, bounds)?)
+                Some(WalkFollower::new(
+                    profile,
+                    q,
+                    config.solver,
+                    area,
+                    footsteps,
+                    bounds,
+                )?)
             }
             false => None,
         };
@@ -274,7 +281,7 @@ impl PoubelImitator {
             self.step_walking(frame, human, dt)?;
         } else {
             let wanted = (self.footsteps).update(frame, human, leg_ratio, feet, self.phase, dt);
-            if self.may_start_walking(wanted) {
+            if self.may_start_walking(wanted, &feet) {
                 self.start_walking(frame.time, feet)?;
                 self.step_walking(frame, human, dt)?;
             } else {
@@ -314,23 +321,25 @@ impl PoubelImitator {
     }
 
     /// Whether a walk starts this frame: the robot may walk, stands in double support with no
-    /// step of the support phases planned, and a foot is off the scaled human's footprint.
-    fn may_start_walking(&self, wanted: StepRequest) -> bool {
-        self.walk.is_some()
-            && self.phase == SupportPhase::Double
+    /// step of the support phases planned, and would step toward where the human's feet landed.
+    fn may_start_walking(&mut self, wanted: StepRequest, feet: &[GroundPose; 2]) -> bool {
+        let goals = self.footsteps.goals(self.scaler.leg_ratio());
+        let (Some(walk), Some(goals)) = (&mut self.walk, goals) else {
+            return false;
+        };
+        self.phase == SupportPhase::Double
             && wanted.support == HumanSupport::Double
             && self.footsteps.is_idle()
-            && self.footsteps.steps_pending() > 0
+            && walk.has_steps(feet, &goals)
     }
 
     /// Starts the walk at the human's time `time` (s) from the soles at `feet` (`[left,
-    /// right]`, world), the current CoM and torso height.
+    /// right]`, world) and the current CoM.
     fn start_walking(&mut self, time: f64, feet: [GroundPose; 2]) -> Result<(), ImitationError> {
         let now = time + self.shared.paused;
-        let com = self.shared.output.com.xy();
-        let root = self.shared.root;
+        let (com, root) = (self.shared.output.com, self.shared.root);
         if let Some(walk) = &mut self.walk {
-            walk.start(now, feet, com, root, &self.shared.data[root.index()])?;
+            walk.start(now, feet, com, root)?;
         }
         Ok(())
     }
@@ -363,7 +372,7 @@ impl PoubelImitator {
             tracking_step: self.max_tracking_speed * walk.iteration_dt(dt),
             hand_contacts: [None; 2],
             up: planned.up,
-            lowering: planned.lowering,
+            com_height: planned.com_height,
         };
         let criteria = Criteria {
             limits: &self.limits,
@@ -461,7 +470,7 @@ impl PoubelImitator {
             tracking_step: self.max_tracking_speed * step_dt,
             hand_contacts: self.hand_contacts(),
             up: Vector3::z(),
-            lowering: 0.0,
+            com_height: 0.0,
         };
         let criteria = Criteria {
             limits: &self.limits,

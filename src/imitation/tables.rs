@@ -233,6 +233,9 @@ pub enum OrientationTarget {
 pub enum Task {
     /// The CoM ground projection (2 rows).
     ComXY(ComGoal),
+    /// The CoM's height above the root sole (1 row), at the walk's planned height
+    /// ([`super::walking`]): the cart-table's constant height.
+    ComHeight,
     /// Coordinates of a point fixed to a named robot frame (see [`crate::robots::BipedProfile`]), 1–3
     /// rows.
     Point {
@@ -260,6 +263,7 @@ impl Task {
     pub fn name(&self) -> String {
         match self {
             Task::ComXY(_) => "com_xy".to_owned(),
+            Task::ComHeight => "com_z".to_owned(),
             Task::Point {
                 frame,
                 target: PointTarget::HandContact(_),
@@ -281,6 +285,7 @@ impl Task {
     pub fn rows(&self) -> usize {
         match self {
             Task::ComXY(_) => 2,
+            Task::ComHeight => 1,
             Task::Point { axes, .. } => axes.count(),
             Task::Orientation {
                 target: OrientationTarget::HeldFlat | OrientationTarget::Footstep,
@@ -896,7 +901,10 @@ impl TaskTable {
                     Task::Point { offset, .. } if offset.iter().any(|v| !v.is_finite()) => {
                         return Err(not_finite("offset"));
                     }
-                    Task::ComXY(_) | Task::Point { .. } | Task::Orientation { .. } => {}
+                    Task::ComXY(_)
+                    | Task::ComHeight
+                    | Task::Point { .. }
+                    | Task::Orientation { .. } => {}
                 }
                 if !names.insert(name.clone()) {
                     return Err(TableError::DuplicateTask { phase, task: name });
@@ -1014,6 +1022,10 @@ impl fmt::Display for TaskTable {
             for task in &level.tasks {
                 match task {
                     Task::ComXY(goal) => coms.push(ComCell(goal, self.model_root).to_string()),
+                    Task::ComHeight => {
+                        rows += task.rows();
+                        cells.push("z(CoM) as the walk plans".to_owned());
+                    }
                     Task::Point {
                         frame,
                         offset,

@@ -40,13 +40,16 @@ pub fn plan_steps(
         timing,
         first: None,
         max_steps,
+        min_move: GroundPose::new(ARRIVED, 0.0, ARRIVED),
+        alternate: false,
     };
     plan.fill(feet, goal, &mut steps);
     steps
 }
 
 /// How [`StepPlan::fill`] plans: the envelope, the timing of every step, the foot to move
-/// first (`None`: the one that leads toward the goal) and the most steps.
+/// first (`None`: the one that leads toward the goal), the most steps and the smallest move
+/// worth a step.
 #[derive(Debug, Clone, Copy)]
 pub struct StepPlan<'a> {
     /// Where a sole may go relative to the stance sole.
@@ -57,6 +60,14 @@ pub struct StepPlan<'a> {
     pub first: Option<Side>,
     /// The most steps planned.
     pub max_steps: usize,
+    /// A foot whose clipped target is within `min_move.xy.x` metres and `min_move.yaw` radians
+    /// of where it stands does not step (`xy.y` is unused): where the envelope stops a foot
+    /// short of its goal, the next plan would otherwise repeat a step of a few micrometres.
+    pub min_move: GroundPose,
+    /// Whether the feet strictly alternate: the plan ends where the next foot would stay,
+    /// instead of stepping the same foot twice in a row (the robot would stand on one foot for
+    /// two steps' time).
+    pub alternate: bool,
 }
 
 impl StepPlan<'_> {
@@ -68,7 +79,8 @@ impl StepPlan<'_> {
         let mut now = *feet;
         let mut swing = self.first.unwrap_or_else(|| leading_side(feet, goal));
         let mut skipped = 0;
-        while steps.len() < self.max_steps && !arrived(&now, goal) && skipped < 2 {
+        let most_skipped = if self.alternate { 1 } else { 2 };
+        while steps.len() < self.max_steps && !arrived(&now, goal) && skipped < most_skipped {
             let stance = now[swing.other().index()];
             let wanted = stance.relative(&goal[swing.index()]);
             let clipped = self.envelope.clip(
@@ -83,7 +95,7 @@ impl StepPlan<'_> {
                 yaw: clipped.yaw,
             });
             // A foot already where it can get waits while the other steps.
-            let stays = same(&target, &now[swing.index()]);
+            let stays = within(&target, &now[swing.index()], &self.min_move);
             if !stays {
                 now[swing.index()] = target;
                 steps.push(Footstep {
@@ -113,9 +125,12 @@ fn leading_side(feet: &[GroundPose; 2], goal: &[GroundPose; 2]) -> Side {
 }
 
 fn arrived(now: &[GroundPose; 2], goal: &[GroundPose; 2]) -> bool {
-    now.iter().zip(goal).all(|(a, b)| same(a, b))
+    let exact = GroundPose::new(ARRIVED, 0.0, ARRIVED);
+    now.iter().zip(goal).all(|(a, b)| within(a, b, &exact))
 }
 
-fn same(a: &GroundPose, b: &GroundPose) -> bool {
-    (a.xy - b.xy).norm() <= ARRIVED && super::footstep::wrap_angle(a.yaw - b.yaw).abs() <= ARRIVED
+/// Whether `a` is within `tolerance.xy.x` metres and `tolerance.yaw` radians of `b`.
+fn within(a: &GroundPose, b: &GroundPose, tolerance: &GroundPose) -> bool {
+    (a.xy - b.xy).norm() <= tolerance.xy.x
+        && super::footstep::wrap_angle(a.yaw - b.yaw).abs() <= tolerance.yaw
 }

@@ -223,16 +223,30 @@ impl Model {
         &self,
         data: &ModelData,
         rows: usize,
-        mut out: MatMut<'_, f64>,
+        out: MatMut<'_, f64>,
     ) -> Result<(), ModelError> {
         if rows == 0 || rows > 3 {
             return Err(ModelError::BadRowCount(rows));
+        }
+        self.com_jacobian_axes(data, &[Axis::X, Axis::Y, Axis::Z][..rows], out)
+    }
+
+    /// The rows of [`Model::com_jacobian`] of `axes` (1–3, in that order), written into an
+    /// `axes.len()`×n view: `[Axis::Z]` for a CoM height task.
+    pub fn com_jacobian_axes(
+        &self,
+        data: &ModelData,
+        axes: &[Axis],
+        mut out: MatMut<'_, f64>,
+    ) -> Result<(), ModelError> {
+        if axes.is_empty() || axes.len() > 3 {
+            return Err(ModelError::BadRowCount(axes.len()));
         }
         self.check_computed(data)?;
         if self.total_mass <= 0.0 {
             return Err(ModelError::NoMass);
         }
-        self.check_shape(&out, rows)?;
+        self.check_shape(&out, axes.len())?;
         out.fill(0.0);
         let inv_mass = 1.0 / self.total_mass;
         for &i in &self.moving {
@@ -247,8 +261,8 @@ impl Model {
                 JointKind::Prismatic | JointKind::Fixed => axis * share,
             };
             let (k, column) = self.driven(i, column);
-            for r in 0..rows {
-                out[(r, k)] += column[r];
+            for (r, &a) in axes.iter().enumerate() {
+                out[(r, k)] += column[a as usize];
             }
         }
         Ok(())

@@ -38,10 +38,16 @@ pub(in crate::imitation) struct WalkFollower {
     near: (f64, f64),
     /// The robot's time (s) when the walk started; `None` while standing.
     started: Option<f64>,
-    /// How far below standing the torso was at the start (m): raised over the first double
+    /// The CoM's height at the start (m): brought to the walking height over the first double
     /// support.
-    start_lowering: f64,
+    start_height: f64,
     root: Side,
+    /// The generator's state at the tick before its last.
+    previous: WalkState,
+    /// The walk at the frame's time, between `previous` and the generator's state.
+    state: WalkState,
+    /// The foot of the last step queued in this walk.
+    last_side: Option<Side>,
     /// The steps planned this frame (room for [`QUEUE_AHEAD`]).
     planned: Vec<Footstep>,
     /// Half the distance between the soles at the start (m): the torso leans fully when the
@@ -69,8 +75,7 @@ impl WalkFollower {
             params.centres.clone(),
             [origin; 2],
             Vector2::zeros(),
-        )
-        ?;
+        )?;
         let solver = |root| {
             let table = super::walking_table(root, profile);
             let inequalities = table.levels.iter().any(|l| !l.constraints.is_empty());
@@ -81,6 +86,8 @@ impl WalkFollower {
             PhaseSolver::new(&table, profile, q, settings)
         };
         Ok(Self {
+            previous: *generator.state(),
+            state: *generator.state(),
             generator,
             params,
             solvers: [solver(Side::Left)?, solver(Side::Right)?],
@@ -88,8 +95,9 @@ impl WalkFollower {
             envelope,
             near: (config.distance, config.heading),
             started: None,
-            start_lowering: 0.0,
+            start_height: 0.0,
             root: Side::Right,
+            last_side: None,
             planned: Vec::with_capacity(QUEUE_AHEAD),
             half_span: 0.0,
         })
@@ -110,9 +118,9 @@ impl WalkFollower {
         self.root
     }
 
-    /// The walk at the last frame.
+    /// The walk at the last frame's time.
     pub(in crate::imitation) fn state(&self) -> &WalkState {
-        self.generator.state()
+        &self.state
     }
 
     /// The walking table's solver of the current root.
@@ -122,33 +130,46 @@ impl WalkFollower {
 
     /// The support phase the walk is in.
     pub(in crate::imitation) fn phase(&self) -> SupportPhase {
-        match self.generator.state().support {
+        match self.state.support {
             Support::Double => SupportPhase::Double,
-            Support::Single { swing: Side::Left, .. } => SupportPhase::Right,
-            Support::Single { swing: Side::Right, .. } => SupportPhase::Left,
+            Support::Single {
+                swing: Side::Left, ..
+            } => SupportPhase::Right,
+            Support::Single {
+                swing: Side::Right, ..
+            } => SupportPhase::Left,
         }
     }
 
-    /// Starts a walk at robot time `now` (s) from the soles at `feet` (`[left, right]`, world)
-    /// with the CoM above `com_xy` (world), the model rooted at `root` in the posture whose
-    /// forward kinematics `data` holds.
+    /// Starts a walk at robot time `now` (s) from the soles at `feet` (`[left, right]`, world,
+    /// on the floor z = 0) with the CoM at `com` (world), the model rooted at `root`.
     pub(in crate::imitation) fn start(
         &mut self,
         now: f64,
         feet: [GroundPose; 2],
-        com_xy: Vector2<f64>,
+        com: Vector3<f64>,
         root: Side,
-        data: &ModelData,
     ) -> Result<(), ImitationError> {
-        let lowering = self.solvers[root.index()].below_standing(data).max(0.0);
-        (self.generator)
-            .restart(feet, com_xy)
-            ?;
+        self.generator.restart(feet, com.xy())?;
+        self.previous = *self.generator.state();
+        self.state = self.previous;
         self.started = Some(now);
         self.root = root;
-        self.start_lowering = lowering;
+        self.start_height = com.z;
+        self.last_side = None;
         self.half_span = (feet[0].xy - feet[1].xy).norm() / 2.0;
         Ok(())
+    }
+
+    /// Whether the soles standing at `feet` (`[left, right]`, world) would step toward `goals`.
+    /// Allocates nothing.
+    pub(in crate::imitation) fn has_steps(
+        &mut self,
+        feet: &[GroundPose; 2],
+        goals: &[GroundPose; 2],
+    ) -> bool {
+        self.plan(feet, goals, None, QUEUE_AHEAD);
+        !self.planned.is_empty()
     }
 
     /// Queues the steps toward `goals` (`[left, right]`, world) the generator does not have
@@ -165,11 +186,13 @@ impl WalkFollower {
         if let Some(goals) = goals {
             self.refill(&goals)?;
         }
-        let dt = self.params.settings.dt;
-        while self.generator.state().time + 0.5 * dt <= now - started {
+        let elapsed = now - started;
+        while self.generator.state().time < elapsed {
+            self.previous = *self.generator.state();
             self.generator.tick();
         }
-        if let Support::Single { swing, .. } = self.generator.state().support {
+        self.state = between(&self.previous, self.generator.state(), elapsed);
+        if let Support::Single { swing, .. } = self.state.support {
             self.root = swing.other();
         }
         let over = self.generator.is_stopped() && self.planned.is_empty();
@@ -188,22 +211,41 @@ impl WalkFollower {
             return Ok(());
         }
         let from = *self.generator.planned_feet();
+        self.plan(
+            &from,
+            goals,
+            self.last_side.map(Side::other),
+            QUEUE_AHEAD - queued,
+        );
+        for step in &self.planned {
+            self.generator.push(*step)?;
+            self.last_side = Some(step.side);
+        }
+        Ok(())
+    }
+
+    /// Fills `planned` with up to `max_steps` steps from `from` toward `goals`, `first` moving
+    /// first (`None`: the leading foot); a foot near its goal stays.
+    fn plan(
+        &mut self,
+        from: &[GroundPose; 2],
+        goals: &[GroundPose; 2],
+        first: Option<Side>,
+        max_steps: usize,
+    ) {
         let goal = [0, 1].map(|i| match self.is_near(&from[i], &goals[i]) {
             true => from[i],
             false => goals[i],
         });
-        let last = self.generator.queued_steps().last().map(|(_, _, s)| s.side);
         let plan = StepPlan {
             envelope: &self.envelope,
             timing: self.params.timing,
-            first: last.map(Side::other),
-            max_steps: QUEUE_AHEAD - queued,
+            first,
+            max_steps,
+            min_move: GroundPose::new(self.near.0, 0.0, self.near.1),
+            alternate: first.is_some(),
         };
-        plan.fill(&from, &goal, &mut self.planned);
-        for step in &self.planned {
-            self.generator.push(*step)?;
-        }
-        Ok(())
+        plan.fill(from, &goal, &mut self.planned);
     }
 
     fn is_near(&self, a: &GroundPose, b: &GroundPose) -> bool {
@@ -212,9 +254,13 @@ impl WalkFollower {
 
     /// The walk's part of a frame's targets in the frame of the root sole placed at
     /// `world_t_root`: the CoM's ground point, the other sole's planned footprint and height,
-    /// the torso's up direction and lowering.
-    pub(in crate::imitation) fn targets(&self, world_t_root: &IsometryMatrix3<f64>, now: f64) -> WalkTargets {
-        let walk = self.generator.state();
+    /// the torso's up direction, the CoM's height.
+    pub(in crate::imitation) fn targets(
+        &self,
+        world_t_root: &IsometryMatrix3<f64>,
+        now: f64,
+    ) -> WalkTargets {
+        let walk = &self.state;
         let to_root = |p: Vector3<f64>| world_t_root.inverse_transform_point(&p.into()).coords;
         let root_yaw = crate::imitation::imitator::ground_pose(world_t_root).yaw;
         let sole = walk.feet[self.root.other().index()];
@@ -233,7 +279,8 @@ impl WalkFollower {
             },
             swing_lift: z,
             up,
-            lowering: self.start_lowering * (1.0 - share * share * (3.0 - 2.0 * share)),
+            com_height: self.start_height
+                + (walk.com.z - self.start_height) * share * share * (3.0 - 2.0 * share),
         }
     }
 
@@ -241,7 +288,9 @@ impl WalkFollower {
     /// walk's lean times the CoM's offset from the middle of the soles, as a share of half
     /// their distance at the start.
     fn lean(&self, walk: &WalkState, heading: f64) -> f64 {
-        let [l, r] = walk.feet.map(|f| Vector2::new(f.position[0], f.position[1]));
+        let [l, r] = walk
+            .feet
+            .map(|f| Vector2::new(f.position[0], f.position[1]));
         let offset = Rotation2::new(-heading) * (walk.com.xy() - (l + r) / 2.0);
         let share = offset.y / self.half_span.max(f64::EPSILON);
         self.params.torso_lean * share.clamp(-1.0, 1.0)
@@ -290,6 +339,33 @@ pub(in crate::imitation) struct WalkTargets {
     pub(in crate::imitation) swing_lift: f64,
     /// The torso's up direction.
     pub(in crate::imitation) up: Vector3<f64>,
-    /// How far below standing the torso is.
-    pub(in crate::imitation) lowering: f64,
+    /// The CoM's height above the floor.
+    pub(in crate::imitation) com_height: f64,
+}
+
+/// The walk at `time` (s), linearly between the states `a` and `b` of two successive ticks
+/// (`a` itself before the first tick): the generator's 10 ms ticks sampled at any frame rate
+/// without a staircase.
+fn between(a: &WalkState, b: &WalkState, time: f64) -> WalkState {
+    let span = b.time - a.time;
+    if span <= 0.0 {
+        return *b;
+    }
+    let s = ((time - a.time) / span).clamp(0.0, 1.0);
+    let lerp = |x: f64, y: f64| x + (y - x) * s;
+    let mut out = *b;
+    out.time = lerp(a.time, b.time);
+    out.com = a.com.lerp(&b.com, s);
+    out.com_velocity = a.com_velocity.lerp(&b.com_velocity, s);
+    out.com_acceleration = a.com_acceleration.lerp(&b.com_acceleration, s);
+    out.zmp = a.zmp.lerp(&b.zmp, s);
+    out.zmp_reference = a.zmp_reference.lerp(&b.zmp_reference, s);
+    for (o, (p, q)) in out.feet.iter_mut().zip(a.feet.iter().zip(&b.feet)) {
+        o.position = [0, 1, 2].map(|k| lerp(p.position[k], q.position[k]));
+        o.yaw = p.yaw + wrap_angle(q.yaw - p.yaw) * s;
+    }
+    if s < 0.5 {
+        out.support = a.support;
+    }
+    out
 }

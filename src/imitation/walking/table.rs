@@ -1,7 +1,7 @@
 //! The task table of a walking frame: what the whole body does while the pattern generator
 //! walks it.
 
-use crate::human::{HumanJoint, Side};
+use crate::human::Side;
 use crate::imitation::phase::SupportPhase;
 use crate::imitation::tables::{
     Axes, ComGoal, Gradient, GradientKind, Level, OrientationTarget, PointTarget, Task, TaskTable,
@@ -17,12 +17,15 @@ use crate::robots::BipedProfile;
 /// 2. **collision**: the profile's self-collision pairs (the swing foot passes the stance leg);
 /// 3. **balance**: the CoM's ground point on the generator's CoM;
 /// 4. **torso**: the torso's tilt, leaning over the stance hip as the walk plans;
-/// 5. **height**: the torso at its standing height (the cart-table's CoM height);
-/// 6. **tracking**: both hands on the scaled human's.
+/// 5. **height**: the CoM at the cart-table's height.
 ///
-/// Then the paper's gradients (joint limits, the human's joint angles). The legs carry levels
-/// 1–5; the arms follow the human below them, so a hand out of reach never moves a foot or the
-/// CoM.
+/// Then the paper's gradients (joint limits, the human's joint angles): the arms follow the
+/// human's joint angles, not the hands' positions. A hand level below the height drove the legs
+/// through their remaining freedom onto their limits (the swing knee straight at −0.092 rad in
+/// a few frames on CMU 09_12), and a joint at its limit is held there for every level, so the
+/// torso and the CoM height then lost 5° and 2.5 cm; without it the legs stay free. Tracking
+/// the hands while walking waits for a clamping that holds a joint only for the level that
+/// pushed it (see the changelog).
 pub fn walking_table(root: Side, profile: &BipedProfile) -> TaskTable {
     let free_sole = &profile.foot(root.other()).sole;
     let point = |frame: &str, axes, target| Task::Point {
@@ -55,21 +58,7 @@ pub fn walking_table(root: Side, profile: &BipedProfile) -> TaskTable {
             target: OrientationTarget::Leaning,
         }],
     ));
-    levels.push(level(
-        "height",
-        vec![point(
-            &profile.torso,
-            Axes::Z,
-            PointTarget::Standing { lower: 0.0 },
-        )],
-    ));
-    levels.push(level(
-        "tracking",
-        vec![
-            point(&profile.hands[0], Axes::XYZ, PointTarget::Scaled(HumanJoint::LHand)),
-            point(&profile.hands[1], Axes::XYZ, PointTarget::Scaled(HumanJoint::RHand)),
-        ],
-    ));
+    levels.push(level("height", vec![Task::ComHeight]));
     TaskTable {
         phase: match root {
             Side::Right => SupportPhase::Right,
