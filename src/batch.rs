@@ -623,5 +623,12 @@ pub fn metrics_value(m: &ImitationMetrics, clip: &Path) -> Value {
             "landing": spread(&m.landing_lag),
             "human_lifts": m.human_lifts,
         },
+        "walking": m.walking.map(|w| json!({
+            "steps": w.steps,
+            "mean_speed_m_s": w.mean_speed_m_s,
+            "step_duration_s": w.step_duration_s,
+            "zmp_margin_min_m": w.zmp_margin_min_m,
+            "walking_s": w.walking_s,
+        })),
     })
 }

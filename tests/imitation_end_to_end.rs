@@ -204,6 +204,63 @@ fn walks_are_walked() {
     }
 }
 
+/// How far (m, rad) a standing foot may move in the plan of a dynamic walk: the walking frames
+/// solve two Gauss–Newton iterations per frame for feet that move faster than in the support
+/// phases (measured: 4e-5 m on CMU 09_12).
+const WALKING_FOOT_TOLERANCE: f64 = 1e-4;
+
+/// The dynamic walk ([`FootstepConfig::dynamic`]) on the bundled walks: the robot takes steps of
+/// the NAO's timing (0.5 s double + 0.5 s single support), the plan's ZMP stays at least 5 mm
+/// inside the support polygon on every walking frame (the pattern generator's margin), the
+/// invariants of `run_held` hold (limits, velocities, the CoM over the soles on the floor,
+/// standing feet still) and the robot ends within 25 % of the scaled human's travel after a
+/// 60 s hold (the NAO walks 5 cm steps of 1 s). Physically it still falls (see the changelog): this checks the plan only.
+#[test]
+fn dynamic_walks_are_walked() {
+    for name in [
+        "cmu_07_04_slow_walk.bvh",
+        "cmu_09_12_walk_forward_backward_sideways.bvh",
+        "cmu_131_01_start_walk_stop_maxskel.bvh",
+    ] {
+        let (m, _) = run_held(name, dynamic(), WALKING_FOOT_TOLERANCE, 60.0);
+        let w = m.walking.unwrap_or_else(|| panic!("{name}: never walked"));
+        assert!(w.steps >= 6, "{name}: {w:?}");
+        assert!(w.zmp_margin_min_m >= 0.005, "{name}: {w:?}");
+        let step = w.step_duration_s.expect("several steps per walk");
+        assert!((step - 1.0).abs() < 0.02, "{name}: {w:?}");
+        let t = &m.travel;
+        assert!(
+            (t.robot_m - t.scaled_human_m).abs() <= 0.25 * t.scaled_human_m,
+            "{name}: {t:?}"
+        );
+    }
+}
+
+/// A human standing in place (CMU 02_10: arm gestures, feet pivoting a little) makes the
+/// dynamic walk take no step at all: only where a human foot lands counts.
+#[test]
+fn dynamic_walk_takes_no_step_for_a_standing_human() {
+    let (m, _) = run_held(
+        "cmu_02_10_wash_self_standing_arm_gestures.bvh",
+        dynamic(),
+        HELD_FOOT_TOLERANCE,
+        SETTLE_SECONDS,
+    );
+    assert_eq!(m.walking, None);
+    assert_eq!(m.robot_support_sequence, vec!["DS"]);
+}
+
+fn dynamic() -> ImitatorConfig {
+    ImitatorConfig {
+        footsteps: FootstepConfig {
+            follow: true,
+            dynamic: true,
+            ..FootstepConfig::default()
+        },
+        ..ImitatorConfig::default()
+    }
+}
+
 /// The offline mode ([`FootLookAhead`]) on the clips with one-leg stances it can follow: the
 /// robot's foot never leaves the ground before the human's (no negative lag), its best-timed
 /// lift comes a second or more sooner after the human's lift-off than online and its

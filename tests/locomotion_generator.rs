@@ -462,3 +462,29 @@ fn cancelled_steps_are_not_taken_and_the_walk_stops_safely() {
     );
     assert_eq!(g.planned_feet(), g.standing_feet());
 }
+
+/// `restart` puts a generator that has walked back where a new one starts: the same state, and
+/// the same walk from there, tick for tick; a non-finite pose is refused and leaves it as it was.
+#[test]
+fn a_restarted_generator_walks_like_a_new_one() {
+    let feet = [
+        GroundPose::new(0.3, 0.15, 0.2),
+        GroundPose::new(0.32, 0.05, 0.2),
+    ];
+    let com = Vector2::new(0.33, 0.1);
+    let (centres, _) = nao_centres();
+    let mut fresh = PatternGenerator::new(settings(), centres, feet, com).unwrap();
+    let mut used = generator();
+    walk(&mut used, &[step(Side::Left, 0.04, 0.1, 0.0)]);
+    let before = *used.state();
+    let bad = [GroundPose::new(f64::NAN, 0.0, 0.0), feet[1]];
+    assert!(used.restart(bad, com).is_err());
+    assert_eq!(*used.state(), before);
+    used.restart(feet, com).unwrap();
+    assert_eq!(used.state(), fresh.state());
+    assert_eq!(used.queued(), 0);
+    assert!(used.is_stopped());
+    let next = step(Side::Right, 0.36, 0.05, 0.2);
+    let (a, b) = (walk(&mut used, &[next]), walk(&mut fresh, &[next]));
+    assert_eq!(a, b);
+}

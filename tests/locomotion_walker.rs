@@ -6,8 +6,8 @@
 use nalgebra::Vector2;
 use taskstack::Side;
 use taskstack::locomotion::{
-    Footstep, GroundPose, StepTiming, SupportPolygon, WalkParams, WholeBodyWalker, goal_feet,
-    plan_steps,
+    Footstep, GroundPose, StepPlan, StepTiming, SupportPolygon, WalkParams, WholeBodyWalker,
+    goal_feet, plan_steps,
 };
 use taskstack::robots::{BipedProfile, FootArea, g1, nao};
 
@@ -245,4 +245,46 @@ fn the_planner_reaches_the_goal_within_the_envelope() {
         steps.len()
     );
     assert!(plan_steps(&feet, &feet, &envelope(), timing, 100).is_empty());
+}
+
+/// [`StepPlan`]: a foot whose clipped target is within `min_move` of where it stands does not
+/// step; with `alternate` the plan ends where the next foot would stay instead of stepping the
+/// same foot twice; the given first foot moves first; `fill` reuses its buffer.
+#[test]
+fn step_plans_skip_small_moves_and_alternate_on_request() {
+    let timing = StepTiming {
+        double_support: 0.5,
+        single_support: 0.5,
+    };
+    let feet = [
+        GroundPose::new(0.0, 0.1, 0.0),
+        GroundPose::new(0.0, 0.0, 0.0),
+    ];
+    let plan = |first, alternate, min_move| StepPlan {
+        envelope: &nao::STEP_ENVELOPE,
+        timing,
+        first,
+        max_steps: 4,
+        min_move,
+        alternate,
+    };
+    let exact = GroundPose::new(1e-9, 0.0, 1e-9);
+    let mut steps = Vec::with_capacity(4);
+    // Only the right foot is off its goal (0.3 m forward, beyond the envelope's 5 cm from the
+    // left): left first, it stays, so the right steps as far as the envelope allows.
+    let goal = [feet[0], GroundPose::new(0.3, 0.0, 0.0)];
+    plan(Some(Side::Left), false, exact).fill(&feet, &goal, &mut steps);
+    assert_eq!(steps[0].side, Side::Right);
+    assert!((steps[0].target.xy.x - 0.05).abs() < 1e-12, "{steps:?}");
+    // Alternating, the left would have to move first: it stays, so nothing is planned.
+    plan(Some(Side::Left), true, exact).fill(&feet, &goal, &mut steps);
+    assert!(steps.is_empty(), "{steps:?}");
+    // A goal 1 cm off is no step with a 2 cm minimum move, one step without it.
+    let near = [feet[0], GroundPose::new(0.01, 0.0, 0.0)];
+    let two_cm = GroundPose::new(0.02, 0.0, 0.087);
+    plan(None, false, two_cm).fill(&feet, &near, &mut steps);
+    assert!(steps.is_empty(), "{steps:?}");
+    plan(None, false, exact).fill(&feet, &near, &mut steps);
+    assert_eq!(steps.len(), 1);
+    assert_eq!(steps[0].side, Side::Right);
 }

@@ -35,6 +35,7 @@ use taskstack::human::HumanFrame;
 use taskstack::human::Side;
 use taskstack::imitation::config::ImitationMethod;
 use taskstack::imitation::contact_events::ContactConfig;
+use taskstack::imitation::footsteps::FootstepConfig;
 use taskstack::imitation::hand_support::{HandContactPlan, HandSupportConfig};
 use taskstack::imitation::imitator::{Imitator, ImitatorConfig, RobotFrame};
 use taskstack::imitation::koenemann::KoenemannConfig;
@@ -321,6 +322,22 @@ fn full_soak_all_clips_ten_passes() {
 fn g1_step_does_not_allocate_after_warm_up() {
     let imitator = Imitator::new(g1::profile(), ImitatorConfig::default()).unwrap();
     assert_no_allocation_after_warm_up(imitator);
+}
+
+/// Nor does the dynamic walk ([`FootstepConfig::dynamic`]): the pattern generator, its step
+/// planning and the walking tables are allocated in `new` (the slow walk, second of the clips,
+/// starts its walks after the warm-up).
+#[test]
+fn dynamic_walk_step_does_not_allocate_after_warm_up() {
+    let config = ImitatorConfig {
+        footsteps: FootstepConfig {
+            follow: true,
+            dynamic: true,
+            ..FootstepConfig::default()
+        },
+        ..ImitatorConfig::default()
+    };
+    assert_no_allocation_after_warm_up(Imitator::new(nao::profile(), config).unwrap());
 }
 
 /// Nor does Koenemann et al.'s method (its IK problems, goals and bounds are built in `new`).

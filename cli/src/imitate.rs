@@ -232,6 +232,19 @@ fn print_summary(
         "travel: scaled human {:.3} m, robot {:.3} m; steps: human {}, robot {}",
         t.scaled_human_m, t.robot_m, m.human_steps, m.robot_steps
     );
+    if let Some(w) = &m.walking {
+        let duration = w
+            .step_duration_s
+            .map_or("-".to_owned(), |d| format!("{d:.2} s"));
+        let _ = writeln!(
+            text,
+            "walking: {} steps in {:.1} s, {:.3} m/s, median step {duration}, planned ZMP >= {:.1} mm inside the support",
+            w.steps,
+            w.walking_s,
+            w.mean_speed_m_s,
+            w.zmp_margin_min_m * 1e3
+        );
+    }
     if m.human_lifts > 0 {
         let _ = writeln!(
             text,

@@ -31,6 +31,7 @@ use super::support::HumanSupport;
 use super::travel::{
     FootTiming, HandTrace, Stance, StepCounter, Travel, TravelRecorder, robot_stance,
 };
+use super::walking::{WalkMeter, WalkingSummary};
 use crate::solver::JointBounds;
 use crate::tasks::{convex_hull, hull_margin};
 
@@ -271,6 +272,8 @@ pub struct ImitationMetrics {
     /// continuous phase, no step pending, on the human's feet. False after a hold that ended
     /// before the robot did (a fixed one too short, or the cap of an automatic one).
     pub finished: bool,
+    /// The robot's walks ([`super::walking`]); `None` when it never walked.
+    pub walking: Option<WalkingSummary>,
 }
 
 /// Accumulates [`ImitationMetrics`] frame by frame.
@@ -323,6 +326,7 @@ pub struct MetricsRecorder {
     pending: usize,
     /// Frames and last time when the clip ended ([`MetricsRecorder::mark_clip_end`]).
     clip_end: Option<(usize, f64)>,
+    walking: WalkMeter,
 }
 
 fn continuous_name(phase: SupportPhase) -> Option<&'static str> {
@@ -434,6 +438,7 @@ impl MetricsRecorder {
             human_up: [false; 2],
             pending: 0,
             clip_end: None,
+            walking: WalkMeter::new(profile),
         }
     }
 
@@ -479,6 +484,7 @@ impl MetricsRecorder {
         self.pending = frame.pending_steps;
 
         self.record_supports(frame);
+        self.walking.record(frame);
         self.first_time.get_or_insert(frame.time);
         self.last_time = frame.time;
         self.clock_pause = frame.time - frame.human_time;
@@ -666,6 +672,7 @@ impl MetricsRecorder {
             hand_lag_s,
             human_clock_pause: self.clock_pause,
             finished: self.finished,
+            walking: self.walking.finish(),
             lift_lag: Spread::of(&mut lift_lag),
             landing_lag: Spread::of(&mut landing_lag),
             human_lifts,

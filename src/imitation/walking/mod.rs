@@ -31,6 +31,8 @@
 //! Units: metres, radians, seconds; world frame as the imitation's.
 
 pub(super) mod follower;
+mod meter;
 mod table;
 
+pub use meter::{WalkMeter, WalkingSummary};
 pub use table::walking_table;
