@@ -523,7 +523,7 @@ fn outer_edge(profile: &BipedProfile, foot: Side) -> [f64; 3] {
 
 /// The "collision" level of the executable tables: every self-collision pair of the profile
 /// kept at its margin; none when the profile has no pairs.
-pub(super) fn self_collision_level(profile: &BipedProfile) -> Option<Level> {
+fn self_collision_level(profile: &BipedProfile) -> Option<Level> {
     let collision = &profile.self_collision;
     let constraints: Vec<Constraint> = (collision.pairs.iter())
         .map(|[first, second]| Constraint::Distance {

@@ -78,9 +78,10 @@ impl WalkFollower {
         )?;
         let solver = |root| {
             let table = super::walking_table(root, profile);
-            let inequalities = table.levels.iter().any(|l| !l.constraints.is_empty());
+            // When a velocity bound binds, the whole step slows down and keeps its priorities
+            // (see `walking_table` for what holding the bound joint instead did).
             let settings = Settings {
-                scale_to_fit: !inequalities,
+                scale_to_fit: true,
                 ..settings
             };
             PhaseSolver::new(&table, profile, q, settings)
