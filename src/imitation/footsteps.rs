@@ -325,7 +325,7 @@ impl FootstepPlanner {
     /// walking) or the scaled human footprints (walking).
     fn aims(&mut self, feet: [GroundPose; 2], ratio: f64) -> Aims {
         if self.origin.is_none()
-            && let [Some(l), Some(r)] = self.human
+            && let [Some(l), Some(r)] = *self.prints()
         {
             let heading = |[l, r]: [GroundPose; 2]| wrap(r.yaw + 0.5 * wrap(l.yaw - r.yaw));
             self.origin = Some(([l, r], feet, wrap(heading(feet) - heading([l, r]))));
@@ -551,7 +551,7 @@ impl FootstepPlanner {
     /// heading turned since the start (a toe-out of the human's walk that was not there at the
     /// start does not splay the robot's feet); else the foot's last footprint.
     fn scaled_footprint(&self, foot: Side, ratio: f64) -> Option<GroundPose> {
-        if !(self.config.follow && self.config.dynamic) {
+        if !self.walks_dynamically() {
             return self.scaled(self.human[foot.index()]?, foot, ratio);
         }
         let ([left, right], (human0, _, _)) = (self.landed, self.origin?);
@@ -562,6 +562,20 @@ impl FootstepPlanner {
             ..self.landed[foot.index()]?
         };
         self.scaled(print, foot, ratio)
+    }
+
+    fn walks_dynamically(&self) -> bool {
+        self.config.follow && self.config.dynamic
+    }
+
+    /// The footprints the feet's targets come from: where the human's feet landed when walking
+    /// dynamically (looking ahead, `human` holds where a foot about to lift will land), else
+    /// their last footprints.
+    fn prints(&self) -> &[Option<GroundPose>; 2] {
+        match self.walks_dynamically() {
+            true => &self.landed,
+            false => &self.human,
+        }
     }
 
     /// `print`, a footprint of the human's `foot`, scaled by `ratio` and moved into the robot's

@@ -337,7 +337,11 @@ impl PoubelImitator {
     /// right]`, world) and the current CoM.
     fn start_walking(&mut self, time: f64, feet: [GroundPose; 2]) -> Result<(), ImitationError> {
         let now = time + self.shared.paused;
-        let (com, root) = (self.shared.output.com, self.shared.root);
+        self.shared.refresh()?;
+        let root = self.shared.root;
+        let model = self.shared.profile.model(root);
+        let com = model.com(&self.shared.data[root.index()])?;
+        let com = self.shared.world_t_root.transform_point(&com.into()).coords;
         if let Some(walk) = &mut self.walk {
             walk.start(now, feet, com, root)?;
         }
