@@ -79,5 +79,37 @@ fn bench(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, bench);
+/// A dynamic walk (`FootstepConfig::dynamic`, the pattern generator in the imitation) on CMU
+/// 07_04, NAO: the clip replayed in laps, so the robot keeps walking after the human's steps.
+fn dynamic_walk(c: &mut Criterion) {
+    let frames = frames("cmu_07_04_slow_walk.bvh");
+    let duration = frames.last().unwrap().time - frames[0].time + 1.0 / 120.0;
+    let mut config = ImitatorConfig::default();
+    config.footsteps.follow = true;
+    config.footsteps.dynamic = true;
+    let mut imitator = Imitator::new(nao::profile(), config).unwrap();
+    let walking = frames
+        .iter()
+        .filter(|f| imitator.step(f).unwrap().walk.is_some())
+        .count();
+    eprintln!(
+        "nao poubel dynamic walk 07_04: {} frames, {walking} walking on the first pass",
+        frames.len()
+    );
+    let (mut i, mut lap) = (0, 1.0);
+    c.bench_function("imitator_step/nao/poubel/dynamic_walk_07_04", |b| {
+        b.iter(|| {
+            let mut frame = frames[i];
+            frame.time += lap * duration;
+            i += 1;
+            if i == frames.len() {
+                i = 0;
+                lap += 1.0;
+            }
+            black_box(imitator.step(&frame).unwrap().q[0])
+        })
+    });
+}
+
+criterion_group!(benches, bench, dynamic_walk);
 criterion_main!(benches);
