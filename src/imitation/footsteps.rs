@@ -58,9 +58,9 @@ pub struct FootstepConfig {
     /// With `follow`, walk with the pattern generator ([`super::walking`]): dynamic steps of
     /// the profile's timing (NAO: 0.5 s double + 0.5 s single support) instead of quasi-static
     /// ones (the CoM moved over the stance foot before each lift). Off by default: **not yet
-    /// physically executable** — on the bundled walks the judge's NAO stands on the nominal
-    /// model but its CoM leaves the contact area 5–14 % of the time, and 2 of 16 runs fall on
-    /// the weak model (see the changelog).
+    /// physically executable** — on the bundled walks the judge's NAO does not fall, but its
+    /// CoM leaves the contact area 3–17 % of the time and a loaded foot turns up to 6° (see the
+    /// changelog).
     pub dynamic: bool,
     /// A foot farther than this from its target (m) is moved by a step. Default 0.02.
     pub distance: f64,
