@@ -42,7 +42,6 @@ fn bench(c: &mut Criterion) {
     .flat_map(|case| methods.map(|method| (case, method)))
     {
         let frames = frames(clip);
-        let duration = frames.last().unwrap().time - frames[0].time + 1.0 / 120.0;
         let config = ImitatorConfig {
             method,
             ..ImitatorConfig::default()
@@ -58,32 +57,34 @@ fn bench(c: &mut Criterion) {
             "{robot} {method_name} {label}: {} frames, {single} in single support on the first pass",
             frames.len()
         );
-        let mut i = 0;
-        let mut lap = 1.0;
-        c.bench_function(
-            &format!("imitator_step/{robot}/{method_name}/{label}"),
-            |b| {
-                b.iter(|| {
-                    // Replay the clip with increasing times so the imitator sees a continuous stream.
-                    let mut frame = frames[i];
-                    frame.time += lap * duration;
-                    i += 1;
-                    if i == frames.len() {
-                        i = 0;
-                        lap += 1.0;
-                    }
-                    black_box(imitator.step(&frame).unwrap().q[0])
-                })
-            },
-        );
+        let name = format!("imitator_step/{robot}/{method_name}/{label}");
+        bench_laps(c, &name, &mut imitator, &frames);
     }
+}
+
+/// Benches `imitator.step` on `frames` replayed in laps with increasing times, so the imitator
+/// sees a continuous stream.
+fn bench_laps(c: &mut Criterion, name: &str, imitator: &mut Imitator, frames: &[HumanFrame]) {
+    let duration = frames.last().unwrap().time - frames[0].time + 1.0 / 120.0;
+    let (mut i, mut lap) = (0, 1.0);
+    c.bench_function(name, |b| {
+        b.iter(|| {
+            let mut frame = frames[i];
+            frame.time += lap * duration;
+            i += 1;
+            if i == frames.len() {
+                i = 0;
+                lap += 1.0;
+            }
+            black_box(imitator.step(&frame).unwrap().q[0])
+        })
+    });
 }
 
 /// A dynamic walk (`FootstepConfig::dynamic`, the pattern generator in the imitation) on CMU
 /// 07_04, NAO: the clip replayed in laps, so the robot keeps walking after the human's steps.
 fn dynamic_walk(c: &mut Criterion) {
     let frames = frames("cmu_07_04_slow_walk.bvh");
-    let duration = frames.last().unwrap().time - frames[0].time + 1.0 / 120.0;
     let mut config = ImitatorConfig::default();
     config.footsteps.follow = true;
     config.footsteps.dynamic = true;
@@ -96,19 +97,12 @@ fn dynamic_walk(c: &mut Criterion) {
         "nao poubel dynamic walk 07_04: {} frames, {walking} walking on the first pass",
         frames.len()
     );
-    let (mut i, mut lap) = (0, 1.0);
-    c.bench_function("imitator_step/nao/poubel/dynamic_walk_07_04", |b| {
-        b.iter(|| {
-            let mut frame = frames[i];
-            frame.time += lap * duration;
-            i += 1;
-            if i == frames.len() {
-                i = 0;
-                lap += 1.0;
-            }
-            black_box(imitator.step(&frame).unwrap().q[0])
-        })
-    });
+    bench_laps(
+        c,
+        "imitator_step/nao/poubel/dynamic_walk_07_04",
+        &mut imitator,
+        &frames,
+    );
 }
 
 criterion_group!(benches, bench, dynamic_walk);

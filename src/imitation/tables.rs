@@ -376,6 +376,23 @@ pub struct Gradient {
     pub kappa: f64,
 }
 
+impl Gradient {
+    /// The paper's gradients: joint limits (eq. 7, κ = −0.10), then the human's joint angles
+    /// (eq. 8, κ = −0.02).
+    pub const fn paper() -> [Gradient; 2] {
+        [
+            Gradient {
+                kind: GradientKind::JointLimits,
+                kappa: -0.10,
+            },
+            Gradient {
+                kind: GradientKind::HumanJoints,
+                kappa: -0.02,
+            },
+        ]
+    }
+}
+
 /// Everything the IK solves in one phase.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TaskTable {
@@ -635,16 +652,7 @@ impl TaskTable {
                 Level::of_tasks("balance", vec![Task::ComXY(com)]),
                 Level::of_tasks("tracking", tracking),
             ],
-            gradients: vec![
-                Gradient {
-                    kind: GradientKind::JointLimits,
-                    kappa: -0.10,
-                },
-                Gradient {
-                    kind: GradientKind::HumanJoints,
-                    kappa: -0.02,
-                },
-            ],
+            gradients: Gradient::paper().to_vec(),
             clamping: true,
         }
     }

@@ -4,7 +4,7 @@
 use crate::human::Side;
 use crate::imitation::phase::SupportPhase;
 use crate::imitation::tables::{
-    Axes, ComGoal, Gradient, GradientKind, Level, OrientationTarget, PointTarget, Task, TaskTable,
+    Axes, ComGoal, Gradient, Level, OrientationTarget, PointTarget, Task, TaskTable,
 };
 use crate::robots::BipedProfile;
 
@@ -70,16 +70,7 @@ pub fn walking_table(root: Side, profile: &BipedProfile) -> TaskTable {
         },
         model_root: root,
         levels,
-        gradients: vec![
-            Gradient {
-                kind: GradientKind::JointLimits,
-                kappa: -0.10,
-            },
-            Gradient {
-                kind: GradientKind::HumanJoints,
-                kappa: -0.02,
-            },
-        ],
+        gradients: Gradient::paper().to_vec(),
         clamping: true,
     }
 }
