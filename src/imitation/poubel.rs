@@ -343,7 +343,7 @@ impl PoubelImitator {
         let com = model.com(&self.shared.data[root.index()])?;
         let com = self.shared.world_t_root.transform_point(&com.into()).coords;
         if let Some(walk) = &mut self.walk {
-            walk.start(now, feet, com, root)?;
+            walk.start(now, feet, com, root, &self.shared.q)?;
         }
         Ok(())
     }
@@ -364,6 +364,12 @@ impl PoubelImitator {
         let over = walk.advance(now, self.footsteps.goals(self.scaler.leg_ratio()))?;
         self.shared.switch_root(walk.root())?;
         self.scale(frame, human)?;
+        if let Some(walk) = &self.walk {
+            // The body holds the posture it started the walk in: the human's arm angles
+            // brought a forearm 3 mm into the torso with no collision level (see
+            // `walking_table`), and the arms swinging with the human cost the judge's NAO.
+            self.tracking.set_reference(walk.start_posture())?;
+        }
         let Some(walk) = &mut self.walk else {
             return Ok(());
         };
