@@ -27,9 +27,10 @@ pub(crate) struct ImitationOptions {
     #[arg(long)]
     pub(crate) walk: bool,
     /// Experimental: walk with the walking pattern generator (implies `--walk`): dynamic steps
-    /// of the robot's own timing (NAO: 0.5 s double + 0.5 s single support) instead of one
-    /// quasi-static step at a time. Not yet physically executable (the physics judge's NAO
-    /// falls on the bundled clips); for development.
+    /// of the robot's own timing (NAO: 1.0 s double + 0.67 s single support) instead of one
+    /// quasi-static step at a time; the arms hold still while the robot walks. Not yet the
+    /// default: on the bundled clips the physics judge's NAO never falls but misses its
+    /// CoM-in-contact-area check on some walks.
     #[arg(long)]
     pub(crate) dynamic_walk: bool,
     /// After the clip, hold the human's last pose (frames 1/120 s apart) so the robot can
