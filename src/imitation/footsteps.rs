@@ -273,9 +273,7 @@ impl FootstepPlanner {
         if let Some(ahead) = &mut self.ahead {
             ahead.times.observe(phase, dt);
         }
-        self.observe(frame, human, dt);
-        let aims = self.aims(feet, ratio);
-        self.off_target = Side::BOTH.iter().filter(|&&f| aims.off(f)).count();
+        let aims = self.track(frame, human, ratio, feet, dt);
         self.advance(now, phase, dt, &aims);
         if self.step == Step::Idle {
             self.following = None;
@@ -304,9 +302,23 @@ impl FootstepPlanner {
         feet: [GroundPose; 2],
         dt: f64,
     ) {
+        self.track(frame, human, ratio, feet, dt);
+    }
+
+    /// The human's footprints and one-leg stance from this frame, then the feet's targets and
+    /// how many feet are off them.
+    fn track(
+        &mut self,
+        frame: &HumanFrame,
+        human: HumanSupport,
+        ratio: f64,
+        feet: [GroundPose; 2],
+        dt: f64,
+    ) -> Aims {
         self.observe(frame, human, dt);
         let aims = self.aims(feet, ratio);
         self.off_target = Side::BOTH.iter().filter(|&&f| aims.off(f)).count();
+        aims
     }
 
     /// Whether the planner is idle: no step of its own under way.

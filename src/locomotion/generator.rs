@@ -1,10 +1,10 @@
 //! The pattern generator: footsteps in, a CoM whose cart-table ZMP follows the support, and
 //! the swing soles, out, one control tick at a time.
 
-use nalgebra::{Vector2, Vector3};
+use nalgebra::{Rotation2, Rotation3, Vector2, Vector3};
 
 use super::LocomotionError;
-use super::footstep::{Footstep, GroundPose};
+use super::footstep::{Footstep, GroundPose, mean_heading};
 use super::preview::{CartTable, PreviewGains, PreviewSettings, positive};
 use super::schedule::{Schedule, SoleCentres, Support};
 use super::swing::{SolePose, SwingProfile};
@@ -84,6 +84,22 @@ pub struct WalkState {
 }
 
 impl WalkState {
+    /// The torso's up direction (unit) in a frame turned `frame_yaw` rad about the vertical:
+    /// leaning sideways toward the side the CoM is on, by `lean_max` rad times the CoM's
+    /// offset from the middle of the soles (across their mean heading) as a share of
+    /// `half_span` m, at most `lean_max`.
+    pub fn torso_up(&self, lean_max: f64, half_span: f64, frame_yaw: f64) -> Vector3<f64> {
+        let heading = mean_heading(self.feet[0].yaw, self.feet[1].yaw);
+        let [l, r] = self
+            .feet
+            .map(|f| Vector2::new(f.position[0], f.position[1]));
+        let offset = Rotation2::new(-heading) * (self.com.xy() - (l + r) / 2.0);
+        let share = offset.y / half_span.max(f64::EPSILON);
+        let (sin, cos) = (lean_max * share.clamp(-1.0, 1.0)).sin_cos();
+        Rotation3::from_axis_angle(&Vector3::z_axis(), heading - frame_yaw)
+            * Vector3::new(0.0, sin, cos)
+    }
+
     /// Standing at `feet` with the CoM at rest above `com_xy` at height `com_height` (m).
     fn at_rest(feet: [GroundPose; 2], com_xy: Vector2<f64>, com_height: f64) -> Self {
         WalkState {

@@ -286,8 +286,8 @@ impl Schedule {
     }
 }
 
-/// `3s² − 2s³`: from 0 to 1 with zero slope at both ends.
-fn smooth(s: f64) -> f64 {
+/// `3s² − 2s³` of `s` clamped to [0, 1]: from 0 to 1 with zero slope at both ends.
+pub(crate) fn smooth(s: f64) -> f64 {
     let s = s.clamp(0.0, 1.0);
     s * s * (3.0 - 2.0 * s)
 }

@@ -11,10 +11,11 @@
 use nalgebra::{IsometryMatrix3, Rotation3, Translation3, Vector2, Vector3};
 
 use super::LocomotionError;
-use super::footstep::{Footstep, GroundPose, mean_heading};
+use super::footstep::{Footstep, GroundPose};
 use super::generator::{PatternGenerator, WalkState};
 use super::params::{WalkParams, standing_feet};
 use super::schedule::Support;
+use super::schedule::smooth;
 use super::swing::SolePose;
 use crate::Error;
 use crate::human::Side;
@@ -134,12 +135,10 @@ impl<'p> WholeBodyWalker<'p> {
         if let Support::Single { swing, .. } = walk.support {
             self.root = swing.other();
         }
-        let heading = mean_heading(walk.feet[0].yaw, walk.feet[1].yaw);
         let root = self.root;
         let root_pose = self.generator.standing_feet()[root.index()];
         let other = walk.feet[root.other().index()];
         let com_height = self.com_height(walk.time);
-        let lean = self.lean(&walk, heading);
         let stack = &mut self.stacks[root.index()];
         let other_name = &self.profile.foot(root.other()).sole;
         stack.set.task_mut::<PoseTask>(other_name)?.target = local_pose(&root_pose, &other);
@@ -147,9 +146,7 @@ impl<'p> WholeBodyWalker<'p> {
         let com_target = Vector3::new(com_local.x, com_local.y, com_height);
         stack.set.task_mut::<ComTask>("com")?.target = com_target;
         stack.set.task_mut::<ComTask>("com height")?.target = com_target;
-        let (sin, cos) = lean.sin_cos();
-        let up = Rotation3::from_axis_angle(&Vector3::z_axis(), heading - root_pose.yaw)
-            * Vector3::new(0.0, sin, cos);
+        let up = walk.torso_up(self.params.torso_lean, self.half_span, root_pose.yaw);
         stack.set.task_mut::<UprightTask>("torso")?.set_up(up)?;
         let report =
             stack
@@ -165,29 +162,15 @@ impl<'p> WholeBodyWalker<'p> {
         Ok(&self.frame)
     }
 
-    /// The torso's sideways lean toward the side the CoM is on (rad, + toward the left): the
-    /// profile's lean times the CoM's offset from the line between the soles, as a share of
-    /// half their standing distance.
-    fn lean(&self, walk: &WalkState, heading: f64) -> f64 {
-        let lean_max = self.params.torso_lean;
-        let [l, r] = walk
-            .feet
-            .map(|f| Vector2::new(f.position[0], f.position[1]));
-        let mid = (l + r) / 2.0;
-        let offset = nalgebra::Rotation2::new(-heading) * (walk.com.xy() - mid);
-        lean_max * (offset.y / self.half_span).clamp(-1.0, 1.0)
-    }
-
     /// The CoM height at `time` (m): from standing down to the walking height over the start
     /// time, then constant.
     fn com_height(&self, time: f64) -> f64 {
-        let share = (time / self.params.settings.start_duration).clamp(0.0, 1.0);
-        let smooth = share * share * (3.0 - 2.0 * share);
+        let share = smooth(time / self.params.settings.start_duration);
         let (stand, walk) = (
             self.params.standing_com_height,
             self.params.settings.com_height,
         );
-        stand + (walk - stand) * smooth
+        stand + (walk - stand) * share
     }
 }
 

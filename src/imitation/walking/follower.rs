@@ -1,7 +1,7 @@
 //! The walk of the imitation: the human's footprints become footsteps of the pattern generator,
 //! and each frame the whole body tracks the generator's CoM and soles ([`super::walking_table`]).
 
-use nalgebra::{IsometryMatrix3, Rotation2, Rotation3, Vector2, Vector3};
+use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 
 use crate::human::Side;
 use crate::imitation::error::ImitationError;
@@ -335,10 +335,7 @@ impl WalkFollower {
         let root_yaw = crate::imitation::imitator::ground_pose(world_t_root).yaw;
         let sole = walk.feet[self.root.other().index()];
         let [x, y, z] = sole.position;
-        let heading = mean_heading(walk.feet[0].yaw, walk.feet[1].yaw);
-        let (sin, cos) = self.lean(walk, heading).sin_cos();
-        let up = Rotation3::from_axis_angle(&Vector3::z_axis(), heading - root_yaw)
-            * Vector3::new(0.0, sin, cos);
+        let up = walk.torso_up(self.params.torso_lean, self.half_span, root_yaw);
         let elapsed = self.started.map_or(0.0, |s| now - s);
         let share = (elapsed / self.params.settings.start_duration).clamp(0.0, 1.0);
         WalkTargets {
@@ -352,18 +349,6 @@ impl WalkFollower {
             com_height: self.start_height
                 + (walk.com.z - self.start_height) * share * share * (3.0 - 2.0 * share),
         }
-    }
-
-    /// The torso's sideways lean toward the side the CoM is on (rad, + toward the left): the
-    /// walk's lean times the CoM's offset from the middle of the soles, as a share of half
-    /// their distance at the start.
-    fn lean(&self, walk: &WalkState, heading: f64) -> f64 {
-        let [l, r] = walk
-            .feet
-            .map(|f| Vector2::new(f.position[0], f.position[1]));
-        let offset = Rotation2::new(-heading) * (walk.com.xy() - (l + r) / 2.0);
-        let share = offset.y / self.half_span.max(f64::EPSILON);
-        self.params.torso_lean * share.clamp(-1.0, 1.0)
     }
 
     /// The time step (s) of one solver iteration of a frame of `dt` seconds.
