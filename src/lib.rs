@@ -106,6 +106,7 @@
 
 pub mod batch;
 pub mod error;
+pub mod export;
 pub mod human;
 pub mod imitation;
 pub mod io;

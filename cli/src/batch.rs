@@ -21,8 +21,9 @@ use crate::run::{Settings, imitate_into};
 
 /// Imitate many clips, each into its own folder OUT/<clip name>/, in parallel.
 ///
-/// Every clip gets the outputs of `taskstack imitate` (joints.csv, metrics.json, view.html and
-/// the SVG plots). A clip that fails does not stop the others; the summary table says which
+/// Every clip gets the outputs of `taskstack imitate` (joints.csv, motion.npz, metrics.json,
+/// view.html and the SVG plots; motion_unitree.csv with --export unitree-csv), so a folder of
+/// clips becomes a dataset in one command; a clip's files appear only when it succeeded. A clip that fails does not stop the others; the summary table says which
 /// failed and why, and the exit status is 1 if any did.
 #[derive(Debug, Args)]
 pub(crate) struct BatchArgs {
@@ -56,6 +57,7 @@ pub(crate) fn run(args: BatchArgs, report: Report) -> Result<ExitCode> {
         config: args.options.imitator_config(),
         hold: args.options.hold,
         map: args.options.skeleton_map()?,
+        exports: args.options.exports(),
     };
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     let jobs = (args.jobs.map_or(cores, |j| j as usize))

@@ -20,7 +20,7 @@ use taskstack::scene::Scene;
 
 use crate::Report;
 use crate::options::{ImitationOptions, open_clip};
-use crate::run::{OUTPUT_FILES, Progress, Settings, default_out, imitate_into};
+use crate::run::{Progress, Settings, default_out, imitate_into};
 
 /// The clip imitated when none is given: CMU 05_02 (standing, arm gestures, small steps, a
 /// stance on the right leg), bundled with the crate.
@@ -37,12 +37,20 @@ const BUNDLED_CLIP: &str = concat!(
 /// --hold seconds. Writes into the output folder, as the frames come:
 ///
 ///   joints.csv     time (s) and the robot's joint angles (rad), one line per frame
+///   motion.npz     for learning pipelines (numpy): fps, time (s), joint_names, dof_pos (rad),
+///                  root_pos (m) and root_quat (x y z w) of the floating base (NAO torso, G1
+///                  pelvis; world: z up, the first right sole at the origin), contacts (left,
+///                  right sole on the floor); resampled to the clip's own rate or --fps
 ///   metrics.json   tracking errors (m), balance margins (m), limits, slip, travel, step times (µs)
 ///   view.html      a 3D viewer of the robot and the scaled human (opens in any browser, offline)
 ///   effectors.svg  each hand's and ankle's distance to the scaled human over time, phases shaded
 ///   com.svg        the CoM ground path inside the footprints, seen from above
 ///   phases.svg     the human's support and the robot's phase over time
 ///   joints.svg     the right arm's joint angles against their limits
+///   motion_unitree.csv  with --export unitree-csv (see --export)
+///
+/// Every file is written as NAME.partial and renamed when the run has succeeded: a failed run
+/// leaves the folder as it was.
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]
 pub(crate) struct ImitateArgs {
@@ -93,6 +101,7 @@ pub(crate) fn run(args: ImitateArgs, report: Report) -> Result<ExitCode> {
         config: args.options.imitator_config(),
         hold: args.options.hold,
         map: args.options.skeleton_map()?,
+        exports: args.options.exports(),
     };
     if args.scene.is_some() || args.offline {
         let source = open_clip(&clip, settings.map.as_ref())?;
@@ -140,7 +149,7 @@ pub(crate) fn run(args: ImitateArgs, report: Report) -> Result<ExitCode> {
         let value = json!({
             "clip": clip,
             "out": out,
-            "files": OUTPUT_FILES,
+            "files": settings.exports.files(),
             "metrics": taskstack::batch::metrics_value(&metrics, &clip),
         });
         let _ = writeln!(text, "{value}");
@@ -262,7 +271,7 @@ fn print_summary(
         text,
         "wrote {}/{{{}}}",
         out.display(),
-        OUTPUT_FILES.join(", ")
+        settings.exports.files().join(", ")
     );
 }
 

@@ -12,6 +12,8 @@ use taskstack::io::clip::Clip;
 use taskstack::io::skeleton_map::SkeletonMap;
 use taskstack::robots::{BipedProfile, g1, nao};
 
+use crate::run::Exports;
+
 /// The longest hold after a clip (s): an hour of the last pose is more than any step needs.
 pub(crate) const MAX_HOLD: f64 = 3600.0;
 
@@ -78,6 +80,23 @@ pub(crate) struct ImitationOptions {
     /// (a loaded foot slides on a real floor).
     #[arg(long, value_enum, default_value_t = RetargetingName::ShiftBothFeet)]
     pub(crate) retargeting: RetargetingName,
+    /// Also write the motion in this layout: `unitree-csv` writes motion_unitree.csv, the
+    /// layout of Unitree's retargeted LAFAN1 dataset (per frame, no header: base x y z (m),
+    /// base quaternion x y z w, the joint angles (rad) in the robot's URDF order; 30 frames a
+    /// second unless --fps).
+    #[arg(long, value_enum, value_name = "FORMAT")]
+    pub(crate) export: Option<ExportFormat>,
+    /// Frame rate of the motion exports (Hz, > 0), resampled from the run's frames. Default:
+    /// motion.npz at the clip's own rate (rounded), --export unitree-csv at 30.
+    #[arg(long, value_name = "HZ", value_parser = positive, allow_negative_numbers = true)]
+    pub(crate) fps: Option<f64>,
+}
+
+/// The motion layouts `--export` writes besides motion.npz.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub(crate) enum ExportFormat {
+    /// motion_unitree.csv: Unitree's retargeted LAFAN1 layout.
+    UnitreeCsv,
 }
 
 /// `--calibration` values.
@@ -116,6 +135,14 @@ impl ImitationOptions {
     }
 
     /// The skeleton map of `--skeleton`, read once for every clip.
+    /// The motion exports asked for.
+    pub(crate) fn exports(&self) -> Exports {
+        Exports {
+            unitree_csv: self.export == Some(ExportFormat::UnitreeCsv),
+            fps: self.fps,
+        }
+    }
+
     pub(crate) fn skeleton_map(&self) -> Result<Option<SkeletonMap>> {
         self.skeleton
             .as_ref()

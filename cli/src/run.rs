@@ -1,5 +1,9 @@
 //! One clip imitated into one output folder, every output streamed as the frames come: the
 //! shared work of `imitate` and `batch`.
+//!
+//! Outputs appear whole or not at all: every file is written as `NAME.partial` and renamed to
+//! `NAME` only when the whole run has succeeded; a failed run removes its partial files, so a
+//! folder holds either the complete outputs of one run or those of an earlier one.
 
 use std::fs::File;
 use std::io::BufWriter;
@@ -8,6 +12,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use serde_json::json;
 use taskstack::batch::{Hold, JointsWriter, imitate_clip, metrics_json};
+use taskstack::export::{MotionRecorder, MotionTrack, write_motion_npz, write_unitree_csv};
 use taskstack::imitation::metrics::ImitationMetrics;
 use taskstack::imitation::support::SupportConfig;
 use taskstack::io::skeleton_map::SkeletonMap;
@@ -18,9 +23,11 @@ use crate::options::open_clip;
 use crate::plots::PlotRecorder;
 use crate::view::ViewWriter;
 
-/// The files each run writes into its output folder.
-pub(crate) const OUTPUT_FILES: [&str; 7] = [
+/// The files each run writes into its output folder (and `motion_unitree.csv` with
+/// `--export unitree-csv`).
+pub(crate) const OUTPUT_FILES: [&str; 8] = [
     "joints.csv",
+    "motion.npz",
     "metrics.json",
     "view.html",
     "effectors.svg",
@@ -36,7 +43,28 @@ pub(crate) struct Settings {
     pub(crate) config: ImitatorConfig,
     pub(crate) hold: Hold,
     pub(crate) map: Option<SkeletonMap>,
+    pub(crate) exports: Exports,
 }
+
+/// The motion exports beside `joints.csv`.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Exports {
+    /// Also write `motion_unitree.csv` (Unitree's LAFAN1 layout).
+    pub(crate) unitree_csv: bool,
+    /// Their frame rate (Hz); `None`: motion.npz at the clip's own rate, the Unitree CSV at 30.
+    pub(crate) fps: Option<f64>,
+}
+
+impl Exports {
+    /// The files a run with these exports writes.
+    pub(crate) fn files(self) -> Vec<&'static str> {
+        let unitree = self.unitree_csv.then_some("motion_unitree.csv");
+        OUTPUT_FILES.into_iter().chain(unitree).collect()
+    }
+}
+
+/// The frame rate of Unitree's retargeted LAFAN1 dataset (Hz).
+const UNITREE_FPS: f64 = 30.0;
 
 /// Progress of a run: the frames expected (clip header + hold; `None` when the clip does not
 /// say), then the frames done so far.
@@ -61,14 +89,27 @@ pub(crate) fn imitate_into(
     ));
     std::fs::create_dir_all(out)
         .with_context(|| format!("output folder {}: cannot create it", out.display()))?;
-    let create = |name: &str| -> Result<BufWriter<File>> {
-        let path = out.join(name);
-        let file = File::create(&path)
-            .with_context(|| format!("output folder {}: cannot write {name}", out.display()))?;
-        Ok(BufWriter::new(file))
-    };
-    let mut joints = JointsWriter::new(create("joints.csv")?);
-    let view_file = create("view.html")?;
+    let mut staged = Staged::new(out);
+    let result = run_staged(clip, source, &mut staged, settings, progress);
+    match result {
+        Ok(metrics) => staged.commit().map(|()| metrics),
+        Err(err) => {
+            staged.discard();
+            Err(err)
+        }
+    }
+}
+
+/// The run itself, every file written through `staged`.
+fn run_staged(
+    clip: &Path,
+    source: taskstack::io::clip::Clip,
+    staged: &mut Staged,
+    settings: &Settings,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<ImitationMetrics> {
+    let mut joints = JointsWriter::new(staged.create("joints.csv")?);
+    let view_file = staged.create("view.html")?;
     let config = ImitatorConfig {
         support: SupportConfig::for_capture(source.capture()),
         ..settings.config.clone()
@@ -80,6 +121,7 @@ pub(crate) fn imitate_into(
         .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
     let mut view = ViewWriter::new(view_file, imitator.profile(), &title)?;
     let mut plots = PlotRecorder::new(&imitator);
+    let mut motion = MotionRecorder::new(&imitator)?;
     joints.header(&imitator)?;
 
     // Writing errors stop the outputs, not the loop; they are reported after it.
@@ -92,7 +134,8 @@ pub(crate) fn imitate_into(
             written = joints
                 .frame(frame)
                 .map_err(anyhow::Error::from)
-                .and_then(|()| view.frame(frame));
+                .and_then(|()| view.frame(frame))
+                .and_then(|()| Ok(motion.record(frame)?));
         }
         plots.record(frame);
         done += 1;
@@ -102,23 +145,106 @@ pub(crate) fn imitate_into(
     };
     let metrics = imitate_clip(clip, source, &mut imitator, settings.hold, each)?;
     progress(Progress::Frames(done));
-    let in_folder = || format!("output folder {}", out.display());
+    let in_folder = || format!("output folder {}", staged.out.display());
     written.with_context(in_folder)?;
     joints.finish().with_context(in_folder)?;
     let clip_end = first_time.unwrap_or(0.0) + metrics.clip_duration;
     let summary = json!({ "frames": metrics.frames, "clip_frames": metrics.clip_frames,
                           "robot_support_sequence": metrics.robot_support_sequence });
     view.finish(clip_end, summary).with_context(in_folder)?;
-    write(out, "metrics.json", metrics_json(&metrics, clip))?;
+    write_exports(
+        staged,
+        &motion.finish(),
+        metrics.clip_frames,
+        settings.exports,
+    )?;
+    staged.write("metrics.json", metrics_json(&metrics, clip))?;
     for (name, svg) in plots.render(&title) {
-        write(out, name, svg)?;
+        staged.write(name, svg)?;
     }
     Ok(metrics)
 }
 
-fn write(out: &Path, name: &str, text: String) -> Result<()> {
-    std::fs::write(out.join(name), text)
-        .with_context(|| format!("output folder {}: cannot write {name}", out.display()))
+/// `motion.npz`, and the Unitree CSV when asked, of `track` (the clip its first
+/// `clip_frames`).
+fn write_exports(
+    staged: &mut Staged,
+    track: &MotionTrack,
+    clip_frames: usize,
+    exports: Exports,
+) -> Result<()> {
+    let folder = staged.out.clone();
+    let in_folder = || format!("output folder {}", folder.display());
+    let rate = exports
+        .fps
+        .or_else(|| track.nominal_rate(clip_frames))
+        .unwrap_or(UNITREE_FPS);
+    write_motion_npz(staged.create("motion.npz")?, track, rate).with_context(in_folder)?;
+    if exports.unitree_csv {
+        let file = staged.create("motion_unitree.csv")?;
+        write_unitree_csv(file, track, exports.fps.unwrap_or(UNITREE_FPS))
+            .with_context(in_folder)?;
+    }
+    Ok(())
+}
+
+/// The files of one run, written as `NAME.partial` until [`Staged::commit`].
+struct Staged {
+    out: PathBuf,
+    names: Vec<String>,
+}
+
+impl Staged {
+    fn new(out: &Path) -> Self {
+        Self {
+            out: out.to_path_buf(),
+            names: Vec::new(),
+        }
+    }
+
+    fn partial(&self, name: &str) -> PathBuf {
+        self.out.join(format!("{name}.partial"))
+    }
+
+    /// A new staged file `name`.
+    fn create(&mut self, name: &str) -> Result<BufWriter<File>> {
+        let file = File::create(self.partial(name)).with_context(|| {
+            format!("output folder {}: cannot write {name}", self.out.display())
+        })?;
+        self.names.push(name.to_owned());
+        Ok(BufWriter::new(file))
+    }
+
+    /// A new staged file `name` holding `text`.
+    fn write(&mut self, name: &str, text: String) -> Result<()> {
+        std::fs::write(self.partial(name), text).with_context(|| {
+            format!("output folder {}: cannot write {name}", self.out.display())
+        })?;
+        self.names.push(name.to_owned());
+        Ok(())
+    }
+
+    /// Renames every staged file to its name, replacing an earlier run's; the Unitree CSV of
+    /// an earlier run that this one did not write goes, so the folder describes one run.
+    fn commit(self) -> Result<()> {
+        for name in &self.names {
+            let path = self.out.join(name);
+            std::fs::rename(self.partial(name), &path).with_context(|| {
+                format!("output folder {}: cannot write {name}", self.out.display())
+            })?;
+        }
+        if !self.names.iter().any(|n| n == "motion_unitree.csv") {
+            let _ = std::fs::remove_file(self.out.join("motion_unitree.csv"));
+        }
+        Ok(())
+    }
+
+    /// Removes every staged file (a failed run leaves nothing behind).
+    fn discard(self) {
+        for name in &self.names {
+            let _ = std::fs::remove_file(self.partial(name));
+        }
+    }
 }
 
 /// The default output folder of a clip: `taskstack-out/<clip file stem>`.

@@ -22,12 +22,16 @@ fn every_subcommand_explains_its_options_and_outputs() {
     assert_eq!(imitate.code, Some(0));
     for needle in [
         "joints.csv",
+        "motion.npz",
         "metrics.json",
         "view.html",
         "effectors.svg",
         "com.svg",
         "phases.svg",
         "joints.svg",
+        "--export",
+        "--fps",
+        "unitree-csv",
         "--hold",
         "[default: auto]",
         "--velocity-fraction",
@@ -84,6 +88,7 @@ fn imitate_writes_every_output_and_reports_clip_and_hold_apart() {
     assert_eq!(run.code, Some(0), "{}", run.stderr);
     for file in [
         "joints.csv",
+        "motion.npz",
         "metrics.json",
         "view.html",
         "effectors.svg",
@@ -136,7 +141,14 @@ fn imitate_json_is_one_document_for_scripts_and_quiet_prints_nothing() {
     assert_eq!(json.code, Some(0), "{}", json.stderr);
     let value: Value = serde_json::from_str(&json.stdout).expect("stdout is one JSON document");
     assert!(value["metrics"]["hand_lag_s"].is_number());
-    assert_eq!(value["files"].as_array().map(Vec::len), Some(7));
+    assert_eq!(value["files"].as_array().map(Vec::len), Some(8));
+    assert!(
+        value["files"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|f| f == "motion.npz")
+    );
     let quiet = taskstack(&[
         "-q",
         "imitate",
@@ -202,6 +214,98 @@ fn fails(args: &[&str], code: i32, needles: &[&str]) {
             run.stderr
         );
     }
+}
+
+#[test]
+fn imitate_exports_unitree_csv_rows_at_the_asked_rate() {
+    let dir = temp_dir("unitree");
+    let out = dir.join("run");
+    let kinect = clip(KINECT);
+    let args = ["imitate", s(&kinect), "--out", s(&out), "--hold", "0.5"];
+    let run = taskstack(&[&args[..], &["--export", "unitree-csv", "--fps", "10"]].concat());
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    let joints = std::fs::read_to_string(out.join("joints.csv")).unwrap();
+    let header = joints.lines().next().unwrap().split(',').count();
+    let times: Vec<f64> = (joints.lines().skip(1))
+        .map(|l| l.split(',').next().unwrap().parse().unwrap())
+        .collect();
+    let span = times[times.len() - 1] - times[0];
+    let csv = std::fs::read_to_string(out.join("motion_unitree.csv")).unwrap();
+    let rows: Vec<Vec<f64>> = (csv.lines())
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    // No header; a row every 0.1 s from the first frame to the last.
+    assert_eq!(rows.len(), (span * 10.0 + 1e-9).floor() as usize + 1);
+    for row in &rows {
+        // x y z, qx qy qz qw, then the joints (joints.csv's columns less its time).
+        assert_eq!(row.len(), 7 + header - 1);
+        let norm: f64 = row[3..7].iter().map(|v| v * v).sum();
+        assert!((norm - 1.0).abs() < 1e-9, "unit quaternion");
+        assert!(
+            (0.25..0.40).contains(&row[2]),
+            "the NAO's torso height {}",
+            row[2]
+        );
+    }
+    // The first row is the first frame: its joints are joints.csv's (6 decimals there).
+    let first: Vec<f64> = (joints.lines().nth(1).unwrap().split(',').skip(1))
+        .map(|v| v.parse().unwrap())
+        .collect();
+    for (a, b) in rows[0][7..].iter().zip(&first) {
+        assert!((a - b).abs() <= 5e-7, "{a} vs {b}");
+    }
+    // Run again without the export: the folder describes the new run only.
+    let run = taskstack(&args);
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    assert!(!out.join("motion_unitree.csv").exists());
+}
+
+#[test]
+fn a_failed_run_leaves_the_folder_as_it_was() {
+    let dir = temp_dir("whole");
+    let out = dir.join("out");
+    let good = taskstack(&["imitate", s(&clip(KINECT)), "--out", s(&out), "--hold", "0"]);
+    assert_eq!(good.code, Some(0), "{}", good.stderr);
+    let before: Vec<(String, Vec<u8>)> = files_in(&out);
+    assert_eq!(
+        before.len(),
+        8,
+        "{:?}",
+        before.iter().map(|f| &f.0).collect::<Vec<_>>()
+    );
+    let text = std::fs::read_to_string(clip(WALK)).unwrap();
+    let truncated = dir.join("truncated.bvh");
+    std::fs::write(&truncated, &text[..text.len() * 2 / 3]).unwrap();
+    let bad = taskstack(&["imitate", s(&truncated), "--out", s(&out), "--hold", "0"]);
+    assert_eq!(bad.code, Some(1));
+    assert!(
+        files_in(&out) == before,
+        "the earlier run's files, untouched, and nothing else"
+    );
+    // Into a new folder: nothing at all.
+    let fresh = dir.join("fresh");
+    let bad = taskstack(&["imitate", s(&truncated), "--out", s(&fresh), "--hold", "0"]);
+    assert_eq!(bad.code, Some(1));
+    assert!(files_in(&fresh).is_empty());
+}
+
+/// The files of `dir` (name, bytes), sorted by name.
+fn files_in(dir: &std::path::Path) -> Vec<(String, Vec<u8>)> {
+    let mut files: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
+        .map(|entries| {
+            entries
+                .map(|e| e.unwrap().path())
+                .map(|p| {
+                    (
+                        p.file_name().unwrap().to_string_lossy().into_owned(),
+                        std::fs::read(&p).unwrap(),
+                    )
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    files.sort();
+    files
 }
 
 #[test]

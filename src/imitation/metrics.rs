@@ -38,6 +38,14 @@ use crate::tasks::{convex_hull, hull_margin};
 /// A foot is on the ground when its outline points are at most this high (m).
 pub const CONTACT_HEIGHT: f64 = 1e-3;
 
+/// Whether a sole is on the floor: every point of its `outline` (sole frame, m) within
+/// [`CONTACT_HEIGHT`] of the floor with the sole at `sole` (world).
+pub fn sole_on_floor(outline: &[[f64; 2]], sole: &IsometryMatrix3<f64>) -> bool {
+    outline
+        .iter()
+        .all(|&[x, y]| sole.transform_point(&[x, y, 0.0].into()).z.abs() <= CONTACT_HEIGHT)
+}
+
 /// Mean and maximum of a series.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct MeanMax {
@@ -528,7 +536,7 @@ impl MetricsRecorder {
         let soles = [&frame.left_sole, &frame.right_sole];
         for (outline, sole) in self.outlines.iter().zip(soles) {
             let corner = |&[x, y]: &[f64; 2]| sole.transform_point(&Vector3::new(x, y, 0.0).into());
-            if outline.iter().all(|c| corner(c).z.abs() <= CONTACT_HEIGHT) {
+            if sole_on_floor(outline, sole) {
                 self.points
                     .extend(outline.iter().map(|c| corner(c).xy().coords));
             }
