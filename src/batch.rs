@@ -38,8 +38,8 @@ use crate::robots::{BipedProfile, nao};
 #[derive(Debug, Error)]
 #[non_exhaustive]
 pub enum BatchError {
-    /// The clip could not be opened or read.
-    #[error("{}: {source}", path.display())]
+    /// The clip could not be opened or read (the reader's message names the clip and line).
+    #[error("{source}")]
     Clip {
         /// The clip file.
         path: PathBuf,
@@ -88,6 +88,9 @@ pub enum BatchError {
         /// The pool's error message.
         message: String,
     },
+    /// A fixed hold that is not a number of seconds in `0..=`[`MAX_HOLD`].
+    #[error("hold of {0} s: must be a number of seconds within 0–{MAX_HOLD} s")]
+    Hold(f64),
 }
 
 /// Options of a batch. The default: the NAO, one thread per core, default imitator settings.
@@ -214,13 +217,15 @@ pub fn clips_in(dir: &Path) -> Result<Vec<PathBuf>, BatchError> {
 }
 
 /// Retargets every clip of `clips` into its folder under `out` (see the module docs), in
-/// parallel with the `parallel` feature. Fails as a whole only when the output folders would
-/// collide or the thread pool cannot start; a clip's own failure is in its [`ClipOutcome`].
+/// parallel with the `parallel` feature. Fails as a whole, before any work, only when
+/// `options.hold` is out of range ([`Hold::validated`]), the output folders would collide or
+/// the thread pool cannot start; a clip's own failure is in its [`ClipOutcome`].
 pub fn retarget_all(
     clips: &[PathBuf],
     out: &Path,
     options: &BatchOptions,
 ) -> Result<BatchSummary, BatchError> {
+    options.hold.validated()?;
     let mut outputs: Vec<PathBuf> = Vec::with_capacity(clips.len());
     let mut seen = HashSet::new();
     for (i, clip) in clips.iter().enumerate() {
@@ -298,6 +303,9 @@ pub const HOLD_STEP: f64 = 1.0 / 120.0;
 /// The longest hold of [`Hold::UntilFinished`] (s).
 pub const HOLD_CAP: f64 = 60.0;
 
+/// The longest fixed hold (s): an hour of the last pose is more than any step needs.
+pub const MAX_HOLD: f64 = 3600.0;
+
 /// How long [`Hold::UntilFinished`] waits with the robot finished before it ends the run (s):
 /// the CoM's last motion toward its goal settles.
 pub const SETTLE_TIME: f64 = 1.0;
@@ -320,6 +328,19 @@ impl From<f64> for Hold {
 }
 
 impl Hold {
+    /// This hold if it is [`Hold::UntilFinished`] or a fixed hold within `0..=`[`MAX_HOLD`].
+    ///
+    /// # Errors
+    /// [`BatchError::Hold`] otherwise (NaN, negative, infinite or longer).
+    pub fn validated(self) -> Result<Self, BatchError> {
+        match self {
+            Hold::Fixed(seconds) if !(0.0..=MAX_HOLD).contains(&seconds) => {
+                Err(BatchError::Hold(seconds))
+            }
+            hold => Ok(hold),
+        }
+    }
+
     /// Whether the hold is over after `held` frames, the robot finished for the last
     /// `finished` of them.
     fn is_over(self, held: u64, finished: u64) -> bool {
@@ -357,8 +378,9 @@ pub fn hold_frames(hold: f64) -> u64 {
 /// `imitate` example.
 ///
 /// # Errors
-/// [`BatchError::Clip`] for a read error, [`BatchError::EmptyClip`] when the clip has no frame,
-/// [`BatchError::Imitation`] naming the frame.
+/// [`BatchError::Hold`] for a hold out of range (before any frame), [`BatchError::Clip`] for a
+/// read error, [`BatchError::EmptyClip`] when the clip has no frame, [`BatchError::Imitation`]
+/// naming the frame.
 pub fn imitate_clip(
     path: &Path,
     mut source: Clip,
@@ -366,7 +388,7 @@ pub fn imitate_clip(
     hold: impl Into<Hold>,
     mut each: impl FnMut(&RobotFrame),
 ) -> Result<ImitationMetrics, BatchError> {
-    let hold = hold.into();
+    let hold = hold.into().validated()?;
     let mut recorder = MetricsRecorder::new(imitator);
     let mut frame = HumanFrame::new(0.0);
     let mut last: Option<HumanFrame> = None;
@@ -486,9 +508,11 @@ impl<W: std::io::Write> JointsWriter<W> {
 }
 
 /// Retargets one clip to `options.robot` and writes `joints.csv` and `metrics.json` into
-/// `output` (created once the clip is open, before any frame is imitated). `joints.csv` is written as the frames
-/// come, so memory stays flat however long the clip. `options.imitator.support` is replaced by
-/// the clip's defaults.
+/// `output` (created once the clip is open, before any frame is imitated). `joints.csv` is
+/// written as the frames come, so memory stays flat however long the clip. Both are written
+/// as `NAME.partial` and renamed when the run has succeeded; a failed run removes them and
+/// leaves an earlier run's files as they were. `options.imitator.support` is replaced by the
+/// clip's defaults.
 pub fn retarget_clip(
     options: &BatchOptions,
     clip: &Path,
@@ -506,7 +530,44 @@ pub fn retarget_clip(
     })?;
     std::fs::create_dir_all(output).map_err(io(output))?;
     let joints_path = output.join("joints.csv");
-    let file = std::fs::File::create(&joints_path).map_err(io(&joints_path))?;
+    let metrics_path = output.join("metrics.json");
+    let [joints_partial, metrics_partial] = [&joints_path, &metrics_path].map(|p| partial(p));
+    let result = write_clip(options, clip, source, &joints_partial, &metrics_partial);
+    let result = result.and_then(|summary| {
+        std::fs::rename(&joints_partial, &joints_path).map_err(io(&joints_path))?;
+        std::fs::rename(&metrics_partial, &metrics_path).map_err(io(&metrics_path))?;
+        Ok(summary)
+    });
+    if result.is_err() {
+        let _ = std::fs::remove_file(&joints_partial);
+        let _ = std::fs::remove_file(&metrics_partial);
+    }
+    let mut summary = result?;
+    summary.wall_time = start.elapsed().as_secs_f64();
+    Ok(summary)
+}
+
+/// `path` with `.partial` appended: where an output is written until its run has succeeded.
+fn partial(path: &Path) -> PathBuf {
+    let mut name = path.as_os_str().to_owned();
+    name.push(".partial");
+    PathBuf::from(name)
+}
+
+/// The run of [`retarget_clip`], writing `joints.csv` and `metrics.json` to the given paths.
+fn write_clip(
+    options: &BatchOptions,
+    clip: &Path,
+    source: Clip,
+    joints_path: &Path,
+    metrics_path: &Path,
+) -> Result<ClipSummary, BatchError> {
+    let path = || clip.to_path_buf();
+    let io = |file: &Path| {
+        let file = file.to_path_buf();
+        move |source| BatchError::Io { path: file, source }
+    };
+    let file = std::fs::File::create(joints_path).map_err(io(joints_path))?;
     let mut joints = JointsWriter::new(std::io::BufWriter::new(file));
     let config = ImitatorConfig {
         support: SupportConfig::for_capture(source.capture()),
@@ -518,7 +579,7 @@ pub fn retarget_clip(
         frame: 0,
         source,
     })?;
-    joints.header(&imitator).map_err(io(&joints_path))?;
+    joints.header(&imitator).map_err(io(joints_path))?;
     let mut written = Ok(());
     let each = |frame: &RobotFrame| {
         if written.is_ok() {
@@ -528,9 +589,8 @@ pub fn retarget_clip(
     let metrics = imitate_clip(clip, source, &mut imitator, options.hold, each)?;
     written
         .and_then(|()| joints.finish())
-        .map_err(io(&joints_path))?;
-    let metrics_path = output.join("metrics.json");
-    std::fs::write(&metrics_path, metrics_json(&metrics, clip)).map_err(io(&metrics_path))?;
+        .map_err(io(joints_path))?;
+    std::fs::write(metrics_path, metrics_json(&metrics, clip)).map_err(io(metrics_path))?;
     let hand = |name: &str| {
         let e = metrics.effectors.iter().find(|e| e.name == name)?;
         e.mean()
@@ -538,7 +598,7 @@ pub fn retarget_clip(
     Ok(ClipSummary {
         frames: metrics.frames,
         duration: metrics.duration,
-        wall_time: start.elapsed().as_secs_f64(),
+        wall_time: 0.0,
         robot_support_changes: metrics.robot_support_changes,
         min_com_margin: metrics.min_com_margin,
         frames_com_outside: metrics.frames_com_outside,

@@ -121,6 +121,68 @@ fn clips_with_the_same_stem_are_refused_before_any_work() {
     assert!(!out.exists());
 }
 
+/// A hold that is not a number of seconds within 0–3600 is refused before any work: an
+/// infinite one would never end the run.
+#[test]
+fn an_out_of_range_hold_is_refused_before_any_work() {
+    use taskstack::batch::{Hold, imitate_clip};
+    use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
+    use taskstack::io::clip::Clip;
+    use taskstack::robots::nao;
+
+    let path = mocap(SHORT[0]);
+    for bad in [f64::INFINITY, f64::NAN, -0.5, 3600.5] {
+        let mut imitator = Imitator::new(nao::profile(), ImitatorConfig::default()).unwrap();
+        let mut frames = 0;
+        let source = Clip::open(&path).unwrap();
+        let err = imitate_clip(&path, source, &mut imitator, bad, |_| frames += 1).unwrap_err();
+        assert!(matches!(err, BatchError::Hold(_)), "{err}");
+        assert_eq!(frames, 0);
+        let out = out_dir("batch_bad_hold");
+        let options = BatchOptions {
+            hold: Hold::Fixed(bad),
+            ..BatchOptions::default()
+        };
+        let err = retarget_all(std::slice::from_ref(&path), &out, &options).unwrap_err();
+        assert!(matches!(err, BatchError::Hold(_)), "{err}");
+        assert!(!out.exists());
+    }
+    assert_eq!(
+        Hold::Fixed(3600.0).validated().unwrap(),
+        Hold::Fixed(3600.0)
+    );
+}
+
+/// A clip that fails part-way leaves no output of its own, and an earlier run's files as they
+/// were.
+#[test]
+fn a_clip_failing_part_way_leaves_the_earlier_outputs() {
+    use taskstack::batch::retarget_clip;
+
+    let out = out_dir("batch_partial");
+    let options = BatchOptions {
+        hold: 0.0.into(),
+        ..BatchOptions::default()
+    };
+    retarget_clip(&options, &mocap(SHORT[0]), &out).unwrap();
+    let joints = std::fs::read(out.join("joints.csv")).unwrap();
+    let metrics = std::fs::read(out.join("metrics.json")).unwrap();
+    let text = std::fs::read_to_string(mocap(SHORT[1])).unwrap();
+    let truncated = out_dir("batch_partial_clip").with_extension("bvh");
+    std::fs::write(&truncated, &text[..text.len() * 2 / 3]).unwrap();
+    let err = retarget_clip(&options, &truncated, &out).unwrap_err();
+    let _ = std::fs::remove_file(&truncated);
+    assert!(matches!(err, BatchError::Clip { .. }), "{err}");
+    assert_eq!(std::fs::read(out.join("joints.csv")).unwrap(), joints);
+    assert_eq!(std::fs::read(out.join("metrics.json")).unwrap(), metrics);
+    let names: Vec<_> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(names.len(), 2, "{names:?}");
+    let _ = std::fs::remove_dir_all(&out);
+}
+
 /// The clip loop holds the human's last pose for `hold` seconds at 120 Hz after the clip: the
 /// extra frames are imitated, passed on and counted, 1/120 s apart after the clip's last frame.
 #[test]

@@ -185,7 +185,7 @@ fn hand_mean(m: &ImitationMetrics, name: &str) -> Option<f64> {
 fn print_table(text: &mut String, done: &[Done], report: Report, jobs: usize, seconds: f64) {
     for d in done {
         if let Err(e) = &d.result {
-            eprintln!("taskstack: error: {e:#}");
+            eprintln!("taskstack: error: {}", crate::describe(e));
         }
     }
     if report.quiet {
@@ -243,7 +243,7 @@ fn batch_json(done: &[Done], jobs: usize, seconds: f64) -> serde_json::Value {
                 "metrics": taskstack::batch::metrics_value(m, &d.clip),
             }),
             Err(e) => {
-                json!({ "clip": d.clip, "out": d.out, "ok": false, "error": format!("{e:#}") })
+                json!({ "clip": d.clip, "out": d.out, "ok": false, "error": crate::describe(e) })
             }
         })
         .collect();

@@ -15,9 +15,10 @@ use taskstack::scene::Scene;
 
 use crate::Report;
 
-/// Lists when the hands, feet (and with --knees, the knees) of a clip's human start and stop
-/// resting on the surfaces of a scene: the chronological contact change list of Di Fava et al.
-/// (eq. 14–15), one offline pass with hysteresis.
+/// List when a clip's human starts and stops resting a hand or foot on a scene's surfaces.
+///
+/// The hands, the feet and (with --knees) the knees: the chronological contact change list of
+/// Di Fava et al. (eq. 14–15), one offline pass with hysteresis.
 ///
 /// The scene is a TOML file of horizontal rectangles (floor, table, stool) in the clip's world
 /// frame (metres, z up); see the `taskstack::scene` docs. Times are the clip's, in seconds.

@@ -88,10 +88,13 @@ pub(crate) struct ImitateArgs {
 }
 
 pub(crate) fn run(args: ImitateArgs, report: Report) -> Result<ExitCode> {
-    let clip = args
-        .clip
-        .clone()
-        .unwrap_or_else(|| PathBuf::from(BUNDLED_CLIP));
+    // The bundled clip's path without the `cli/..` of its build-time spelling.
+    let bundled = || {
+        Path::new(BUNDLED_CLIP)
+            .canonicalize()
+            .unwrap_or_else(|_| BUNDLED_CLIP.into())
+    };
+    let clip = args.clip.clone().unwrap_or_else(bundled);
     if args.clip.is_none() && !clip.is_file() {
         bail!("the bundled clip is not at {}: give a CLIP", clip.display());
     }

@@ -79,10 +79,26 @@ fn main() -> ExitCode {
         Ok(code) => code,
         Err(error) if is_broken_pipe(&error) => ExitCode::SUCCESS,
         Err(error) => {
-            eprintln!("taskstack: error: {error:#}");
+            eprintln!("taskstack: error: {}", describe(&error));
             ExitCode::FAILURE
         }
     }
+}
+
+/// `error` and its causes, `: `-separated, each cause once: our errors' messages already quote
+/// their source's, which `{:#}` would print a second time.
+pub(crate) fn describe(error: &anyhow::Error) -> String {
+    let mut text = String::new();
+    for cause in error.chain() {
+        let message = cause.to_string();
+        if !text.contains(&message) {
+            if !text.is_empty() {
+                text.push_str(": ");
+            }
+            text.push_str(&message);
+        }
+    }
+    text
 }
 
 /// Writes `text` to stdout. A reader that went away (`taskstack … | head`) gives an error that

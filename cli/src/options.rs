@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use clap::Args;
 use taskstack::ImitatorConfig;
-use taskstack::batch::Hold;
+use taskstack::batch::{Hold, MAX_HOLD};
 use taskstack::imitation::config::ImitationMethod;
 use taskstack::imitation::koenemann::{Calibration, FootRetargeting, KoenemannConfig};
 use taskstack::io::clip::Clip;
@@ -13,9 +13,6 @@ use taskstack::io::skeleton_map::SkeletonMap;
 use taskstack::robots::{BipedProfile, g1, nao};
 
 use crate::run::Exports;
-
-/// The longest hold after a clip (s): an hour of the last pose is more than any step needs.
-pub(crate) const MAX_HOLD: f64 = 3600.0;
 
 #[derive(Debug, Clone, Args)]
 pub(crate) struct ImitationOptions {
@@ -134,7 +131,6 @@ impl ImitationOptions {
         robot_profile(&self.robot)
     }
 
-    /// The skeleton map of `--skeleton`, read once for every clip.
     /// The motion exports asked for.
     pub(crate) fn exports(&self) -> Exports {
         Exports {
@@ -143,6 +139,7 @@ impl ImitationOptions {
         }
     }
 
+    /// The skeleton map of `--skeleton`, read once for every clip.
     pub(crate) fn skeleton_map(&self) -> Result<Option<SkeletonMap>> {
         self.skeleton
             .as_ref()

@@ -318,6 +318,15 @@ pub(crate) fn run(args: ViewArgs, report: Report) -> Result<ExitCode> {
     }
     let page = args.out.join("view.html");
     if !page.is_file() {
+        let runs = runs_in(&args.out);
+        if !runs.is_empty() {
+            bail!(
+                "output folder {} holds a batch: its viewers are in the clip folders; view one \
+                 with `taskstack view DIR`, DIR one of:\n  {}",
+                args.out.display(),
+                runs.join("\n  ")
+            );
+        }
         bail!(
             "output folder {}: no view.html (write one with `taskstack imitate CLIP --out {}`)",
             args.out.display(),
@@ -338,6 +347,25 @@ pub(crate) fn run(args: ViewArgs, report: Report) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// The subfolders of `dir` that hold a `view.html` (a batch's clip folders), sorted.
+fn runs_in(dir: &std::path::Path) -> Vec<String> {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Vec::new();
+    };
+    let mut runs: Vec<String> = entries
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.join("view.html").is_file())
+        .map(|p| p.display().to_string())
+        .collect();
+    runs.sort();
+    runs
+}
+
+/// How long `view` waits for the opener to fail, in 50 ms polls (3 s).
+const OPENER_WAIT_POLLS: usize = 60;
+
+/// Opens `page` with the system's opener and waits for it: an opener that finds no browser
+/// exits with an error, which is ours then (open the page yourself).
 fn open_in_browser(page: &std::path::Path) -> Result<()> {
     let opener = if cfg!(target_os = "macos") {
         "open"
@@ -346,9 +374,25 @@ fn open_in_browser(page: &std::path::Path) -> Result<()> {
     } else {
         "xdg-open"
     };
-    std::process::Command::new(opener)
+    let mut child = std::process::Command::new(opener)
         .arg(page)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
         .spawn()
         .with_context(|| format!("cannot start `{opener}`; open {} yourself", page.display()))?;
+    // Some openers return at once, some run the browser in the foreground: wait a little for
+    // a failure, and take an opener still running after that as a browser that opened.
+    for _ in 0..OPENER_WAIT_POLLS {
+        if let Some(status) = child.try_wait()? {
+            if !status.success() {
+                bail!(
+                    "`{opener}` could not open a browser ({status}); open {} yourself",
+                    page.display()
+                );
+            }
+            return Ok(());
+        }
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
     Ok(())
 }

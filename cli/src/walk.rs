@@ -30,8 +30,10 @@ use crate::view::{ViewFrame, ViewWriter};
 /// was farther).
 const MAX_STEPS: usize = 1000;
 
-/// Walk to a goal: footsteps within the robot's step envelope, a CoM from ZMP preview control,
-/// joint angles from the whole-body solver.
+/// Walk to a goal with the pattern generator and the whole-body solver.
+///
+/// Footsteps within the robot's step envelope, a CoM from ZMP preview control, joint angles
+/// from the whole-body solver.
 ///
 /// The goal is the midpoint between the soles moved by --forward and --left (m) and turned by
 /// --turn (rad), in the robot's starting frame (x forward, y left). Writes OUT/joints.csv (time

@@ -75,6 +75,22 @@ fn every_subcommand_explains_its_options_and_outputs() {
             );
         }
     }
+    // One line per command in the overview (a long first doc paragraph would wrap).
+    for line in top
+        .stdout
+        .lines()
+        .skip_while(|l| !l.starts_with("Commands:"))
+        .skip(1)
+    {
+        if line.trim().is_empty() {
+            break;
+        }
+        assert!(line.starts_with("  ") && line.len() <= 100, "{line}");
+        assert!(
+            !line.starts_with("           "),
+            "a wrapped command line: {line}"
+        );
+    }
     // -h is help, not a clip path.
     assert_eq!(taskstack(&["imitate", "-h"]).code, Some(0));
 }
@@ -329,6 +345,16 @@ fn bad_clips_are_errors_naming_the_clip() {
         &["imitate", s(&truncated), "--out", s(&out), "--hold", "0"],
         1,
         &["truncated.bvh"],
+    );
+    // The cause is printed once, not once per error in the chain.
+    let run = taskstack(&["imitate", s(&truncated), "--out", s(&out), "--hold", "0"]);
+    assert_eq!(run.stderr.matches("frame has").count(), 1, "{}", run.stderr);
+    let run = taskstack(&["imitate", s(&missing), "--out", s(&out)]);
+    assert_eq!(
+        run.stderr.matches("No such file").count(),
+        1,
+        "{}",
+        run.stderr
     );
     // A header and no frame of motion.
     let header = text.split("Frame Time:").next().unwrap().replace(
@@ -598,7 +624,15 @@ fn view_prints_the_page_of_an_output_folder() {
         "{}",
         view.stdout
     );
-    fails(&["view", s(&dir), "--no-open"], 1, &["no view.html"]);
+    // A batch folder: the clip folders holding the viewers are listed.
+    fails(
+        &["view", s(&dir), "--no-open"],
+        1,
+        &["holds a batch", s(&out)],
+    );
+    let empty = dir.join("empty");
+    std::fs::create_dir_all(&empty).unwrap();
+    fails(&["view", s(&empty), "--no-open"], 1, &["no view.html"]);
     fails(
         &["view", s(&dir.join("none")), "--no-open"],
         1,

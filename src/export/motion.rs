@@ -210,13 +210,6 @@ impl MotionRecorder {
     /// [`ExportError::JointCount`], [`ExportError::NonFinite`] or [`ExportError::TimeOrder`]
     /// for a frame that does not fit; nothing is recorded then.
     pub fn record(&mut self, frame: &RobotFrame) -> Result<(), ExportError> {
-        let expected = self.track.joint_count();
-        if frame.q.len() != expected {
-            return Err(ExportError::JointCount {
-                expected,
-                got: frame.q.len(),
-            });
-        }
         if !frame.time.is_finite() {
             return Err(ExportError::NonFinite("a frame's time"));
         }
@@ -224,6 +217,29 @@ impl MotionRecorder {
             return Err(ExportError::TimeOrder {
                 index: self.track.len(),
                 time: frame.time,
+            });
+        }
+        let (position, quat) = self.base_pose(frame)?;
+        let contacts = self.contacts(frame);
+        self.track.time.push(frame.time);
+        self.track.dof_pos.extend_from_slice(&frame.q);
+        self.track.root_pos.push(position);
+        self.track.root_quat.push(quat);
+        self.track.contacts.push(contacts);
+        Ok(())
+    }
+
+    /// The floating base's world pose at `frame` without recording it: position (m) and
+    /// quaternion `[x, y, z, w]`, in the hemisphere of the last recorded one (w ≥ 0 before any).
+    ///
+    /// # Errors
+    /// [`ExportError::JointCount`] or [`ExportError::NonFinite`] for a frame that does not fit.
+    pub fn base_pose(&mut self, frame: &RobotFrame) -> Result<([f64; 3], [f64; 4]), ExportError> {
+        let expected = self.track.joint_count();
+        if frame.q.len() != expected {
+            return Err(ExportError::JointCount {
+                expected,
+                got: frame.q.len(),
             });
         }
         let root = frame.root.index();
@@ -238,15 +254,14 @@ impl MotionRecorder {
         if !(position.iter().chain(&quat)).all(|v| v.is_finite()) {
             return Err(ExportError::NonFinite("the base pose"));
         }
+        Ok((position, quat))
+    }
+
+    /// Whether each sole is on the floor at `frame`, `[left, right]`.
+    pub fn contacts(&self, frame: &RobotFrame) -> [bool; 2] {
         let soles = [&frame.left_sole, &frame.right_sole];
-        let contacts = [Side::Left, Side::Right]
-            .map(|side| sole_on_floor(&self.profile.foot(side).outline, soles[side.index()]));
-        self.track.time.push(frame.time);
-        self.track.dof_pos.extend_from_slice(&frame.q);
-        self.track.root_pos.push(position);
-        self.track.root_quat.push(quat);
-        self.track.contacts.push(contacts);
-        Ok(())
+        [Side::Left, Side::Right]
+            .map(|side| sole_on_floor(&self.profile.foot(side).outline, soles[side.index()]))
     }
 
     /// The track recorded so far.

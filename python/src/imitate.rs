@@ -1,0 +1,468 @@
+//! Imitation from Python: a whole clip (`imitate_clip`, the run of `taskstack imitate` with
+//! the same settings and numbers) or live frames (`Imitator`).
+
+use std::path::{Path, PathBuf};
+
+use numpy::ndarray::{Array2, Array3};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray2};
+use pyo3::exceptions::{PyFileNotFoundError, PyOSError};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use taskstack::batch::{Hold, imitate_clip as run_clip, metrics_json};
+use taskstack::export::{MotionRecorder, MotionTrack};
+use taskstack::human::{CaptureSystem, HumanFrame, HumanJoint};
+use taskstack::imitation::config::ImitationMethod;
+use taskstack::imitation::koenemann::{Calibration, FootRetargeting, KoenemannConfig};
+use taskstack::imitation::look_ahead::{FootLookAhead, FootSchedule};
+use taskstack::imitation::support::SupportConfig;
+use taskstack::io::clip::Clip;
+use taskstack::robots::{BipedProfile, ProfileError, g1, nao};
+use taskstack::{Imitator, ImitatorConfig, IsometryMatrix3, RobotFrame};
+
+use crate::errors::{to_py, value_error};
+
+/// The robot named `robot`: `"nao"`, `"g1"` or the path of a biped profile (TOML).
+pub(crate) fn profile(robot: &str) -> PyResult<BipedProfile> {
+    match robot {
+        "nao" => Ok(nao::profile()),
+        "g1" => Ok(g1::profile()),
+        path => BipedProfile::from_toml_file(path).map_err(|err| match err {
+            // The profile error keeps the I/O error's message only: the class from the path.
+            ProfileError::Io { .. } if !Path::new(path).exists() => {
+                PyFileNotFoundError::new_err(err.to_string())
+            }
+            ProfileError::Io { .. } => PyOSError::new_err(err.to_string()),
+            other => to_py(other),
+        }),
+    }
+}
+
+/// The imitator settings of the keyword arguments shared by `imitate_clip` and `Imitator`
+/// (the options of `taskstack imitate`, with its defaults).
+#[derive(Debug, Clone)]
+pub(crate) struct Settings {
+    method: String,
+    walk: bool,
+    dynamic_walk: bool,
+    velocity_fraction: f64,
+    upper_body_fraction: Option<f64>,
+    task_speed: Option<f64>,
+    tracking_speed: Option<f64>,
+    iterations: usize,
+    calibration: String,
+    retargeting: String,
+}
+
+impl Settings {
+    fn config(&self, capture: CaptureSystem) -> PyResult<ImitatorConfig> {
+        let method = match self.method.as_str() {
+            "poubel" => ImitationMethod::Poubel,
+            "koenemann" => ImitationMethod::Koenemann(KoenemannConfig {
+                calibration: match self.calibration.as_str() {
+                    "auto" => Calibration::Auto,
+                    "first-frame" => Calibration::FirstFrame,
+                    "ideal" => Calibration::Ideal,
+                    other => {
+                        return Err(value_error(format!(
+                            "calibration {other:?}: expected \"auto\", \"first-frame\" or \"ideal\""
+                        )));
+                    }
+                },
+                retargeting: match self.retargeting.as_str() {
+                    "shift-both-feet" => FootRetargeting::ShiftBothFeet,
+                    "move-one-foot" => FootRetargeting::MoveOneFoot,
+                    other => {
+                        return Err(value_error(format!(
+                            "retargeting {other:?}: expected \"shift-both-feet\" or \"move-one-foot\""
+                        )));
+                    }
+                },
+                ..KoenemannConfig::default()
+            }),
+            other => {
+                return Err(value_error(format!(
+                    "method {other:?}: expected \"poubel\" or \"koenemann\""
+                )));
+            }
+        };
+        let fraction = |name: &str, value: f64| {
+            if value > 0.0 && value <= 1.0 {
+                Ok(value)
+            } else {
+                Err(value_error(format!("{name} = {value}: must be in (0, 1]")))
+            }
+        };
+        let positive = |name: &str, value: Option<f64>| match value {
+            Some(v) if !(v.is_finite() && v > 0.0) => {
+                Err(value_error(format!("{name} = {v}: must be a number > 0")))
+            }
+            v => Ok(v),
+        };
+        if !(1..=100).contains(&self.iterations) {
+            return Err(value_error(format!(
+                "iterations = {}: must be 1–100",
+                self.iterations
+            )));
+        }
+        let mut config = ImitatorConfig {
+            method,
+            velocity_fraction: fraction("velocity_fraction", self.velocity_fraction)?,
+            upper_body_velocity_fraction: (self.upper_body_fraction)
+                .map(|f| fraction("upper_body_fraction", f))
+                .transpose()?,
+            max_task_speed: positive("task_speed", self.task_speed)?,
+            max_tracking_speed: positive("tracking_speed", self.tracking_speed)?,
+            iterations_per_frame: self.iterations,
+            support: SupportConfig::for_capture(capture),
+            ..ImitatorConfig::default()
+        };
+        config.footsteps.follow = self.walk || self.dynamic_walk;
+        config.footsteps.dynamic = self.dynamic_walk;
+        Ok(config)
+    }
+}
+
+/// `hold`: `None` or `"auto"` (until the robot has finished), or seconds.
+fn hold(value: Option<&Bound<'_, PyAny>>) -> PyResult<Hold> {
+    let Some(value) = value else {
+        return Ok(Hold::UntilFinished);
+    };
+    if let Ok(text) = value.extract::<String>() {
+        return match text.as_str() {
+            "auto" => Ok(Hold::UntilFinished),
+            other => Err(value_error(format!(
+                "hold {other:?}: expected \"auto\" or seconds"
+            ))),
+        };
+    }
+    let seconds: f64 = value.extract()?;
+    Hold::Fixed(seconds).validated().map_err(to_py)
+}
+
+/// Everything `imitate_clip` returns, gathered without the GIL.
+struct ClipRun {
+    track: MotionTrack,
+    phases: Vec<String>,
+    metrics: String,
+}
+
+/// Runs `path` as `taskstack imitate` does: the clip's support defaults, offline look-ahead
+/// when asked (the whole clip read first), the hold.
+fn run(
+    path: &Path,
+    profile: BipedProfile,
+    settings: &Settings,
+    offline: bool,
+    hold: Hold,
+) -> PyResult<ClipRun> {
+    let open = || Clip::open(path).map_err(to_py);
+    let mut source = open()?;
+    let capture = source.capture();
+    let mut config = settings.config(capture)?;
+    if offline {
+        let frames = (source.collect::<Result<Vec<HumanFrame>, _>>()).map_err(to_py)?;
+        let schedule =
+            FootSchedule::of_clip(&frames, SupportConfig::for_capture(capture)).map_err(to_py)?;
+        config.look_ahead = Some(FootLookAhead {
+            schedule,
+            lift_lead: FootLookAhead::DEFAULT_LIFT_LEAD,
+            landing_lead: FootLookAhead::DEFAULT_LANDING_LEAD,
+        });
+        source = open()?;
+    }
+    let mut imitator = Imitator::new(profile, config).map_err(to_py)?;
+    let mut recorder = MotionRecorder::new(&imitator).map_err(to_py)?;
+    let mut phases = Vec::new();
+    let mut recorded = Ok(());
+    let metrics = run_clip(path, source, &mut imitator, hold, |frame| {
+        if recorded.is_ok() {
+            recorded = recorder.record(frame);
+        }
+        phases.push(frame.phase.to_string());
+    })
+    .map_err(to_py)?;
+    recorded.map_err(to_py)?;
+    Ok(ClipRun {
+        track: recorder.finish(),
+        phases,
+        metrics: metrics_json(&metrics, path),
+    })
+}
+
+/// Imitates the clip at `path` (BVH or Kinect v2 CSV); see the Python docstring.
+#[pyfunction]
+#[pyo3(signature = (
+    path, robot = "nao", hold = None, method = "poubel", walk = false, dynamic_walk = false,
+    offline = false, velocity_fraction = 0.1, upper_body_fraction = None, task_speed = None,
+    tracking_speed = None, iterations = 1, calibration = "auto", retargeting = "shift-both-feet"
+))]
+#[allow(clippy::too_many_arguments)] // Python keyword arguments, one per CLI option
+pub(crate) fn imitate_clip<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+    robot: &str,
+    hold: Option<&Bound<'py, PyAny>>,
+    method: &str,
+    walk: bool,
+    dynamic_walk: bool,
+    offline: bool,
+    velocity_fraction: f64,
+    upper_body_fraction: Option<f64>,
+    task_speed: Option<f64>,
+    tracking_speed: Option<f64>,
+    iterations: usize,
+    calibration: &str,
+    retargeting: &str,
+) -> PyResult<Bound<'py, PyDict>> {
+    let settings = Settings {
+        method: method.to_owned(),
+        walk,
+        dynamic_walk,
+        velocity_fraction,
+        upper_body_fraction,
+        task_speed,
+        tracking_speed,
+        iterations,
+        calibration: calibration.to_owned(),
+        retargeting: retargeting.to_owned(),
+    };
+    let hold = self::hold(hold)?;
+    let profile = profile(robot)?;
+    let run = py.detach(|| run(&path, profile, &settings, offline, hold))?;
+    let out = track_dict(py, run.track)?;
+    out.set_item("phase", PyList::new(py, run.phases)?)?;
+    out.set_item("metrics_json", run.metrics)?;
+    Ok(out)
+}
+
+/// A track's arrays: `time` (N), `q` (N × J), `joint_names`, `root_pos` (N × 3), `root_quat`
+/// (N × 4), `contacts` (N × 2, bool).
+fn track_dict(py: Python<'_>, track: MotionTrack) -> PyResult<Bound<'_, PyDict>> {
+    let n = track.len();
+    let j = track.joint_count();
+    let rows = |data: Vec<f64>, cols: usize| -> PyResult<Bound<'_, PyArray2<f64>>> {
+        let array =
+            Array2::from_shape_vec((n, cols), data).map_err(|e| value_error(e.to_string()))?;
+        Ok(array.into_pyarray(py))
+    };
+    let out = PyDict::new(py);
+    out.set_item("time", PyArray1::from_vec(py, track.time))?;
+    out.set_item("q", rows(track.dof_pos, j)?)?;
+    out.set_item("joint_names", PyList::new(py, track.joint_names)?)?;
+    out.set_item("root_pos", rows(track.root_pos.concat(), 3)?)?;
+    out.set_item("root_quat", rows(track.root_quat.concat(), 4)?)?;
+    let contacts: Vec<bool> = track.contacts.concat();
+    let contacts =
+        Array2::from_shape_vec((n, 2), contacts).map_err(|e| value_error(e.to_string()))?;
+    out.set_item("contacts", contacts.into_pyarray(py))?;
+    Ok(out)
+}
+
+/// A clip's frame times, human joint names and joint positions.
+type ClipArrays<'py> = (
+    Bound<'py, PyArray1<f64>>,
+    Vec<&'static str>,
+    Bound<'py, PyArray3<f64>>,
+);
+
+/// Reads the clip at `path`: its frame times (N, s), the human joint names (J) and their
+/// positions (N, J, 3; m, world z up; NaN where a joint is missing).
+#[pyfunction]
+pub(crate) fn read_clip<'py>(py: Python<'py>, path: PathBuf) -> PyResult<ClipArrays<'py>> {
+    let frames = py.detach(|| {
+        let clip = Clip::open(&path).map_err(to_py)?;
+        clip.collect::<Result<Vec<HumanFrame>, _>>().map_err(to_py)
+    })?;
+    let joints = HumanJoint::ALL;
+    let times: Vec<f64> = frames.iter().map(|f| f.time).collect();
+    let positions = Array3::from_shape_fn((frames.len(), joints.len(), 3), |(i, j, k)| {
+        frames[i].get(joints[j]).map_or(f64::NAN, |p| p[k])
+    });
+    let names = joints.iter().map(|j| j.name()).collect();
+    Ok((
+        PyArray1::from_vec(py, times),
+        names,
+        positions.into_pyarray(py),
+    ))
+}
+
+/// A live imitator: one human frame in, one robot frame out.
+// Unsendable: the imitator's solvers keep scratch space in `RefCell`s (not `Sync`); an
+// `Imitator` is used from the thread that made it (Python raises otherwise).
+#[pyclass(name = "Imitator", module = "taskstack._taskstack", unsendable)]
+pub(crate) struct PyImitator {
+    imitator: Imitator,
+    recorder: MotionRecorder,
+    frame: HumanFrame,
+}
+
+#[pymethods]
+impl PyImitator {
+    #[new]
+    #[pyo3(signature = (
+        robot = "nao", capture = "optical", method = "poubel", walk = false, dynamic_walk = false,
+        velocity_fraction = 0.1, upper_body_fraction = None, task_speed = None,
+        tracking_speed = None, iterations = 1, calibration = "auto", retargeting = "shift-both-feet"
+    ))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        robot: &str,
+        capture: &str,
+        method: &str,
+        walk: bool,
+        dynamic_walk: bool,
+        velocity_fraction: f64,
+        upper_body_fraction: Option<f64>,
+        task_speed: Option<f64>,
+        tracking_speed: Option<f64>,
+        iterations: usize,
+        calibration: &str,
+        retargeting: &str,
+    ) -> PyResult<Self> {
+        let capture = match capture {
+            "optical" => CaptureSystem::Optical,
+            "kinect" | "depth" => CaptureSystem::DepthCamera,
+            other => {
+                return Err(value_error(format!(
+                    "capture {other:?}: expected \"optical\" or \"kinect\""
+                )));
+            }
+        };
+        let settings = Settings {
+            method: method.to_owned(),
+            walk,
+            dynamic_walk,
+            velocity_fraction,
+            upper_body_fraction,
+            task_speed,
+            tracking_speed,
+            iterations,
+            calibration: calibration.to_owned(),
+            retargeting: retargeting.to_owned(),
+        };
+        let imitator = Imitator::new(profile(robot)?, settings.config(capture)?).map_err(to_py)?;
+        let recorder = MotionRecorder::new(&imitator).map_err(to_py)?;
+        Ok(Self {
+            imitator,
+            recorder,
+            frame: HumanFrame::new(0.0),
+        })
+    }
+
+    /// The robot's joint names, in the order of `q`.
+    #[getter]
+    fn joint_names(&self) -> Vec<String> {
+        self.imitator.variable_names().map(str::to_owned).collect()
+    }
+
+    /// The human joint names a frame may hold.
+    #[staticmethod]
+    fn human_joint_names() -> Vec<&'static str> {
+        HumanJoint::ALL.iter().map(|j| j.name()).collect()
+    }
+
+    #[pyo3(signature = (time, positions, names = None))]
+    fn step<'py>(
+        &mut self,
+        py: Python<'py>,
+        time: f64,
+        positions: &Bound<'py, PyAny>,
+        names: Option<Vec<String>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        self.frame.clear(time);
+        match names {
+            Some(names) => {
+                let array: PyReadonlyArray2<'py, f64> = positions.extract().map_err(|_| {
+                    value_error("positions: with names, expected a float array of shape (J, 3)")
+                })?;
+                let array = array.as_array();
+                if array.ncols() != 3 || array.nrows() != names.len() {
+                    return Err(value_error(format!(
+                        "positions of shape {:?} for {} names: expected ({}, 3)",
+                        array.shape(),
+                        names.len(),
+                        names.len()
+                    )));
+                }
+                for (name, row) in names.iter().zip(array.rows()) {
+                    self.set(name, [row[0], row[1], row[2]])?;
+                }
+            }
+            None => {
+                let dict = positions.cast::<PyDict>().map_err(|_| {
+                    value_error("positions: expected a dict of joint name -> (x, y, z), or an array with names")
+                })?;
+                for (key, value) in dict.iter() {
+                    let name: String = key.extract()?;
+                    let p: [f64; 3] = value.extract().map_err(|_| {
+                        value_error(format!(
+                            "joint {name}: expected three numbers (x, y, z) in metres"
+                        ))
+                    })?;
+                    self.set(&name, p)?;
+                }
+            }
+        }
+        self.frame.derive_mid_hip();
+        let frame = self.imitator.step(&self.frame).map_err(to_py)?;
+        let (root_pos, root_quat) = self.recorder.base_pose(frame).map_err(to_py)?;
+        robot_frame_dict(
+            py,
+            frame,
+            root_pos,
+            root_quat,
+            self.recorder.contacts(frame),
+        )
+    }
+}
+
+impl PyImitator {
+    fn set(&mut self, name: &str, p: [f64; 3]) -> PyResult<()> {
+        let joint = HumanJoint::from_name(name).ok_or_else(|| {
+            value_error(format!(
+                "unknown human joint {name:?} (see Imitator.human_joint_names())"
+            ))
+        })?;
+        if p.iter().all(|v| v.is_nan()) {
+            return Ok(()); // NaN, NaN, NaN: the joint is missing in this frame
+        }
+        if !p.iter().all(|v| v.is_finite()) {
+            return Err(value_error(format!(
+                "joint {name}: position {p:?} is not finite"
+            )));
+        }
+        self.frame.set(joint, Some(p.into()));
+        Ok(())
+    }
+}
+
+/// A robot frame as a dict (see the Python docstring of `Imitator.step`).
+fn robot_frame_dict<'py>(
+    py: Python<'py>,
+    frame: &RobotFrame,
+    root_pos: [f64; 3],
+    root_quat: [f64; 4],
+    contacts: [bool; 2],
+) -> PyResult<Bound<'py, PyDict>> {
+    let out = PyDict::new(py);
+    out.set_item("time", frame.time)?;
+    out.set_item("q", PyArray1::from_slice(py, &frame.q))?;
+    out.set_item("phase", frame.phase.to_string())?;
+    out.set_item("root_pos", PyArray1::from_slice(py, &root_pos))?;
+    out.set_item("root_quat", PyArray1::from_slice(py, &root_quat))?;
+    out.set_item("left_sole", matrix(py, &frame.left_sole))?;
+    out.set_item("right_sole", matrix(py, &frame.right_sole))?;
+    out.set_item("com", PyArray1::from_slice(py, frame.com.as_slice()))?;
+    out.set_item("contacts", contacts.to_vec())?;
+    out.set_item("awaiting_contact", frame.awaiting_contact)?;
+    Ok(out)
+}
+
+/// A placement as a 4 × 4 homogeneous matrix.
+pub(crate) fn matrix<'py>(
+    py: Python<'py>,
+    placement: &IsometryMatrix3<f64>,
+) -> Bound<'py, PyArray2<f64>> {
+    let m = placement.to_homogeneous();
+    Array2::from_shape_fn((4, 4), |(r, c)| m[(r, c)]).into_pyarray(py)
+}

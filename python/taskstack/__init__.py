@@ -1,0 +1,144 @@
+"""taskstack: prioritized task-stack inverse kinematics and human-to-humanoid motion imitation.
+
+Python bindings of the Rust crate ``taskstack``. Units everywhere: metres, radians, seconds.
+World frame of an imitation: z up, x forward, the floor at z = 0, the first frame's right sole
+at the origin.
+
+* :func:`imitate_clip` imitates a clip file (BVH or Kinect v2 CSV) and returns an
+  :class:`ImitationResult`: the numbers of ``taskstack imitate`` (its ``joints.csv``) with the
+  floating base's pose and the soles' contacts, as numpy arrays.
+* :class:`Imitator` imitates live, one human frame at a time; :func:`read_clip` reads a clip's
+  human joint positions.
+* :class:`Model` is a kinematic model (the NAO, the G1, any URDF): forward kinematics,
+  Jacobians, centre of mass.
+* :class:`Task` and :class:`TaskSet` are the prioritized solver on its own.
+
+Errors are exceptions carrying the Rust message: ``ValueError`` for bad input,
+``FileNotFoundError`` / ``OSError`` for files.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from os import PathLike
+from typing import Any, Dict, List, Optional, Union
+
+import numpy as np
+
+from ._taskstack import Imitator, Model, Task, TaskSet, __version__, read_clip
+from ._taskstack import imitate_clip as _imitate_clip
+
+__all__ = [
+    "ImitationResult",
+    "Imitator",
+    "Model",
+    "Task",
+    "TaskSet",
+    "imitate_clip",
+    "read_clip",
+    "__version__",
+]
+
+
+@dataclass(frozen=True)
+class ImitationResult:
+    """One imitated clip, a row per robot frame (N frames, J joints).
+
+    Attributes:
+        time: (N,) frame times in seconds (the clip's, then the held frames 1/120 s apart).
+        q: (N, J) joint angles in radians, columns named by ``joint_names``.
+        joint_names: the J joint names (the robot model's variable order; for the G1 its
+            URDF's joint order).
+        root_pos: (N, 3) the floating base's origin in metres (world; NAO ``torso``, G1
+            ``pelvis``).
+        root_quat: (N, 4) the floating base's orientation, quaternion x y z w (world),
+            without sign flips between frames.
+        contacts: (N, 2) bool, the left and the right sole on the floor (within 1 mm).
+        phase: the robot's support phase per frame (e.g. ``"DS"``, ``"DS to RS: CoM to RFoot"``).
+        metrics: the run's metrics, the dict of ``taskstack imitate``'s ``metrics.json``.
+    """
+
+    time: np.ndarray
+    q: np.ndarray
+    joint_names: List[str]
+    root_pos: np.ndarray
+    root_quat: np.ndarray
+    contacts: np.ndarray
+    phase: List[str]
+    metrics: Dict[str, Any]
+
+    @property
+    def fps(self) -> float:
+        """The clip's own frame rate (Hz, rounded): its frame count over its duration."""
+        m = self.metrics
+        frames, duration = m["clip_frames"], m["clip_duration_s"]
+        return float(round((frames - 1) / duration)) if frames > 1 and duration > 0 else 0.0
+
+
+def imitate_clip(
+    path: Union[str, PathLike],
+    robot: str = "nao",
+    hold: Union[float, str, None] = "auto",
+    method: str = "poubel",
+    walk: bool = False,
+    dynamic_walk: bool = False,
+    offline: bool = False,
+    velocity_fraction: float = 0.1,
+    upper_body_fraction: Optional[float] = None,
+    task_speed: Optional[float] = None,
+    tracking_speed: Optional[float] = None,
+    iterations: int = 1,
+    calibration: str = "auto",
+    retargeting: str = "shift-both-feet",
+) -> ImitationResult:
+    """Imitate a motion clip with a humanoid; the run of ``taskstack imitate`` with the same
+    options (same joint angles as its ``joints.csv``).
+
+    Args:
+        path: a BVH clip (CMU skeleton) or a Kinect v2 CSV.
+        robot: ``"nao"``, ``"g1"`` or the path of a biped profile (TOML next to a URDF).
+        hold: after the clip, hold the human's last pose: ``"auto"`` (until the robot has
+            finished, at most 60 s) or seconds (0 to 3600).
+        method: ``"poubel"`` (support phases and task tables) or ``"koenemann"``.
+        walk: the robot's feet follow the human's footprints (quasi-static steps).
+        dynamic_walk: experimental, walk with the pattern generator (implies ``walk``).
+        offline: read the whole clip first and time weight shifts ahead of the human.
+        velocity_fraction: share of the rated joint velocity the legs may use, in (0, 1].
+        upper_body_fraction: the same for arms, head and torso (default: the robot's).
+        task_speed: fastest CoM and foot target speed (m/s; default: the robot's).
+        tracking_speed: fastest hand target speed (m/s; default: the robot's).
+        iterations: solver iterations per frame (1 to 100).
+        calibration: ``method="koenemann"``: ``"auto"``, ``"first-frame"`` or ``"ideal"``.
+        retargeting: ``method="koenemann"``: ``"shift-both-feet"`` or ``"move-one-foot"``.
+
+    Raises:
+        FileNotFoundError, OSError: the clip or the profile cannot be read.
+        ValueError: a malformed clip, an option out of range, a frame the imitator refuses.
+    """
+    raw = _imitate_clip(
+        str(path),
+        robot=robot,
+        hold=hold,
+        method=method,
+        walk=walk,
+        dynamic_walk=dynamic_walk,
+        offline=offline,
+        velocity_fraction=velocity_fraction,
+        upper_body_fraction=upper_body_fraction,
+        task_speed=task_speed,
+        tracking_speed=tracking_speed,
+        iterations=iterations,
+        calibration=calibration,
+        retargeting=retargeting,
+    )
+    return ImitationResult(
+        time=raw["time"],
+        q=raw["q"],
+        joint_names=list(raw["joint_names"]),
+        root_pos=raw["root_pos"],
+        root_quat=raw["root_quat"],
+        contacts=raw["contacts"],
+        phase=list(raw["phase"]),
+        metrics=json.loads(raw["metrics_json"]),
+    )

@@ -1,0 +1,174 @@
+"""Type stubs of the native module ``taskstack._taskstack`` (Rust, PyO3). Units: metres,
+radians, seconds."""
+
+from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+def imitate_clip(
+    path: str,
+    robot: str = "nao",
+    hold: Union[float, str, None] = None,
+    method: str = "poubel",
+    walk: bool = False,
+    dynamic_walk: bool = False,
+    offline: bool = False,
+    velocity_fraction: float = 0.1,
+    upper_body_fraction: Optional[float] = None,
+    task_speed: Optional[float] = None,
+    tracking_speed: Optional[float] = None,
+    iterations: int = 1,
+    calibration: str = "auto",
+    retargeting: str = "shift-both-feet",
+) -> Dict[str, Any]:
+    """The arrays of ``taskstack.ImitationResult`` as a dict, ``metrics_json`` a JSON string."""
+    ...
+
+def read_clip(path: str) -> Tuple[np.ndarray, List[str], np.ndarray]:
+    """A clip's frame times (N, s), the human joint names (J) and their positions (N, J, 3;
+    m, world z up; NaN where a joint is missing). Raises FileNotFoundError, OSError or
+    ValueError as ``imitate_clip``."""
+    ...
+
+class Imitator:
+    """A live imitator: one human frame in, one robot frame out (the thread that made it only)."""
+
+    def __init__(
+        self,
+        robot: str = "nao",
+        capture: str = "optical",
+        method: str = "poubel",
+        walk: bool = False,
+        dynamic_walk: bool = False,
+        velocity_fraction: float = 0.1,
+        upper_body_fraction: Optional[float] = None,
+        task_speed: Optional[float] = None,
+        tracking_speed: Optional[float] = None,
+        iterations: int = 1,
+        calibration: str = "auto",
+        retargeting: str = "shift-both-feet",
+    ) -> None:
+        """``robot``: "nao", "g1" or a profile path; ``capture``: "optical" (motion capture,
+        120 Hz, mm noise) or "kinect" (depth camera, 30 Hz, cm noise), which sets the support
+        detection's thresholds; the other options as ``taskstack.imitate_clip``."""
+        ...
+    @property
+    def joint_names(self) -> List[str]:
+        """The robot's joint names, in the order of ``q``."""
+        ...
+    @staticmethod
+    def human_joint_names() -> List[str]:
+        """The human joint names a frame may hold ("LShoulder", "RAnkle", ...)."""
+        ...
+    def step(
+        self,
+        time: float,
+        positions: Union[Mapping[str, Sequence[float]], npt.ArrayLike],
+        names: Optional[Sequence[str]] = None,
+    ) -> Dict[str, Any]:
+        """Imitates one human frame at ``time`` (s, increasing): ``positions`` a dict of human
+        joint name -> (x, y, z) in metres (world: z up), or a (J, 3) array with its ``names``.
+        Missing joints are left out of the dict, or NaN rows of the array.
+
+        Returns a dict: ``time`` (s), ``q`` (J, rad), ``phase`` (str), ``root_pos`` (3, m) and
+        ``root_quat`` (4, x y z w) of the floating base, ``left_sole`` and ``right_sole``
+        (4 x 4 world placements), ``com`` (3, m), ``contacts`` ([left, right] on the floor),
+        ``awaiting_contact`` (feed the same frame again: a hand is being placed).
+
+        Raises ValueError for an unknown joint name, a non-finite position, a bad shape, or a
+        frame the imitator refuses (time not after the previous one)."""
+        ...
+
+class Model:
+    """A kinematic tree; every quantity is in its base frame (the root link)."""
+
+    @staticmethod
+    def nao(root: str = "r_sole") -> "Model":
+        """The NAO H25 V5 (DH tables), rooted at "r_sole", "l_sole" or "torso"."""
+        ...
+    @staticmethod
+    def g1(root: Optional[str] = None) -> "Model":
+        """The Unitree G1 (29 DoF, bundled URDF), rooted at a link ("left_sole", "right_sole";
+        None: the pelvis)."""
+        ...
+    @staticmethod
+    def from_urdf(path: str, root: Optional[str] = None) -> "Model":
+        """Any URDF file, rooted at the link ``root`` (None: the URDF's root); every link is a
+        frame."""
+        ...
+    @property
+    def nv(self) -> int: ...
+    @property
+    def variable_names(self) -> List[str]: ...
+    @property
+    def frame_names(self) -> List[str]: ...
+    @property
+    def limits(self) -> Tuple[np.ndarray, np.ndarray]:
+        """Lower and upper joint limits (rad), two arrays of ``nv``."""
+        ...
+    @property
+    def total_mass(self) -> float:
+        """kg."""
+        ...
+    def fk(self, q: Sequence[float], frame: str) -> np.ndarray:
+        """The 4 x 4 placement of ``frame`` at ``q`` (m)."""
+        ...
+    def fk_all(self, q: Sequence[float]) -> Dict[str, np.ndarray]:
+        """Every frame's 4 x 4 placement at ``q``."""
+        ...
+    def com(self, q: Sequence[float]) -> np.ndarray:
+        """The centre of mass (3, m)."""
+        ...
+    def jacobian(self, q: Sequence[float], frame: str) -> np.ndarray:
+        """(6, nv): the frame origin's linear velocity (rows 0-2) and the frame's angular
+        velocity (rows 3-5) per joint velocity."""
+        ...
+    def com_jacobian(self, q: Sequence[float]) -> np.ndarray:
+        """(3, nv): the CoM's velocity per joint velocity."""
+        ...
+
+class Task:
+    """A task of a ``TaskSet`` level; targets in the model's base frame."""
+
+    @staticmethod
+    def position(frame: str, target: Sequence[float]) -> "Task":
+        """The frame's origin at ``target`` (m)."""
+        ...
+    @staticmethod
+    def orientation(frame: str, rotation: npt.ArrayLike) -> "Task":
+        """The frame's axes at the 3 x 3 rotation matrix ``rotation``."""
+        ...
+    @staticmethod
+    def pose(frame: str, placement: npt.ArrayLike) -> "Task":
+        """The frame at the 4 x 4 homogeneous ``placement`` (m)."""
+        ...
+    @staticmethod
+    def com(target: Sequence[float]) -> "Task":
+        """The centre of mass at ``target`` (m)."""
+        ...
+    @staticmethod
+    def com_ground(xy: Sequence[float]) -> "Task":
+        """The CoM's ground projection at ``xy`` (m); its height free."""
+        ...
+    @staticmethod
+    def posture(joints: Sequence[str], target: Sequence[float]) -> "Task":
+        """The named joints at ``target`` (rad)."""
+        ...
+
+class TaskSet:
+    """Levels of tasks on one model, the first level the highest priority."""
+
+    def __init__(self, model: Model) -> None: ...
+    def level(self, name: str, tasks: Sequence[Task]) -> "TaskSet":
+        """Adds a level below the existing ones; returns the set (chainable)."""
+        ...
+    def solve(
+        self, q: Sequence[float], tolerance: float = 1e-4, max_iterations: int = 50
+    ) -> Dict[str, Any]:
+        """Gauss-Newton iterations of the prioritized solve within the joint limits, from
+        ``q`` (rad). Returns ``q`` (nv), ``task_errors`` (per task, m or rad), ``iterations``,
+        ``stop`` ("converged", "stalled" or "iteration_limit")."""
+        ...
