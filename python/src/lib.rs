@@ -2,12 +2,12 @@
 //! pure-Python package `taskstack` (`python/taskstack/`), which documents the API and adds the
 //! result types.
 //!
-//! * [`imitate`]: `imitate_clip` (a clip file in, arrays out: the numbers of `taskstack
+//! * `imitate`: `imitate_clip` (a clip file in, arrays out: the numbers of `taskstack
 //!   imitate`) and `Imitator` (live, one human frame at a time).
-//! * [`kinematics`]: `Model` (the NAO, the G1, any URDF): forward kinematics, Jacobians, CoM.
-//! * [`solve`]: `Task` and `TaskSet`, the prioritized solver on its own.
+//! * `kinematics`: `Model` (the NAO, the G1, any URDF): forward kinematics, Jacobians, CoM.
+//! * `solve`: `Task` and `TaskSet`, the prioritized solver on its own.
 //!
-//! Errors become Python exceptions carrying the Rust message ([`errors`]): `ValueError` for bad
+//! Errors become Python exceptions carrying the Rust message (`errors`): `ValueError` for bad
 //! input, `OSError` for files; no panic crosses the boundary (a panic would become
 //! `pyo3_runtime.PanicException`; the library returns typed errors instead).
 
