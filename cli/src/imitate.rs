@@ -19,6 +19,7 @@ use taskstack::imitation::support::SupportConfig;
 use taskstack::scene::Scene;
 
 use crate::Report;
+use crate::check::PhysicsModel;
 use crate::options::{ImitationOptions, open_clip};
 use crate::run::{Progress, Settings, default_out, imitate_into};
 
@@ -28,6 +29,9 @@ const BUNDLED_CLIP: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
     "/../tests/data/mocap/cmu_05_02_stand_arm_gestures_turn_single_leg.bvh"
 );
+
+/// Seconds of the last posture `--check` plays after the run (the run's own hold is in it).
+const CHECK_HOLD: f64 = 1.0;
 
 /// Imitate a motion clip with a humanoid robot, online, frame by frame.
 ///
@@ -83,6 +87,11 @@ pub(crate) struct ImitateArgs {
     /// Offline mode: the first guess of how long the robot's lowering of a foot takes (s, ≥ 0)
     #[arg(long, value_name = "SECONDS", default_value_t = FootLookAhead::DEFAULT_LANDING_LEAD, requires = "offline", allow_negative_numbers = true)]
     landing_lead: f64,
+    /// After the run, check it in physics on the nominal and the weak model (`taskstack
+    /// check`: needs the Python package with its simulation extra); the exit status is then
+    /// the check's (1 when a model fails it).
+    #[arg(long)]
+    check: bool,
     #[command(flatten)]
     options: ImitationOptions,
 }
@@ -160,6 +169,9 @@ pub(crate) fn run(args: ImitateArgs, report: Report) -> Result<ExitCode> {
         print_summary(&mut text, &metrics, &clip, &out, &settings);
     }
     crate::output(&text)?;
+    if args.check {
+        return crate::check::check(&[out], PhysicsModel::Both, CHECK_HOLD, report);
+    }
     Ok(ExitCode::SUCCESS)
 }
 

@@ -4,6 +4,7 @@
 //! every option.
 
 mod batch;
+mod check;
 mod contacts;
 mod fk;
 mod imitate;
@@ -39,6 +40,7 @@ struct Cli {
 enum Command {
     Imitate(imitate::ImitateArgs),
     Batch(batch::BatchArgs),
+    Check(check::CheckArgs),
     Contacts(contacts::ContactsArgs),
     Fk(fk::FkArgs),
     Solve(solve::SolveArgs),
@@ -69,6 +71,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Imitate(args) => imitate::run(args, report),
         Command::Batch(args) => batch::run(args, report),
+        Command::Check(args) => check::run(args, report),
         Command::Contacts(args) => contacts::run(args, report),
         Command::Fk(args) => fk::run(args),
         Command::Solve(args) => solve::run(args, report),

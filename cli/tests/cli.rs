@@ -11,7 +11,7 @@ fn every_subcommand_explains_its_options_and_outputs() {
     let top = taskstack(&["--help"]);
     assert_eq!(top.code, Some(0), "{}", top.stderr);
     for command in [
-        "imitate", "batch", "contacts", "fk", "solve", "view", "walk",
+        "imitate", "batch", "check", "contacts", "fk", "solve", "view", "walk",
     ] {
         assert!(
             top.stdout.contains(command),
@@ -322,6 +322,46 @@ fn files_in(dir: &std::path::Path) -> Vec<(String, Vec<u8>)> {
         .unwrap_or_default();
     files.sort();
     files
+}
+
+#[test]
+fn check_without_the_simulator_says_how_to_install_it() {
+    use std::process::Command;
+    let dir = temp_dir("check");
+    let out = dir.join("run");
+    let run = taskstack(&[
+        "-q",
+        "imitate",
+        s(&clip(KINECT)),
+        "--out",
+        s(&out),
+        "--hold",
+        "0",
+    ]);
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    let missing = Command::new(env!("CARGO_BIN_EXE_taskstack"))
+        .args(["check", s(&out)])
+        .env("TASKSTACK_PYTHON", dir.join("no-python"))
+        .output()
+        .unwrap();
+    assert_eq!(missing.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&missing.stderr);
+    assert!(stderr.contains("python[sim]"), "{stderr}");
+    fails(&["check", s(&dir.join("nothing"))], 2, &["nothing"]);
+    let help = taskstack(&["check", "--help"]);
+    for needle in [
+        "OUT_DIR",
+        "5 mm",
+        "99 %",
+        "physics.svg",
+        "Exit status",
+        "--model",
+    ] {
+        assert!(
+            help.stdout.contains(needle),
+            "check --help mentions {needle}"
+        );
+    }
 }
 
 #[test]

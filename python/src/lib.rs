@@ -6,6 +6,7 @@
 //!   imitate`) and `Imitator` (live, one human frame at a time).
 //! * `kinematics`: `Model` (the NAO, the G1, any URDF): forward kinematics, Jacobians, CoM.
 //! * `solve`: `Task` and `TaskSet`, the prioritized solver on its own.
+//! * `description`: `robot_description`, what `taskstack.sim` builds a physics model from.
 //!
 //! Errors become Python exceptions carrying the Rust message (`errors`): `ValueError` for bad
 //! input, `OSError` for files; no panic crosses the boundary (a panic would become
@@ -13,6 +14,7 @@
 
 use pyo3::prelude::*;
 
+mod description;
 mod errors;
 mod imitate;
 mod kinematics;
@@ -22,6 +24,7 @@ mod solve;
 fn _taskstack(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(imitate::imitate_clip, m)?)?;
     m.add_function(wrap_pyfunction!(imitate::read_clip, m)?)?;
+    m.add_function(wrap_pyfunction!(description::robot_description, m)?)?;
     m.add_class::<imitate::PyImitator>()?;
     m.add_class::<kinematics::PyModel>()?;
     m.add_class::<solve::PyTask>()?;

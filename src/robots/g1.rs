@@ -239,11 +239,21 @@ pub fn profile() -> BipedProfile {
 /// G1's 29 ([`UrdfError::UnknownVariable`] for a missing one, [`UrdfError::MissingVariable`] for
 /// an extra one).
 pub fn from_urdf_str(text: &str, root_link: Option<&str>) -> Result<Model, UrdfError> {
+    Model::from_urdf_str(&urdf_with_soles(text)?, &urdf_options(root_link))
+}
+
+/// G1 URDF text with the two sole links (`left_sole`, `right_sole`: fixed, [`SOLE_DEPTH`]
+/// under the ankle-roll links, axes as theirs) added: the description every G1 model is built
+/// from, and what a physics model of the G1 needs to put its soles where the profile's are.
+///
+/// # Errors
+/// [`UrdfError::Xml`] when the text has no closing `</robot>` tag.
+pub fn urdf_with_soles(text: &str) -> Result<String, UrdfError> {
     let mut text = text.to_owned();
     for (sole, ankle) in SOLES {
         text = with_fixed_link(&text, sole, ankle, [0.0, 0.0, -SOLE_DEPTH])?;
     }
-    Model::from_urdf_str(&text, &urdf_options(root_link))
+    Ok(text)
 }
 
 fn built_in(root_link: &str) -> Model {

@@ -1,0 +1,137 @@
+"""The checks of a playback, their thresholds, and the verdict of a run.
+
+A run passes when, over the trajectory and the hold after it:
+
+=======================  ======================================================================
+``fall``                 the base stays above 60 % of its standing height and within 45° of
+                         upright
+``foot_tilt_deg``        a sole touching the floor tilts at most 5° (more is a foot rocking on
+                         an edge)
+``slip_m``               a loaded sole (≥ 20 % of the weight) slides at most 5 mm under its
+                         centre of pressure
+``turn_deg``             a loaded sole turns at most 2° about the vertical
+``com_inside_share``     the CoM ground projection is inside the hull of the soles' floor
+                         contacts at least 99 % of the time
+``non_foot_contact``     nothing but the soles touches the floor
+``limit_violations``     no target outside the URDF's joint limits
+=======================  ======================================================================
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Dict, List, Optional
+
+import numpy as np
+
+from .. import _taskstack
+from .model import PhysicsModel, build
+from .player import Playback, play
+
+#: Every check's threshold (units in the names).
+THRESHOLDS = {
+    "foot_tilt_deg": 5.0,
+    "slip_m": 0.005,
+    "turn_deg": 2.0,
+    "com_inside_share": 0.99,
+}
+
+
+@dataclass
+class Verdict:
+    """One run on one model: pass or fail, each failed check said in words, the measures."""
+
+    out_dir: str
+    robot: str
+    model: str
+    passed: bool
+    failures: List[str]
+    playback: Playback
+
+    def summary(self) -> str:
+        p = self.playback
+        head = f"{'PASS' if self.passed else 'FAIL'} {self.out_dir} {self.robot} {self.model:7}"
+        measures = (f"tilt {p.max_foot_tilt_deg:4.1f}° slip {p.max_slip_m * 1000:5.1f} mm "
+                    f"turn {p.max_turn_deg:4.1f}° CoM inside {p.com_inside_share * 100:5.1f} %")
+        return f"{head} {measures}" + (f"; {'; '.join(self.failures)}" if self.failures else "")
+
+    def to_json(self) -> Dict:
+        out = asdict(self)
+        out["playback"].pop("series")
+        out["thresholds"] = THRESHOLDS
+        return out
+
+
+def judge(p: Playback) -> List[str]:
+    """The failed checks of a playback, in words (empty: it passes)."""
+    failures = []
+    if p.fell_at is not None:
+        failures.append(f"fell at {p.fell_at:.2f} s ({p.fall_reason})")
+    if p.max_foot_tilt_deg > THRESHOLDS["foot_tilt_deg"]:
+        failures.append(f"a sole on the floor tilted {p.max_foot_tilt_deg:.1f}° (> 5°)")
+    if p.max_slip_m > THRESHOLDS["slip_m"]:
+        failures.append(f"a loaded sole slid {p.max_slip_m * 1000:.1f} mm (> 5 mm)")
+    if p.max_turn_deg > THRESHOLDS["turn_deg"]:
+        failures.append(f"a loaded sole turned {p.max_turn_deg:.1f}° (> 2°)")
+    if p.com_inside_share < THRESHOLDS["com_inside_share"]:
+        failures.append(f"CoM inside the contact hull {p.com_inside_share * 100:.1f} % of the time (< 99 %)")
+    if p.non_foot_contact is not None:
+        failures.append(f"{p.non_foot_contact} touched the floor at {p.non_foot_contact_at:.2f} s")
+    if p.limit_violations:
+        failures.append(f"{p.limit_violations} targets outside the joint limits")
+    return failures
+
+
+class InputError(ValueError):
+    """A run folder or trajectory that cannot be checked."""
+
+
+def read_trajectory(path: Path):
+    """``joints.csv``: its column names, times (N) and joint angles (N x J)."""
+    try:
+        with open(path, newline="") as f:
+            rows = list(csv.reader(f))
+    except OSError as e:
+        raise InputError(f"{path}: {e.strerror or e}") from e
+    if len(rows) < 2 or not rows[0] or rows[0][0] != "time":
+        raise InputError(f"{path}: not a joints.csv (a header time,<joints> and one row per frame)")
+    try:
+        data = np.array([[float(v) for v in row] for row in rows[1:] if row], dtype=float)
+    except ValueError as e:
+        raise InputError(f"{path}: {e}") from e
+    if data.ndim != 2 or data.shape[1] != len(rows[0]) or not np.all(np.isfinite(data)):
+        raise InputError(f"{path}: rows must have {len(rows[0])} finite numbers")
+    if np.any(np.diff(data[:, 0]) <= 0):
+        raise InputError(f"{path}: times must increase")
+    return rows[0][1:], data[:, 0], data[:, 1:]
+
+
+def robot_of(columns: List[str]) -> str:
+    """The built-in robot whose joints are ``columns``."""
+    for robot in ("nao", "g1"):
+        if set(_taskstack.robot_description(robot)["variables"]) == set(columns):
+            return robot
+    raise InputError(f"joints {columns[:3]}…: neither the NAO's nor the G1's")
+
+
+_MODELS: Dict[tuple, PhysicsModel] = {}
+
+
+def check_run(out_dir, weak: bool = False, settle: float = 1.0, hold: float = 1.0) -> Verdict:
+    """Plays ``OUT_DIR/joints.csv`` (or a ``joints.csv`` path) on the nominal or weak model of
+    the robot its header names, and judges it."""
+    path = Path(out_dir)
+    csv_path = path / "joints.csv" if path.is_dir() else path
+    columns, times, q = read_trajectory(csv_path)
+    robot = robot_of(columns)
+    key = (robot, weak)
+    if key not in _MODELS:
+        _MODELS[key] = build(robot, weak)
+    pm = _MODELS[key]
+    order = [columns.index(c) for c in pm.columns]
+    playback = play(pm, times, q[:, order], settle=settle, hold=hold)
+    failures = judge(playback)
+    return Verdict(str(out_dir), robot, "weak" if weak else "nominal", not failures, failures, playback)

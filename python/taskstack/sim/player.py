@@ -1,0 +1,238 @@
+"""Plays a joint trajectory on a :class:`~taskstack.sim.model.PhysicsModel` and measures it.
+
+The robot starts standing in the trajectory's first posture: its soles flat on the floor
+(those within 5 mm and 2° of the lower one are both put down, the rest hang), the right sole's
+origin over the world origin. It holds that posture for ``settle`` seconds, plays the
+trajectory (targets interpolated linearly at every 1 ms step, each target's speed limited to
+its joint's URDF velocity), then holds the last posture for ``hold`` seconds.
+
+Measured at every step (see :mod:`taskstack.sim.checks` for what is judged):
+
+* the base's height and tilt (angle of its z axis from the vertical);
+* per sole: the normal force of its floor contacts, its tilt while it touches, its slip and
+  turn while it carries at least 20 % of the weight (the sliding of the contact point under it
+  since the load came on: the world motion of the sole-fixed point that was the centre of
+  pressure then; the yaw change since then);
+* the CoM's signed distance to the convex hull of the soles' floor contact points;
+* the first body other than a sole touching the floor.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Dict, List, Optional, Sequence
+
+import mujoco
+import numpy as np
+
+from .model import PhysicsModel
+
+#: A foot carrying at least this share of the weight is loaded (slip and turn are measured).
+LOADED_SHARE = 0.2
+#: A contact pushing less than this (N) is not a contact.
+CONTACT_FORCE = 1.0
+#: Soles within this height (m) and tilt (rad) of the lower one start on the floor together.
+BOTH_FEET_HEIGHT, BOTH_FEET_TILT = 0.005, math.radians(2.0)
+#: Period of the recorded time series (s).
+SERIES_PERIOD = 0.01
+
+
+@dataclass
+class Playback:
+    """What a playback measured (SI units; angles in degrees where named ``_deg``)."""
+
+    duration: float
+    fell_at: Optional[float] = None
+    fall_reason: str = ""
+    max_tilt_deg: float = 0.0
+    max_foot_tilt_deg: float = 0.0
+    max_slip_m: float = 0.0
+    max_turn_deg: float = 0.0
+    com_inside_share: float = 1.0
+    min_com_margin_m: float = math.inf
+    non_foot_contact: Optional[str] = None
+    non_foot_contact_at: Optional[float] = None
+    limit_violations: int = 0
+    #: The largest |target − angle| (rad) of any joint after the settle, its joint and time: how
+    #: far the servos were from the plan.
+    max_tracking_error: float = 0.0
+    max_tracking_joint: str = ""
+    max_tracking_time: float = 0.0
+    #: Rows every 10 ms: time, base height, base tilt (deg), CoM margin (m), left and right
+    #: sole normal force (N).
+    series: List[Sequence[float]] = field(default_factory=list)
+
+
+def _quat_tilt_deg(xmat: np.ndarray) -> float:
+    return math.degrees(math.acos(max(-1.0, min(1.0, float(xmat[8])))))
+
+
+def _hull(points: np.ndarray) -> np.ndarray:
+    """Convex hull (counter-clockwise) of 2-D points (monotone chain)."""
+    pts = sorted(set(map(tuple, np.round(points, 9))))
+    if len(pts) < 3:
+        return np.array(pts)
+
+    def cross(o, a, b):
+        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+
+    lower, upper = [], []
+    for p in pts:
+        while len(lower) >= 2 and cross(lower[-2], lower[-1], p) <= 0:
+            lower.pop()
+        lower.append(p)
+    for p in reversed(pts):
+        while len(upper) >= 2 and cross(upper[-2], upper[-1], p) <= 0:
+            upper.pop()
+        upper.append(p)
+    return np.array(lower[:-1] + upper[:-1])
+
+
+def _margin(hull: np.ndarray, p: np.ndarray) -> float:
+    """Signed distance of ``p`` to the hull's boundary (> 0 inside); -inf without a hull."""
+    if len(hull) == 0:
+        return -math.inf
+    if len(hull) < 3:  # a point or a segment: never inside
+        if len(hull) == 1:
+            return -float(np.linalg.norm(p - hull[0]))
+        a, b = hull
+        t = np.clip(np.dot(p - a, b - a) / max(np.dot(b - a, b - a), 1e-18), 0, 1)
+        return -float(np.linalg.norm(p - (a + t * (b - a))))
+    inside, dist = True, math.inf
+    for a, b in zip(hull, np.roll(hull, -1, axis=0)):
+        edge = b - a
+        cross = edge[0] * (p[1] - a[1]) - edge[1] * (p[0] - a[0])
+        inside &= cross >= 0
+        t = np.clip(np.dot(p - a, edge) / max(np.dot(edge, edge), 1e-18), 0, 1)
+        dist = min(dist, float(np.linalg.norm(p - (a + t * edge))))
+    return dist if inside else -dist
+
+
+def place(pm: PhysicsModel, data: mujoco.MjData, q0: np.ndarray) -> None:
+    """Sets the posture ``q0`` standing (module docs)."""
+    m = pm.model
+    data.qpos[:] = 0
+    data.qpos[3] = 1.0
+    pm.set_joints(data.qpos, q0)
+    mujoco.mj_forward(m, data)
+    soles = [(data.xpos[b].copy(), data.xmat[b].reshape(3, 3).copy()) for b in pm.sole_bodies]
+    low = min(range(2), key=lambda i: soles[i][0][2])
+    down = [
+        i for i in range(2)
+        if soles[i][0][2] - soles[low][0][2] <= BOTH_FEET_HEIGHT
+        and math.acos(min(1.0, float(np.dot(soles[i][1][:, 2], soles[low][1][:, 2])))) <= BOTH_FEET_TILT
+    ]
+    normal = sum(soles[i][1][:, 2] for i in down)
+    normal = normal / np.linalg.norm(normal)
+    # The rotation taking the soles' mean normal to the vertical.
+    axis = np.cross(normal, [0.0, 0.0, 1.0])
+    angle = math.atan2(np.linalg.norm(axis), normal[2])
+    quat = np.zeros(4)
+    if np.linalg.norm(axis) > 1e-12:
+        mujoco.mju_axisAngle2Quat(quat, axis / np.linalg.norm(axis), angle)
+    else:
+        quat[:] = [1, 0, 0, 0]
+    data.qpos[3:7] = quat
+    mujoco.mj_forward(m, data)
+    lowest = min(data.xpos[pm.sole_bodies[i]][2] for i in down)
+    right = data.xpos[pm.sole_bodies[1]]
+    data.qpos[0:3] = [-right[0], -right[1], -lowest]
+    data.qvel[:] = 0
+    mujoco.mj_forward(m, data)
+
+
+def play(
+    pm: PhysicsModel,
+    times: np.ndarray,
+    targets: np.ndarray,
+    settle: float = 1.0,
+    hold: float = 1.0,
+) -> Playback:
+    """Plays ``targets`` (N x len(pm.columns), rad) at ``times`` (N, s, increasing) on ``pm``."""
+    m = pm.model
+    data = mujoco.MjData(m)
+    out = Playback(duration=float(times[-1] - times[0]))
+    out.limit_violations = int(np.sum((targets < pm.lower - 1e-9) | (targets > pm.upper + 1e-9)))
+    targets = np.clip(targets, pm.lower, pm.upper)
+    place(pm, data, targets[0])
+    dt = m.opt.timestep
+    steps_settle = int(round(settle / dt))
+    steps_play = int(math.ceil((times[-1] - times[0]) / dt))
+    steps = steps_settle + steps_play + int(round(hold / dt))
+    weight = pm.total_mass * 9.81
+    h0 = float(data.xpos[pm.base_body][2])
+    ctrl = targets[0].copy()
+    max_step = pm.velocity * dt
+    force6 = np.zeros(6)
+    anchor: List[Optional[tuple]] = [None, None]  # (sole-local CoP, its world start, start yaw)
+    inside = 0
+    every = int(round(SERIES_PERIOD / dt))
+    clock = times[0] + (np.arange(steps) - steps_settle + 1) * dt
+    tau = np.clip(clock, times[0], times[-1])
+    goals = np.column_stack([np.interp(tau, times, targets[:, c]) for c in range(targets.shape[1])])
+    for k in range(steps):
+        t = float(clock[k])
+        ctrl += np.clip(goals[k] - ctrl, -max_step, max_step)
+        data.ctrl[:] = ctrl
+        mujoco.mj_step(m, data)
+        base_tilt = _quat_tilt_deg(data.xmat[pm.base_body])
+        height = float(data.xpos[pm.base_body][2])
+        out.max_tilt_deg = max(out.max_tilt_deg, base_tilt)
+        if height < 0.6 * h0 or base_tilt > 45.0:
+            out.fell_at = t
+            out.fall_reason = (f"base at {height:.3f} m, under 60 % of {h0:.3f} m" if height < 0.6 * h0
+                               else f"base tilted {base_tilt:.1f}°")
+            break
+        force = [0.0, 0.0]
+        cop = [np.zeros(3), np.zeros(3)]
+        points = []
+        for c in range(data.ncon):
+            con = data.contact[c]
+            if pm.floor_geom not in (con.geom1, con.geom2):
+                continue
+            other = con.geom2 if con.geom1 == pm.floor_geom else con.geom1
+            mujoco.mj_contactForce(m, data, c, force6)
+            if force6[0] < CONTACT_FORCE:
+                continue
+            side = pm.sole_geoms.get(int(other))
+            if side is None:
+                if out.non_foot_contact is None:
+                    out.non_foot_contact = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, int(m.geom_bodyid[other]))
+                    out.non_foot_contact_at = t
+                continue
+            force[side] += force6[0]
+            cop[side] += force6[0] * con.pos
+            points.append(con.pos[:2].copy())
+        for side, body in enumerate(pm.sole_bodies):
+            R = data.xmat[body].reshape(3, 3)
+            if force[side] > 0:
+                out.max_foot_tilt_deg = max(out.max_foot_tilt_deg, _quat_tilt_deg(data.xmat[body]))
+            if force[side] >= LOADED_SHARE * weight:
+                yaw = math.atan2(R[1, 0], R[0, 0])
+                if anchor[side] is None:
+                    p = cop[side] / force[side]
+                    anchor[side] = (R.T @ (p - data.xpos[body]), p, yaw)
+                local, start, yaw0 = anchor[side]
+                now = R @ local + data.xpos[body]
+                out.max_slip_m = max(out.max_slip_m, float(np.linalg.norm((now - start)[:2])))
+                turn = (yaw - yaw0 + math.pi) % (2 * math.pi) - math.pi
+                out.max_turn_deg = max(out.max_turn_deg, abs(math.degrees(turn)))
+            else:
+                anchor[side] = None
+        if k >= steps_settle:
+            error = np.abs(data.qpos[pm.qpos_address] - ctrl)
+            worst = int(np.argmax(error))
+            if error[worst] > out.max_tracking_error:
+                out.max_tracking_error = float(error[worst])
+                out.max_tracking_joint, out.max_tracking_time = pm.columns[worst], t
+        # Body 1 is the floating root: its subtree is the whole robot.
+        com = data.subtree_com[1][:2]
+        margin = _margin(_hull(np.array(points)) if points else np.zeros((0, 2)), com)
+        if k >= steps_settle:
+            inside += margin >= 0
+            out.min_com_margin_m = min(out.min_com_margin_m, margin)
+        if k % every == 0:
+            out.series.append((t, height, base_tilt, margin, force[0], force[1]))
+    out.com_inside_share = inside / max(1, k + 1 - steps_settle)
+    return out
