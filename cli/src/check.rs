@@ -70,7 +70,10 @@ pub(crate) fn check(
     report: Report,
 ) -> Result<ExitCode> {
     if let Some(run) = runs.iter().find(|run| !run.exists()) {
-        eprintln!("taskstack: error: {}: no such folder or file", run.display());
+        eprintln!(
+            "taskstack: error: {}: no such folder or file",
+            run.display()
+        );
         return Ok(ExitCode::from(2));
     }
     let python = std::env::var_os("TASKSTACK_PYTHON").unwrap_or_else(|| "python3".into());

@@ -57,32 +57,7 @@ fn the_viewer_draws_and_plays_in_a_headless_browser() {
     assert_eq!(run.code, Some(0), "{}", run.stderr);
     let page = out.join("view.html").canonicalize().unwrap();
     let size = std::fs::metadata(&page).unwrap().len();
-    let profile = temp_dir("viewer-profile");
-    let output = Command::new(&browser)
-        .args([
-            "--headless",
-            "--no-sandbox",
-            "--disable-gpu",
-            "--no-first-run",
-            "--window-size=900,600",
-            "--virtual-time-budget=5000",
-            "--enable-logging=stderr",
-            "--v=0",
-        ])
-        .arg(format!("--user-data-dir={}", s(&profile)))
-        .arg("--dump-dom")
-        .arg(format!("file://{}#selftest", s(&page)))
-        .output()
-        .expect("the browser runs");
-    let dom = String::from_utf8_lossy(&output.stdout);
-    let log = String::from_utf8_lossy(&output.stderr);
-    let report = dom
-        .split("<pre id=\"selftest\">")
-        .nth(1)
-        .and_then(|rest| rest.split("</pre>").next())
-        .unwrap_or_else(|| panic!("no self-test report in the page; browser log:\n{log}"));
-    let report: Value =
-        serde_json::from_str(&report.replace("&quot;", "\"")).expect("the report is JSON");
+    let report = selftest(&browser, &page);
     assert_eq!(
         report["errors"],
         Value::Array(vec![]),
@@ -102,6 +77,54 @@ fn the_viewer_draws_and_plays_in_a_headless_browser() {
         (15..=31).contains(&played),
         "one second of playback moves up to 30 frames: {report}"
     );
-    assert!(!log.contains("Uncaught"), "console errors:\n{log}");
     assert!(size < 2_000_000, "view.html is {size} bytes");
+
+    // With a simulated robot spliced in as `taskstack check` does (python/taskstack/sim/view.py),
+    // the page still runs clean and draws more: the gray robot beside the plan.
+    let text = std::fs::read_to_string(&page).unwrap();
+    let sim = r#"const SIM = {"t0":0,"rate":30,"frames":[[0,300,0,0,300,300],[0,300,0,0,300,280]],"segments":[[0,1]],"model":"nominal","verdict":"PASS"};"#;
+    std::fs::write(
+        &page,
+        text.replacen("\nconst TAIL = ", &format!("\n{sim}\nconst TAIL = "), 1),
+    )
+    .unwrap();
+    let with_sim = selftest(&browser, &page);
+    assert_eq!(
+        with_sim["errors"],
+        Value::Array(vec![]),
+        "script errors: {with_sim}"
+    );
+    let first = |r: &Value| r["drawn"][0].as_f64().unwrap();
+    assert!(first(&with_sim) > first(&report), "{with_sim} vs {report}");
+}
+
+/// Loads `page` with `#selftest` in the headless `browser` and returns the page's report; the
+/// browser's log must hold no uncaught error.
+fn selftest(browser: &PathBuf, page: &std::path::Path) -> Value {
+    let profile = temp_dir("viewer-profile");
+    let output = Command::new(browser)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--no-first-run",
+            "--window-size=900,600",
+            "--virtual-time-budget=5000",
+            "--enable-logging=stderr",
+            "--v=0",
+        ])
+        .arg(format!("--user-data-dir={}", s(&profile)))
+        .arg("--dump-dom")
+        .arg(format!("file://{}#selftest", s(page)))
+        .output()
+        .expect("the browser runs");
+    let dom = String::from_utf8_lossy(&output.stdout);
+    let log = String::from_utf8_lossy(&output.stderr);
+    let report = dom
+        .split("<pre id=\"selftest\">")
+        .nth(1)
+        .and_then(|rest| rest.split("</pre>").next())
+        .unwrap_or_else(|| panic!("no self-test report in the page; browser log:\n{log}"));
+    assert!(!log.contains("Uncaught"), "console errors:\n{log}");
+    serde_json::from_str(&report.replace("&quot;", "\"")).expect("the report is JSON")
 }

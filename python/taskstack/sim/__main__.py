@@ -3,7 +3,8 @@
 Each OUT_DIR is an output folder of ``taskstack imitate``/``batch``/``walk`` (its
 ``joints.csv``) or a ``joints.csv``; the robot is told by the joint names. Prints one line per
 run and model (``--json``: one JSON document), writes ``OUT_DIR/physics.svg`` (base tilt, CoM
-margin, sole forces over time) for a folder. Exit status: 0 every run passes, 1 one fails,
+margin, sole forces over time) for a folder and adds the simulated robot (the first model's) to
+its ``view.html``, drawn in gray beside the plan. Exit status: 0 every run passes, 1 one fails,
 2 bad input.
 """
 
@@ -17,6 +18,7 @@ from typing import List
 
 from .checks import InputError, Verdict, check_run
 from .plot import write_plot
+from .view import add_simulation
 
 
 def main(argv: List[str] = None) -> int:
@@ -28,7 +30,8 @@ def main(argv: List[str] = None) -> int:
                     help="which physics model (default: both)")
     ap.add_argument("--json", action="store_true", help="print one JSON document")
     ap.add_argument("--hold", type=float, default=1.0, help="seconds of the last posture after the run (default 1)")
-    ap.add_argument("--no-plot", action="store_true", help="do not write OUT_DIR/physics.svg")
+    ap.add_argument("--no-plot", action="store_true",
+                    help="do not write OUT_DIR/physics.svg nor add the simulation to view.html")
     a = ap.parse_args(argv)
     if not (0.0 <= a.hold <= 3600.0):
         print(f"taskstack check: --hold {a.hold}: must be 0–3600 s", file=sys.stderr)
@@ -48,6 +51,8 @@ def main(argv: List[str] = None) -> int:
                 print(v.summary(), flush=True)
         if Path(run).is_dir() and not a.no_plot:
             write_plot(Path(run) / "physics.svg", per_run)
+            if (Path(run) / "view.html").is_file():
+                add_simulation(Path(run) / "view.html", per_run[0])
         verdicts += per_run
     if a.json:
         print(json.dumps({"runs": [v.to_json() for v in verdicts],

@@ -60,7 +60,8 @@ class Verdict:
 
     def to_json(self) -> Dict:
         out = asdict(self)
-        out["playback"].pop("series")
+        for bulky in ("series", "draw_frames", "draw_segments", "draw_t0"):
+            out["playback"].pop(bulky)
         out["thresholds"] = THRESHOLDS
         return out
 

@@ -36,6 +36,8 @@ CONTACT_FORCE = 1.0
 BOTH_FEET_HEIGHT, BOTH_FEET_TILT = 0.005, math.radians(2.0)
 #: Period of the recorded time series (s).
 SERIES_PERIOD = 0.01
+#: Frames a second of the simulated robot recorded for the viewer.
+DRAW_RATE = 30
 
 
 @dataclass
@@ -62,6 +64,12 @@ class Playback:
     #: Rows every 10 ms: time, base height, base tilt (deg), CoM margin (m), left and right
     #: sole normal force (N).
     series: List[Sequence[float]] = field(default_factory=list)
+    #: The simulated robot for a viewer, ``DRAW_RATE`` frames a second from ``draw_t0`` (s):
+    #: per frame the drawn bodies' origins (x y z in integer mm, world), and the segments
+    #: (pairs of indices into a frame's points) that draw the robot.
+    draw_t0: float = 0.0
+    draw_frames: List[List[int]] = field(default_factory=list)
+    draw_segments: List[Sequence[int]] = field(default_factory=list)
 
 
 def _quat_tilt_deg(xmat: np.ndarray) -> float:
@@ -107,6 +115,22 @@ def _margin(hull: np.ndarray, p: np.ndarray) -> float:
         t = np.clip(np.dot(p - a, edge) / max(np.dot(edge, edge), 1e-18), 0, 1)
         dist = min(dist, float(np.linalg.norm(p - (a + t * edge))))
     return dist if inside else -dist
+
+
+def drawing(pm: PhysicsModel, data: mujoco.MjData):
+    """The bodies drawn (the links: at least 1 g, and the soles) and the segments joining each
+    to its nearest drawn ancestor, for the posture in ``data``."""
+    m = pm.model
+    keep = [b for b in range(1, m.nbody) if m.body_mass[b] >= 0.001 or b in pm.sole_bodies]
+    index = {b: i for i, b in enumerate(keep)}
+    segments = []
+    for b in keep:
+        parent = int(m.body_parentid[b])
+        while parent > 0 and parent not in index:
+            parent = int(m.body_parentid[parent])
+        if parent in index and np.linalg.norm(data.xpos[b] - data.xpos[parent]) >= 0.005:
+            segments.append((index[parent], index[b]))
+    return keep, segments
 
 
 def place(pm: PhysicsModel, data: mujoco.MjData, q0: np.ndarray) -> None:
@@ -168,6 +192,9 @@ def play(
     anchor: List[Optional[tuple]] = [None, None]  # (sole-local CoP, its world start, start yaw)
     inside = 0
     every = int(round(SERIES_PERIOD / dt))
+    drawn, out.draw_segments = drawing(pm, data)
+    draw_every = int(round(1.0 / DRAW_RATE / dt))
+    out.draw_t0 = float(times[0] + (1 - steps_settle) * dt)
     clock = times[0] + (np.arange(steps) - steps_settle + 1) * dt
     tau = np.clip(clock, times[0], times[-1])
     goals = np.column_stack([np.interp(tau, times, targets[:, c]) for c in range(targets.shape[1])])
@@ -232,6 +259,8 @@ def play(
         if k >= steps_settle:
             inside += margin >= 0
             out.min_com_margin_m = min(out.min_com_margin_m, margin)
+        if k % draw_every == 0:
+            out.draw_frames.append(np.round(data.xpos[drawn] * 1000).astype(int).ravel().tolist())
         if k % every == 0:
             out.series.append((t, height, base_tilt, margin, force[0], force[1]))
     out.com_inside_share = inside / max(1, k + 1 - steps_settle)
