@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{KINECT, WALK, clip, s, taskstack, taskstack_with_input, temp_dir};
+use common::{KINECT, WALK, clip, imitated_kinect, s, taskstack, taskstack_with_input, temp_dir};
 use serde_json::Value;
 
 #[test]
@@ -328,17 +328,7 @@ fn files_in(dir: &std::path::Path) -> Vec<(String, Vec<u8>)> {
 fn check_without_the_simulator_says_how_to_install_it() {
     use std::process::Command;
     let dir = temp_dir("check");
-    let out = dir.join("run");
-    let run = taskstack(&[
-        "-q",
-        "imitate",
-        s(&clip(KINECT)),
-        "--out",
-        s(&out),
-        "--hold",
-        "0",
-    ]);
-    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    let out = imitated_kinect(&dir, "0");
     let missing = Command::new(env!("CARGO_BIN_EXE_taskstack"))
         .args(["check", s(&out)])
         .env("TASKSTACK_PYTHON", dir.join("no-python"))
@@ -646,17 +636,7 @@ fn solve_runs_a_benchmark_problem() {
 #[test]
 fn view_prints_the_page_of_an_output_folder() {
     let dir = temp_dir("view");
-    let out = dir.join("run");
-    let run = taskstack(&[
-        "-q",
-        "imitate",
-        s(&clip(KINECT)),
-        "--out",
-        s(&out),
-        "--hold",
-        "0",
-    ]);
-    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    let out = imitated_kinect(&dir, "0");
     let view = taskstack(&["view", s(&out), "--no-open"]);
     assert_eq!(view.code, Some(0), "{}", view.stderr);
     assert!(

@@ -8,7 +8,7 @@ mod common;
 use std::path::PathBuf;
 use std::process::Command;
 
-use common::{KINECT, clip, s, taskstack, temp_dir};
+use common::{imitated_kinect, s, temp_dir};
 use serde_json::Value;
 
 /// The first browser found: `TASKSTACK_BROWSER`, else chromium, chromium-browser, google-chrome.
@@ -44,17 +44,7 @@ fn the_viewer_draws_and_plays_in_a_headless_browser() {
         return;
     };
     let dir = temp_dir("viewer");
-    let out = dir.join("run");
-    let run = taskstack(&[
-        "-q",
-        "imitate",
-        s(&clip(KINECT)),
-        "--out",
-        s(&out),
-        "--hold",
-        "1",
-    ]);
-    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    let out = imitated_kinect(&dir, "1");
     let page = out.join("view.html").canonicalize().unwrap();
     let size = std::fs::metadata(&page).unwrap().len();
     let report = selftest(&browser, &page);

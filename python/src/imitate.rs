@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use numpy::ndarray::{Array2, Array3};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray2};
-use pyo3::exceptions::{PyFileNotFoundError, PyOSError};
+use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyTypeError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use taskstack::batch::{Hold, imitate_clip as run_clip, metrics_json};
@@ -54,6 +54,47 @@ pub(crate) struct Settings {
 }
 
 impl Settings {
+    /// The settings of the keyword arguments `kwargs` (the options of `taskstack imitate`,
+    /// with its defaults); an unknown keyword is a `TypeError`, as Python's own are.
+    fn from_kwargs(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
+        let mut s = Settings {
+            method: "poubel".into(),
+            walk: false,
+            dynamic_walk: false,
+            velocity_fraction: 0.1,
+            upper_body_fraction: None,
+            task_speed: None,
+            tracking_speed: None,
+            iterations: 1,
+            calibration: "auto".into(),
+            retargeting: "shift-both-feet".into(),
+        };
+        let Some(kwargs) = kwargs else {
+            return Ok(s);
+        };
+        for (key, value) in kwargs.iter() {
+            let key: String = key.extract()?;
+            match key.as_str() {
+                "method" => s.method = value.extract()?,
+                "walk" => s.walk = value.extract()?,
+                "dynamic_walk" => s.dynamic_walk = value.extract()?,
+                "velocity_fraction" => s.velocity_fraction = value.extract()?,
+                "upper_body_fraction" => s.upper_body_fraction = value.extract()?,
+                "task_speed" => s.task_speed = value.extract()?,
+                "tracking_speed" => s.tracking_speed = value.extract()?,
+                "iterations" => s.iterations = value.extract()?,
+                "calibration" => s.calibration = value.extract()?,
+                "retargeting" => s.retargeting = value.extract()?,
+                other => {
+                    return Err(PyTypeError::new_err(format!(
+                        "unexpected keyword argument {other:?}"
+                    )));
+                }
+            }
+        }
+        Ok(s)
+    }
+
     fn config(&self, capture: CaptureSystem) -> PyResult<ImitatorConfig> {
         let method = match self.method.as_str() {
             "poubel" => ImitationMethod::Poubel,
@@ -189,43 +230,19 @@ fn run(
     })
 }
 
-/// Imitates the clip at `path` (BVH or Kinect v2 CSV); see the Python docstring.
+/// Imitates the clip at `path` (BVH or Kinect v2 CSV); see the Python docstring. `options`:
+/// the keywords of [`Settings::from_kwargs`].
 #[pyfunction]
-#[pyo3(signature = (
-    path, robot = "nao", hold = None, method = "poubel", walk = false, dynamic_walk = false,
-    offline = false, velocity_fraction = 0.1, upper_body_fraction = None, task_speed = None,
-    tracking_speed = None, iterations = 1, calibration = "auto", retargeting = "shift-both-feet"
-))]
-#[allow(clippy::too_many_arguments)] // Python keyword arguments, one per CLI option
+#[pyo3(signature = (path, robot = "nao", hold = None, offline = false, **options))]
 pub(crate) fn imitate_clip<'py>(
     py: Python<'py>,
     path: PathBuf,
     robot: &str,
     hold: Option<&Bound<'py, PyAny>>,
-    method: &str,
-    walk: bool,
-    dynamic_walk: bool,
     offline: bool,
-    velocity_fraction: f64,
-    upper_body_fraction: Option<f64>,
-    task_speed: Option<f64>,
-    tracking_speed: Option<f64>,
-    iterations: usize,
-    calibration: &str,
-    retargeting: &str,
+    options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let settings = Settings {
-        method: method.to_owned(),
-        walk,
-        dynamic_walk,
-        velocity_fraction,
-        upper_body_fraction,
-        task_speed,
-        tracking_speed,
-        iterations,
-        calibration: calibration.to_owned(),
-        retargeting: retargeting.to_owned(),
-    };
+    let settings = Settings::from_kwargs(options)?;
     let hold = self::hold(hold)?;
     let profile = profile(robot)?;
     let run = py.detach(|| run(&path, profile, &settings, offline, hold))?;
@@ -299,26 +316,8 @@ pub(crate) struct PyImitator {
 #[pymethods]
 impl PyImitator {
     #[new]
-    #[pyo3(signature = (
-        robot = "nao", capture = "optical", method = "poubel", walk = false, dynamic_walk = false,
-        velocity_fraction = 0.1, upper_body_fraction = None, task_speed = None,
-        tracking_speed = None, iterations = 1, calibration = "auto", retargeting = "shift-both-feet"
-    ))]
-    #[allow(clippy::too_many_arguments)]
-    fn new(
-        robot: &str,
-        capture: &str,
-        method: &str,
-        walk: bool,
-        dynamic_walk: bool,
-        velocity_fraction: f64,
-        upper_body_fraction: Option<f64>,
-        task_speed: Option<f64>,
-        tracking_speed: Option<f64>,
-        iterations: usize,
-        calibration: &str,
-        retargeting: &str,
-    ) -> PyResult<Self> {
+    #[pyo3(signature = (robot = "nao", capture = "optical", **options))]
+    fn new(robot: &str, capture: &str, options: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
         let capture = match capture {
             "optical" => CaptureSystem::Optical,
             "kinect" | "depth" => CaptureSystem::DepthCamera,
@@ -328,18 +327,7 @@ impl PyImitator {
                 )));
             }
         };
-        let settings = Settings {
-            method: method.to_owned(),
-            walk,
-            dynamic_walk,
-            velocity_fraction,
-            upper_body_fraction,
-            task_speed,
-            tracking_speed,
-            iterations,
-            calibration: calibration.to_owned(),
-            retargeting: retargeting.to_owned(),
-        };
+        let settings = Settings::from_kwargs(options)?;
         let imitator = Imitator::new(profile(robot)?, settings.config(capture)?).map_err(to_py)?;
         let recorder = MotionRecorder::new(&imitator).map_err(to_py)?;
         Ok(Self {

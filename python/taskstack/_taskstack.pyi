@@ -12,19 +12,11 @@ def imitate_clip(
     path: str,
     robot: str = "nao",
     hold: Union[float, str, None] = None,
-    method: str = "poubel",
-    walk: bool = False,
-    dynamic_walk: bool = False,
     offline: bool = False,
-    velocity_fraction: float = 0.1,
-    upper_body_fraction: Optional[float] = None,
-    task_speed: Optional[float] = None,
-    tracking_speed: Optional[float] = None,
-    iterations: int = 1,
-    calibration: str = "auto",
-    retargeting: str = "shift-both-feet",
+    **options: Any,
 ) -> Dict[str, Any]:
-    """The arrays of ``taskstack.ImitationResult`` as a dict, ``metrics_json`` a JSON string."""
+    """The arrays of ``taskstack.ImitationResult`` as a dict, ``metrics_json`` a JSON string.
+    ``options``: the keywords of ``taskstack.imitate_clip`` after ``offline``."""
     ...
 
 def read_clip(path: str) -> Tuple[np.ndarray, List[str], np.ndarray]:
@@ -36,24 +28,13 @@ def read_clip(path: str) -> Tuple[np.ndarray, List[str], np.ndarray]:
 class Imitator:
     """A live imitator: one human frame in, one robot frame out (the thread that made it only)."""
 
-    def __init__(
-        self,
-        robot: str = "nao",
-        capture: str = "optical",
-        method: str = "poubel",
-        walk: bool = False,
-        dynamic_walk: bool = False,
-        velocity_fraction: float = 0.1,
-        upper_body_fraction: Optional[float] = None,
-        task_speed: Optional[float] = None,
-        tracking_speed: Optional[float] = None,
-        iterations: int = 1,
-        calibration: str = "auto",
-        retargeting: str = "shift-both-feet",
-    ) -> None:
+    def __init__(self, robot: str = "nao", capture: str = "optical", **options: Any) -> None:
         """``robot``: "nao", "g1" or a profile path; ``capture``: "optical" (motion capture,
         120 Hz, mm noise) or "kinect" (depth camera, 30 Hz, cm noise), which sets the support
-        detection's thresholds; the other options as ``taskstack.imitate_clip``."""
+        detection's thresholds; ``options``: ``method``, ``walk``, ``dynamic_walk``,
+        ``velocity_fraction``, ``upper_body_fraction``, ``task_speed``, ``tracking_speed``,
+        ``iterations``, ``calibration``, ``retargeting``, as ``taskstack.imitate_clip``'s (an
+        unknown one is a TypeError)."""
         ...
     @property
     def joint_names(self) -> List[str]:

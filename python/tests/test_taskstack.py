@@ -126,6 +126,8 @@ def test_bad_input_raises_python_exceptions_with_the_rust_message(tmp):
         taskstack.imitate_clip(KINECT, velocity_fraction=0.0)
     with pytest.raises(FileNotFoundError, match="missing_profile.toml"):
         taskstack.imitate_clip(KINECT, robot=str(tmp / "missing_profile.toml"))
+    with pytest.raises(TypeError, match="velocity_fractoin"):
+        taskstack.Imitator(velocity_fractoin=0.5)
     imitator = taskstack.Imitator()
     with pytest.raises(ValueError, match="unknown human joint"):
         imitator.step(0.0, {"LeftElbowThing": [0.0, 0.0, 1.0]})

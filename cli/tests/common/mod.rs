@@ -87,3 +87,21 @@ pub const WALK: &str = "cmu_07_04_slow_walk.bvh";
 pub fn s(path: &Path) -> &str {
     path.to_str().expect("temporary paths are UTF-8")
 }
+
+/// `taskstack -q imitate KINECT --out DIR/run --hold HOLD`, asserted to succeed: the output
+/// folder of a short run (the bundled Kinect clip), for tests of what reads one.
+pub fn imitated_kinect(dir: &Path, hold: &str) -> PathBuf {
+    let out = dir.join("run");
+    let kinect = clip(KINECT);
+    let run = taskstack(&[
+        "-q",
+        "imitate",
+        s(&kinect),
+        "--out",
+        s(&out),
+        "--hold",
+        hold,
+    ]);
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    out
+}
