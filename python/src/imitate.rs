@@ -12,6 +12,7 @@ use taskstack::batch::{Hold, imitate_clip as run_clip, metrics_json};
 use taskstack::export::{MotionRecorder, MotionTrack};
 use taskstack::human::{CaptureSystem, HumanFrame, HumanJoint};
 use taskstack::imitation::config::ImitationMethod;
+use taskstack::imitation::imitator::EFFECTORS;
 use taskstack::imitation::koenemann::{Calibration, FootRetargeting, KoenemannConfig};
 use taskstack::imitation::look_ahead::{FootLookAhead, FootSchedule};
 use taskstack::imitation::support::SupportConfig;
@@ -443,6 +444,19 @@ fn robot_frame_dict<'py>(
     out.set_item("com", PyArray1::from_slice(py, frame.com.as_slice()))?;
     out.set_item("contacts", contacts.to_vec())?;
     out.set_item("awaiting_contact", frame.awaiting_contact)?;
+    // Hands and ankles, world frame, beside the scaled human's same joints.
+    let effectors = PyDict::new(py);
+    let reference = PyDict::new(py);
+    for ((name, joint), position) in EFFECTORS.iter().zip(&frame.effectors) {
+        let world = frame.world_t_root.transform_point(&(*position).into());
+        effectors.set_item(*name, PyArray1::from_slice(py, world.coords.as_slice()))?;
+        if let Some(p) = frame.reference[joint.index()] {
+            let world = frame.world_t_root.transform_point(&p.into());
+            reference.set_item(*name, PyArray1::from_slice(py, world.coords.as_slice()))?;
+        }
+    }
+    out.set_item("effectors", effectors)?;
+    out.set_item("human_effectors", reference)?;
     Ok(out)
 }
 

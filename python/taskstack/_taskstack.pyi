@@ -57,7 +57,9 @@ class Imitator:
         Returns a dict: ``time`` (s), ``q`` (J, rad), ``phase`` (str), ``root_pos`` (3, m) and
         ``root_quat`` (4, x y z w) of the floating base, ``left_sole`` and ``right_sole``
         (4 x 4 world placements), ``com`` (3, m), ``contacts`` ([left, right] on the floor),
-        ``awaiting_contact`` (feed the same frame again: a hand is being placed).
+        ``awaiting_contact`` (feed the same frame again: a hand is being placed),
+        ``effectors`` (the robot's "l_hand", "r_hand", "l_ankle", "r_ankle": (3,) world
+        positions, m) and ``human_effectors`` (the scaled human's same joints, where known).
 
         Raises ValueError for an unknown joint name, a non-finite position, a bad shape, or a
         frame the imitator refuses (time not after the previous one)."""

@@ -80,6 +80,16 @@ def test_imitate_clip_gives_the_cli_joint_angles(tmp, clip, robot, args, kwargs)
         metrics = json.load(f)
     assert r.metrics["frames"] == metrics["frames"] == len(r.time)
     assert len(r.phase) == len(r.time)
+    # motion.npz loads with numpy, its arrays consistent, at the clip's own rate.
+    npz = np.load(tmp / "out" / "motion.npz")
+    n = len(npz["time"])
+    assert list(npz["joint_names"]) == r.joint_names
+    assert npz["dof_pos"].shape == (n, len(r.joint_names)) and npz["root_pos"].shape == (n, 3)
+    assert npz["root_quat"].shape == (n, 4) and npz["contacts"].shape == (n, 2)
+    assert npz["contacts"].dtype == bool and float(npz["fps"]) == r.fps
+    assert np.allclose(np.diff(npz["time"]), 1.0 / r.fps)
+    # Its first frame is the run's first frame.
+    assert np.array_equal(npz["dof_pos"][0], r.q[0]) and np.array_equal(npz["root_pos"][0], r.root_pos[0])
 
 
 def test_the_result_has_consistent_shapes_and_a_standing_sole_on_the_floor():
@@ -155,6 +165,7 @@ def test_a_live_imitator_fed_a_clip_frame_by_frame_gives_the_clips_run():
         out = imitator.step(t, frame, names=names)
         assert out["q"].shape == (len(imitator.joint_names),)
         assert out["root_quat"].shape == (4,) and out["left_sole"].shape == (4, 4)
+        assert set(out["effectors"]) == {"l_hand", "r_hand", "l_ankle", "r_ankle"}
         qs.append(out["q"])
     batch = taskstack.imitate_clip(KINECT, hold=0)
     assert np.array_equal(np.array(qs), batch.q)
