@@ -11,7 +11,7 @@ use crate::Report;
 
 /// Check runs in physics: play each OUT_DIR's joints.csv on a MuJoCo model of its robot.
 ///
-/// The robot (NAO or G1, told by the joint names) starts standing in the first posture, holds it
+/// The robot (NAO or G1, told by the joint names, or --robot) starts standing in the first posture, holds it
 /// 1 s, plays the run, holds the last posture --hold s. A run passes when the robot does not fall
 /// (base under 60 % of its height or tilted over 45°), no sole on the floor tilts over 5°, no
 /// loaded sole (≥ 20 % of the weight) slides over 5 mm or turns over 2°, the CoM ground point is
@@ -35,6 +35,10 @@ pub(crate) struct CheckArgs {
     /// Seconds the last posture is held after the run (0–3600).
     #[arg(long, value_name = "SECONDS", default_value_t = 1.0)]
     hold: f64,
+    /// The robot: nao, g1 or a biped profile file (TOML). Default: the built-in robot the
+    /// joint names of joints.csv belong to.
+    #[arg(long, value_name = "nao|g1|PROFILE.toml")]
+    robot: Option<String>,
 }
 
 /// The physics models a check plays on.
@@ -59,7 +63,13 @@ impl PhysicsModel {
 }
 
 pub(crate) fn run(args: CheckArgs, report: Report) -> Result<ExitCode> {
-    check(&args.runs, args.model, args.hold, report)
+    check(
+        &args.runs,
+        args.model,
+        args.hold,
+        args.robot.as_deref(),
+        report,
+    )
 }
 
 /// Runs `taskstack.sim` on `runs`; its exit status (0 pass, 1 fail, 2 bad input) is ours.
@@ -67,6 +77,7 @@ pub(crate) fn check(
     runs: &[PathBuf],
     model: PhysicsModel,
     hold: f64,
+    robot: Option<&str>,
     report: Report,
 ) -> Result<ExitCode> {
     if let Some(run) = runs.iter().find(|run| !run.exists()) {
@@ -97,6 +108,9 @@ pub(crate) fn check(
     command.arg("--hold").arg(hold.to_string());
     if report.json {
         command.arg("--json");
+    }
+    if let Some(robot) = robot {
+        command.arg("--robot").arg(robot);
     }
     command.args(runs);
     if report.quiet && !report.json {

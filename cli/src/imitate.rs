@@ -170,7 +170,8 @@ pub(crate) fn run(args: ImitateArgs, report: Report) -> Result<ExitCode> {
     }
     crate::output(&text)?;
     if args.check {
-        return crate::check::check(&[out], PhysicsModel::Both, CHECK_HOLD, report);
+        let robot = Some(args.options.robot.as_str());
+        return crate::check::check(&[out], PhysicsModel::Both, CHECK_HOLD, robot, report);
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -10,13 +10,14 @@ use taskstack::human::Side;
 use taskstack::model::{JointKind, Model};
 use taskstack::robots::{BipedProfile, g1, nao};
 
-use crate::errors::{to_py, value_error};
+use crate::errors::{profile_error, to_py};
+use crate::imitate::profile;
 
 /// The NAO H25 V5 URDF (qibullet's, no meshes): the second derivation of the NAO in this
 /// repository (its README is beside it), and the source of its physics model.
 const NAO_URDF: &str = include_str!("../../tests/data/nao.urdf");
 
-/// The description of `robot` (`"nao"` or `"g1"`); see the Python docstring.
+/// The description of `robot` (`"nao"`, `"g1"` or a profile file); see the Python docstring.
 #[pyfunction]
 pub(crate) fn robot_description<'py>(py: Python<'py>, robot: &str) -> PyResult<Bound<'py, PyDict>> {
     let (urdf, model, profile): (String, Model, BipedProfile) = match robot {
@@ -30,10 +31,11 @@ pub(crate) fn robot_description<'py>(py: Python<'py>, robot: &str) -> PyResult<B
             g1::pelvis(),
             g1::profile(),
         ),
-        other => {
-            return Err(value_error(format!(
-                "robot {other:?}: the physics models are built for \"nao\" and \"g1\""
-            )));
+        path => {
+            let (urdf, options) =
+                BipedProfile::physics_source(path).map_err(|e| profile_error(path, e))?;
+            let model = Model::from_urdf_str(&urdf, &options).map_err(to_py)?;
+            (urdf, model, profile(path)?)
         }
     };
     let variables = model.variables();

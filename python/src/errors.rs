@@ -5,6 +5,7 @@ use std::error::Error;
 
 use pyo3::PyErr;
 use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyValueError};
+use taskstack::robots::ProfileError;
 
 /// The error and its causes, `: `-separated, each once (our messages quote their sources).
 pub(crate) fn message(error: &(dyn Error + 'static)) -> String {
@@ -48,4 +49,16 @@ pub(crate) fn to_py(error: impl Error + 'static) -> PyErr {
 /// A `ValueError` with `text`.
 pub(crate) fn value_error(text: impl Into<String>) -> PyErr {
     PyValueError::new_err(text.into())
+}
+
+/// A profile file's error: the profile error keeps an I/O error's message only, so the class
+/// comes from the path (`FileNotFoundError` when it does not exist, `OSError` otherwise).
+pub(crate) fn profile_error(path: &str, error: ProfileError) -> PyErr {
+    match error {
+        ProfileError::Io { .. } if !std::path::Path::new(path).exists() => {
+            PyFileNotFoundError::new_err(error.to_string())
+        }
+        ProfileError::Io { .. } => PyOSError::new_err(error.to_string()),
+        other => to_py(other),
+    }
 }

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use numpy::ndarray::{Array2, Array3};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray2};
-use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyTypeError};
+use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use taskstack::batch::{Hold, imitate_clip as run_clip, metrics_json};
@@ -17,24 +17,17 @@ use taskstack::imitation::koenemann::{Calibration, FootRetargeting, KoenemannCon
 use taskstack::imitation::look_ahead::{FootLookAhead, FootSchedule};
 use taskstack::imitation::support::SupportConfig;
 use taskstack::io::clip::Clip;
-use taskstack::robots::{BipedProfile, ProfileError, g1, nao};
+use taskstack::robots::{BipedProfile, g1, nao};
 use taskstack::{Imitator, ImitatorConfig, IsometryMatrix3, RobotFrame};
 
-use crate::errors::{to_py, value_error};
+use crate::errors::{profile_error, to_py, value_error};
 
 /// The robot named `robot`: `"nao"`, `"g1"` or the path of a biped profile (TOML).
 pub(crate) fn profile(robot: &str) -> PyResult<BipedProfile> {
     match robot {
         "nao" => Ok(nao::profile()),
         "g1" => Ok(g1::profile()),
-        path => BipedProfile::from_toml_file(path).map_err(|err| match err {
-            // The profile error keeps the I/O error's message only: the class from the path.
-            ProfileError::Io { .. } if !Path::new(path).exists() => {
-                PyFileNotFoundError::new_err(err.to_string())
-            }
-            ProfileError::Io { .. } => PyOSError::new_err(err.to_string()),
-            other => to_py(other),
-        }),
+        path => BipedProfile::from_toml_file(path).map_err(|err| profile_error(path, err)),
     }
 }
 

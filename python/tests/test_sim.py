@@ -18,6 +18,8 @@ from taskstack import sim  # noqa: E402
 from taskstack._taskstack import robot_description  # noqa: E402
 
 ROBOTS = ["nao", "g1"]
+#: A biped nobody tuned, from its profile file: the check builds its model from the profile.
+TINY = str(Path(__file__).resolve().parents[2] / "tests" / "data" / "tiny_biped" / "tiny_biped.toml")
 
 
 @pytest.fixture
@@ -45,7 +47,7 @@ def smooth(s):
     return s * s * (3 - 2 * s)
 
 
-@pytest.mark.parametrize("robot", ROBOTS)
+@pytest.mark.parametrize("robot", ROBOTS + [TINY])
 def test_the_physics_model_has_the_rust_models_masses_and_frames(tmp, robot):
     pm = sim.build(robot)
     d = robot_description(robot)
@@ -78,14 +80,14 @@ def test_the_physics_model_has_the_rust_models_masses_and_frames(tmp, robot):
     assert compared >= 20
 
 
-@pytest.mark.parametrize("robot", ROBOTS)
+@pytest.mark.parametrize("robot", ROBOTS + [TINY])
 def test_a_standing_pose_stands(tmp, robot):
     pm = sim.build(robot)
     times = np.linspace(0.0, 2.0, 201)
     q = np.tile(stand(pm), (len(times), 1))
     run = write_run(tmp / "stand", pm.columns, times, q)
     for weak in (False, True):
-        v = sim.check_run(run, weak=weak)
+        v = sim.check_run(run, weak=weak, robot=robot)
         assert v.passed, v.summary()
         assert v.playback.com_inside_share == 1.0
 
@@ -143,7 +145,7 @@ def test_a_quasi_static_step_onto_one_leg_stands(tmp, robot):
     assert np.any((forces[:, 0] == 0) & (forces[:, 1] > 0))
 
 
-@pytest.mark.parametrize("robot", ROBOTS)
+@pytest.mark.parametrize("robot", ROBOTS + [TINY])
 def test_a_lean_that_must_fall_falls(tmp, robot):
     pm = sim.build(robot)
     times = np.arange(0.0, 3.0, 0.01)
@@ -153,7 +155,7 @@ def test_a_lean_that_must_fall_falls(tmp, robot):
         if "ankle" in name.lower() and "pitch" in name.lower():
             q[:, c] = np.clip(q[:, c] + 0.6 * smooth(times - 0.5), pm.lower[c], pm.upper[c])
     run = write_run(tmp / "lean", pm.columns, times, q)
-    v = sim.check_run(run)
+    v = sim.check_run(run, robot=robot)
     assert not v.passed and v.playback.fell_at is not None, v.summary()
 
 

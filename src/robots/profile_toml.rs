@@ -175,16 +175,24 @@ impl BipedProfile {
     /// [`ProfileError::Model`]).
     pub fn from_toml_file(path: impl AsRef<Path>) -> Result<Self, ProfileError> {
         let path = path.as_ref();
-        let read = |p: &Path| {
-            std::fs::read_to_string(p).map_err(|e| ProfileError::Io {
-                path: p.display().to_string(),
-                message: e.to_string(),
-            })
-        };
-        let text = read(path)?;
-        let file = parse(&text, &path.display().to_string())?;
+        let file = parse(&read_file(path)?, &path.display().to_string())?;
         let urdf_path = path.parent().unwrap_or(Path::new("")).join(&file.urdf);
-        build(file, &read(&urdf_path)?)
+        build(file, &read_file(&urdf_path)?)
+    }
+
+    /// What a physics model of the robot of the profile file at `path` is generated from: the
+    /// URDF text its models are built from (the file's URDF with the two sole links added) and
+    /// the loader options of the model rooted at the URDF's own root (the floating base), with
+    /// the profile's locked joints and variable order.
+    ///
+    /// # Errors
+    /// As [`BipedProfile::from_toml_file`].
+    pub fn physics_source(path: impl AsRef<Path>) -> Result<(String, UrdfOptions), ProfileError> {
+        let path = path.as_ref();
+        let file = parse(&read_file(path)?, &path.display().to_string())?;
+        let urdf_path = path.parent().unwrap_or(Path::new("")).join(&file.urdf);
+        let (text, frames) = with_sole_links(&file, &read_file(&urdf_path)?)?;
+        Ok((text, loader_options(&file, frames, None)))
     }
 
     /// [`BipedProfile::from_toml_file`] from the profile's text and its URDF's text (the
@@ -194,6 +202,13 @@ impl BipedProfile {
     }
 }
 
+fn read_file(path: &Path) -> Result<String, ProfileError> {
+    std::fs::read_to_string(path).map_err(|e| ProfileError::Io {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    })
+}
+
 fn parse(text: &str, path: &str) -> Result<File, ProfileError> {
     toml::from_str(text).map_err(|e: toml::de::Error| ProfileError::Syntax {
         path: path.to_owned(),
@@ -201,7 +216,9 @@ fn parse(text: &str, path: &str) -> Result<File, ProfileError> {
     })
 }
 
-fn build(file: File, urdf: &str) -> Result<BipedProfile, ProfileError> {
+/// The URDF text with the two sole links added, and the profile's frames (toe and heel points,
+/// the file's `frames`).
+fn with_sole_links(file: &File, urdf: &str) -> Result<(String, Vec<UrdfFrame>), ProfileError> {
     let feet = [&file.feet.left, &file.feet.right];
     let mut text = urdf.to_owned();
     let mut frames: Vec<UrdfFrame> = Vec::new();
@@ -216,13 +233,24 @@ fn build(file: File, urdf: &str) -> Result<BipedProfile, ProfileError> {
     for (name, f) in &file.frames {
         frames.push(offset_frame(name.clone(), &f.link, f.xyz));
     }
-    let options = |root: &str| UrdfOptions {
-        root_link: Some(root.to_owned()),
+    Ok((text, frames))
+}
+
+/// The loader options of the profile's models, rooted at `root` (`None`: the URDF's root).
+fn loader_options(file: &File, frames: Vec<UrdfFrame>, root: Option<&str>) -> UrdfOptions {
+    UrdfOptions {
+        root_link: root.map(str::to_owned),
         locked_joints: file.locked.iter().map(|(j, v)| (j.clone(), *v)).collect(),
         variable_order: file.variables.clone(),
-        frames: frames.clone(),
+        frames,
         link_frames: true,
-    };
+    }
+}
+
+fn build(file: File, urdf: &str) -> Result<BipedProfile, ProfileError> {
+    let feet = [&file.feet.left, &file.feet.right];
+    let (text, frames) = with_sole_links(&file, urdf)?;
+    let options = |root: &str| loader_options(&file, frames.clone(), Some(root));
     let models = [
         Model::from_urdf_str(&text, &options("left_sole"))?,
         Model::from_urdf_str(&text, &options("right_sole"))?,

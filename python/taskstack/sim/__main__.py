@@ -29,6 +29,7 @@ def main(argv: List[str] = None) -> int:
     ap.add_argument("--model", choices=["nominal", "weak", "both"], default="both",
                     help="which physics model (default: both)")
     ap.add_argument("--json", action="store_true", help="print one JSON document")
+    ap.add_argument("--robot", help="nao, g1 or a biped profile file (default: told by the joint names)")
     ap.add_argument("--hold", type=float, default=1.0, help="seconds of the last posture after the run (default 1)")
     ap.add_argument("--no-plot", action="store_true",
                     help="do not write OUT_DIR/physics.svg nor add the simulation to view.html")
@@ -42,7 +43,7 @@ def main(argv: List[str] = None) -> int:
         per_run = []
         for weak in models:
             try:
-                v = check_run(run, weak=weak, hold=a.hold)
+                v = check_run(run, weak=weak, hold=a.hold, robot=a.robot)
             except InputError as e:
                 print(f"taskstack check: {e}", file=sys.stderr)
                 return 2

@@ -110,24 +110,33 @@ def read_trajectory(path: Path):
     return rows[0][1:], data[:, 0], data[:, 1:]
 
 
-def robot_of(columns: List[str]) -> str:
-    """The built-in robot whose joints are ``columns``."""
-    for robot in ("nao", "g1"):
-        if set(_taskstack.robot_description(robot)["variables"]) == set(columns):
-            return robot
-    raise InputError(f"joints {columns[:3]}…: neither the NAO's nor the G1's")
+def robot_of(columns: List[str], robot: Optional[str] = None) -> str:
+    """``robot`` if its joints are ``columns``; without one, the built-in robot whose they
+    are."""
+    for candidate in [robot] if robot else ["nao", "g1"]:
+        try:
+            variables = _taskstack.robot_description(candidate)["variables"]
+        except (OSError, ValueError) as e:
+            raise InputError(f"robot {candidate}: {e}") from e
+        if set(variables) == set(columns):
+            return candidate
+    if robot:
+        raise InputError(f"joints {columns[:3]}…: not the joints of {robot}")
+    raise InputError(f"joints {columns[:3]}…: neither the NAO's nor the G1's (a profile's run: --robot PROFILE.toml)")
 
 
 _MODELS: Dict[tuple, PhysicsModel] = {}
 
 
-def check_run(out_dir, weak: bool = False, settle: float = 1.0, hold: float = 1.0) -> Verdict:
+def check_run(out_dir, weak: bool = False, settle: float = 1.0, hold: float = 1.0,
+              robot: Optional[str] = None) -> Verdict:
     """Plays ``OUT_DIR/joints.csv`` (or a ``joints.csv`` path) on the nominal or weak model of
-    the robot its header names, and judges it."""
+    ``robot`` (``"nao"``, ``"g1"``, a profile file; default: the built-in robot the header
+    names), and judges it."""
     path = Path(out_dir)
     csv_path = path / "joints.csv" if path.is_dir() else path
     columns, times, q = read_trajectory(csv_path)
-    robot = robot_of(columns)
+    robot = robot_of(columns, robot)
     key = (robot, weak)
     if key not in _MODELS:
         _MODELS[key] = build(robot, weak)

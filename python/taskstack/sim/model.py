@@ -15,7 +15,8 @@ Recipe (every number here is ours, chosen from the MuJoCo documentation and the 
   ``dampratio`` 1, from the joint's inertia at the zero posture), a reflected rotor inertia
   (armature). Per robot (``SERVOS``): the NAO's micro-servos drive its joints through 130–201:1
   gears, stiff and position-controlled: 5 mrad, armature 2e-3 kg m²; the G1's motors have low
-  reductions and are run soft by design: 35 mrad, armature 1e-2 kg m². The player limits each
+  reductions and are run soft by design: 35 mrad, armature 1e-2 kg m²; any other robot (a
+  profile file) the softer of the two, 35 mrad, armature 5e-3 kg m². The player limits each
   target's speed to the URDF's ``velocity``.
 * **Contacts**: each sole touches the floor through spheres of ``SOLE_SPHERE_RADIUS`` at the
   corners of the profile's sole outline (the support area the imitation plans with); every other
@@ -45,6 +46,8 @@ from .. import _taskstack
 #: Per robot: the tracking error (rad) at which a servo reaches its torque limit, and the rotor
 #: inertia reflected at each driven joint (kg m^2). See the module docs.
 SERVOS = {"nao": (0.005, 0.002), "g1": (0.035, 0.01)}
+#: Any other robot (a profile file): the softer, conservative servo of the two.
+OTHER_SERVO = (0.035, 0.005)
 #: Radius (m) of the contact spheres at the sole outline's corners.
 SOLE_SPHERE_RADIUS = 0.002
 #: Radius (m) of the sphere at every other body's origin, for non-foot contacts.
@@ -110,7 +113,8 @@ def _urdf_for_mujoco(urdf: str) -> str:
 
 
 def build(robot: str = "nao", weak: bool = False) -> PhysicsModel:
-    """The MuJoCo model of ``robot`` (``"nao"`` or ``"g1"``), nominal or weak (module docs)."""
+    """The MuJoCo model of ``robot`` (``"nao"``, ``"g1"`` or a biped profile file), nominal or
+    weak (module docs)."""
     d = _taskstack.robot_description(robot)
     spec = mujoco.MjSpec.from_string(_urdf_for_mujoco(d["urdf"]))
     spec.option.timestep = TIMESTEP
@@ -118,7 +122,7 @@ def build(robot: str = "nao", weak: bool = False) -> PhysicsModel:
     spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
     spec.option.impratio = 10.0
     spec.option.noslip_iterations = 10
-    saturation_error, armature = SERVOS[robot]
+    saturation_error, armature = SERVOS.get(robot, OTHER_SERVO)
     friction = list(FRICTION)
     if weak:
         friction[0] = WEAK_FRICTION
