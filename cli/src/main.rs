@@ -73,6 +73,13 @@ fn main() -> ExitCode {
         Command::Batch(args) => batch::run(args, report),
         Command::Check(args) => check::run(args, report),
         Command::Contacts(args) => contacts::run(args, report),
+        // fk's output is its JSON lines: nothing for --quiet to silence or --json to change.
+        Command::Fk(_) if cli.quiet || cli.json => {
+            eprintln!(
+                "taskstack: error: fk always writes JSON lines; --quiet and --json do not apply"
+            );
+            return ExitCode::from(2);
+        }
         Command::Fk(args) => fk::run(args),
         Command::Solve(args) => solve::run(args, report),
         Command::View(args) => view::run(args, report),

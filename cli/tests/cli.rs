@@ -574,6 +574,9 @@ fn fk_answers_json_lines_and_names_the_bad_line() {
         1,
         "the good line before it was answered"
     );
+    // --quiet and --json mean nothing to fk: refused as a usage error, not ignored.
+    fails(&["fk", "--quiet"], 2, &["--quiet"]);
+    fails(&["--json", "fk"], 2, &["--json"]);
 }
 
 #[test]
