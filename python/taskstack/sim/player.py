@@ -36,6 +36,9 @@ CONTACT_FORCE = 1.0
 BOTH_FEET_HEIGHT, BOTH_FEET_TILT = 0.005, math.radians(2.0)
 #: Period of the recorded time series (s).
 SERIES_PERIOD = 0.01
+#: A target this far (rad) beyond a joint limit is not a violation: joints.csv rounds to six
+#: decimals, so a target at its limit may read up to 5e-7 rad beyond it.
+LIMIT_SLACK = 1e-6
 #: Frames a second of the simulated robot recorded for the viewer.
 DRAW_RATE = 30
 
@@ -177,7 +180,9 @@ def play(
     m = pm.model
     data = mujoco.MjData(m)
     out = Playback(duration=float(times[-1] - times[0]))
-    out.limit_violations = int(np.sum((targets < pm.lower - 1e-9) | (targets > pm.upper + 1e-9)))
+    # A target at a limit is written rounded to joints.csv's six decimals: up to 5e-7 beyond.
+    slack = LIMIT_SLACK
+    out.limit_violations = int(np.sum((targets < pm.lower - slack) | (targets > pm.upper + slack)))
     targets = np.clip(targets, pm.lower, pm.upper)
     place(pm, data, targets[0])
     dt = m.opt.timestep
