@@ -181,6 +181,18 @@ fn derived_settings_follow_the_robots_size() {
     assert!(g1.settings.swing.height > 2.0 * nao.settings.swing.height);
     // The NAO's hips are 0.1 m apart (HipOffsetY 0.05): lean atan(0.05 / z_c).
     assert!((nao.torso_lean - (0.05 / nao.settings.com_height).atan()).abs() < 1e-3);
+    // Landing clearance 0.6 % of the leg and the swing height 12 % of it: a twentieth of the
+    // swing height (NAO about 1.5 mm), lowered in two time constants.
+    for p in [&nao, &g1] {
+        assert!((p.landing_clearance - p.settings.swing.height * 0.006 / 0.12).abs() < 1e-12);
+        let tau = (p.settings.com_height / 9.81).sqrt();
+        assert!((p.landing_preload_time - 2.0 * tau).abs() < 1e-12);
+    }
+    assert!(
+        (0.0013..0.0017).contains(&nao.landing_clearance),
+        "{}",
+        nao.landing_clearance
+    );
 }
 
 fn envelope() -> FootArea {

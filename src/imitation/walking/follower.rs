@@ -6,10 +6,11 @@ use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 use crate::human::Side;
 use crate::imitation::error::ImitationError;
 use crate::imitation::footsteps::{FootstepConfig, GroundPose};
-use crate::imitation::phase::SupportPhase;
+use crate::imitation::phase::{Landing, SupportPhase};
 use crate::imitation::phase_solver::{Criteria, FrameTargets, PhaseSolver};
 use crate::locomotion::footstep::{mean_heading, wrap_angle};
 use crate::locomotion::preview::GRAVITY;
+use crate::locomotion::schedule::smooth;
 use crate::locomotion::{
     Footstep, PatternGenerator, StepPlan, StepTiming, Support, WalkParams, WalkState,
 };
@@ -61,6 +62,10 @@ pub(in crate::imitation) struct WalkFollower {
     near: (f64, f64),
     /// The robot's time (s) when the walk started; `None` while standing.
     started: Option<f64>,
+    /// Walk time (s) of the last touchdown (−∞ before the walk's first).
+    landed_at: f64,
+    /// Walk time (s) of `state`.
+    elapsed: f64,
     /// The CoM's height at the start (m): brought to the walking height over the first double
     /// support.
     start_height: f64,
@@ -131,6 +136,8 @@ impl WalkFollower {
             envelope,
             near: (config.distance, config.heading),
             started: None,
+            landed_at: f64::NEG_INFINITY,
+            elapsed: 0.0,
             start_height: 0.0,
             root: Side::Right,
             posture: q.to_vec(),
@@ -171,9 +178,15 @@ impl WalkFollower {
         &self.solvers[self.root.index()]
     }
 
-    /// The support phase the walk is in.
+    /// The support phase the walk is in: a sole landed less than
+    /// [`WalkParams::landing_preload_time`] ago is still being lowered onto the floor (the
+    /// landing clearance), so the phase is the paper's "lower foot" step until then.
     pub(in crate::imitation) fn phase(&self) -> SupportPhase {
         match self.state.support {
+            Support::Double if self.is_lowering() => match self.root {
+                Side::Right => SupportPhase::RightToDouble(Landing::LowerFoot),
+                Side::Left => SupportPhase::LeftToDouble(Landing::LowerFoot),
+            },
             Support::Double => SupportPhase::Double,
             Support::Single {
                 swing: Side::Left, ..
@@ -202,6 +215,8 @@ impl WalkFollower {
         self.started = Some(now);
         self.root = root;
         self.start_height = com.z;
+        self.landed_at = f64::NEG_INFINITY;
+        self.elapsed = 0.0;
         self.last_side = None;
         self.half_span = (feet[0].xy - feet[1].xy).norm() / 2.0;
         Ok(())
@@ -237,11 +252,17 @@ impl WalkFollower {
             self.previous = *self.generator.state();
             self.generator.tick();
         }
+        let was_single = matches!(self.state.support, Support::Single { .. });
         self.state = between(&self.previous, self.generator.state(), elapsed);
+        self.elapsed = elapsed;
+        if was_single && matches!(self.state.support, Support::Double) {
+            self.landed_at = elapsed;
+        }
         if let Support::Single { swing, .. } = self.state.support {
             self.root = swing.other();
         }
-        let over = self.generator.is_stopped() && self.planned.is_empty();
+        // A walk ends with its last sole on the floor: lowered through the landing clearance.
+        let over = self.generator.is_stopped() && self.planned.is_empty() && !self.is_lowering();
         if over {
             self.started = None;
         }
@@ -338,6 +359,7 @@ impl WalkFollower {
         let up = walk.torso_up(self.params.torso_lean, self.half_span, root_yaw);
         let elapsed = self.started.map_or(0.0, |s| now - s);
         let share = (elapsed / self.params.settings.start_duration).clamp(0.0, 1.0);
+        let z = z + self.landing_clearance();
         WalkTargets {
             com: to_root(Vector3::new(walk.com.x, walk.com.y, 0.0)).xy(),
             footstep: GroundPose {
@@ -349,6 +371,25 @@ impl WalkFollower {
             com_height: self.start_height
                 + (walk.com.z - self.start_height) * share * share * (3.0 - 2.0 * share),
         }
+    }
+
+    /// How far above its plan the moving sole is held `elapsed` seconds into the walk (m): the
+    /// landing clearance ([`WalkParams::landing_clearance`]), reached over the second half of a
+    /// swing and given up over [`WalkParams::landing_preload_time`] after the touchdown.
+    fn landing_clearance(&self) -> f64 {
+        let clearance = self.params.landing_clearance;
+        match self.state.support {
+            Support::Single { phase, .. } => clearance * smooth((phase - 0.5) / 0.5),
+            Support::Double => {
+                let lowered = (self.elapsed - self.landed_at) / self.params.landing_preload_time;
+                clearance * (1.0 - smooth(lowered))
+            }
+        }
+    }
+
+    /// Whether a landed sole is still being lowered through the landing clearance.
+    fn is_lowering(&self) -> bool {
+        self.elapsed - self.landed_at < self.params.landing_preload_time
     }
 
     /// The time step (s) of one solver iteration of a frame of `dt` seconds.
