@@ -18,9 +18,10 @@ use taskstack::imitation::look_ahead::{FootLookAhead, FootSchedule};
 use taskstack::imitation::support::SupportConfig;
 use taskstack::io::clip::Clip;
 use taskstack::robots::{BipedProfile, g1, nao};
-use taskstack::{Imitator, ImitatorConfig, IsometryMatrix3, RobotFrame};
+use taskstack::{Imitator, ImitatorConfig, RobotFrame};
 
 use crate::errors::{profile_error, to_py, value_error};
+use crate::kinematics::matrix;
 
 /// The robot named `robot`: `"nao"`, `"g1"` or the path of a biped profile (TOML).
 pub(crate) fn profile(robot: &str) -> PyResult<BipedProfile> {
@@ -451,13 +452,4 @@ fn robot_frame_dict<'py>(
     out.set_item("effectors", effectors)?;
     out.set_item("human_effectors", reference)?;
     Ok(out)
-}
-
-/// A placement as a 4 × 4 homogeneous matrix.
-pub(crate) fn matrix<'py>(
-    py: Python<'py>,
-    placement: &IsometryMatrix3<f64>,
-) -> Bound<'py, PyArray2<f64>> {
-    let m = placement.to_homogeneous();
-    Array2::from_shape_fn((4, 4), |(r, c)| m[(r, c)]).into_pyarray(py)
 }

@@ -7,12 +7,12 @@ use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use taskstack::IsometryMatrix3;
 use taskstack::faer::Mat;
 use taskstack::model::{Model, ModelData, UrdfOptions};
 use taskstack::robots::{g1, nao};
 
 use crate::errors::{to_py, value_error};
-use crate::imitate::matrix;
 
 /// A kinematic model and its forward-kinematics workspace.
 #[pyclass(name = "Model", module = "taskstack._taskstack")]
@@ -199,4 +199,13 @@ impl PyModel {
             .map_err(to_py)?;
         Ok(Array2::from_shape_fn((3, nv), |(r, c)| j[(r, c)]).into_pyarray(py))
     }
+}
+
+/// A placement as a 4 × 4 homogeneous matrix.
+pub(crate) fn matrix<'py>(
+    py: Python<'py>,
+    placement: &IsometryMatrix3<f64>,
+) -> Bound<'py, PyArray2<f64>> {
+    let m = placement.to_homogeneous();
+    Array2::from_shape_fn((4, 4), |(r, c)| m[(r, c)]).into_pyarray(py)
 }

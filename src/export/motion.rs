@@ -185,12 +185,8 @@ impl MotionRecorder {
     /// [`ExportError::Model`] when a rooted model lacks the profile's torso frame.
     pub fn new(imitator: &Imitator) -> Result<Self, ExportError> {
         let profile = imitator.profile().clone();
-        let base =
-            [Side::Left, Side::Right].map(|side| profile.model(side).frame_id(&profile.torso));
-        let [Ok(left), Ok(right)] = base else {
-            let err = base.into_iter().find_map(Result::err);
-            return Err(err.map_or(ExportError::Empty, ExportError::Model));
-        };
+        let base_in = |side: Side| profile.model(side).frame_id(&profile.torso);
+        let base = [base_in(Side::Left)?, base_in(Side::Right)?];
         let data = [Side::Left, Side::Right].map(|side| profile.model(side).new_data());
         let track = MotionTrack {
             joint_names: imitator.variable_names().map(str::to_owned).collect(),
@@ -199,7 +195,7 @@ impl MotionRecorder {
         Ok(Self {
             profile,
             data,
-            base: [left, right],
+            base,
             track,
         })
     }

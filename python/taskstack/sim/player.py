@@ -75,7 +75,8 @@ class Playback:
     draw_segments: List[Sequence[int]] = field(default_factory=list)
 
 
-def _quat_tilt_deg(xmat: np.ndarray) -> float:
+def _tilt_deg(xmat: np.ndarray) -> float:
+    """Angle (°) of a body's z axis from the vertical, from its row-major rotation matrix."""
     return math.degrees(math.acos(max(-1.0, min(1.0, float(xmat[8])))))
 
 
@@ -208,7 +209,7 @@ def play(
         ctrl += np.clip(goals[k] - ctrl, -max_step, max_step)
         data.ctrl[:] = ctrl
         mujoco.mj_step(m, data)
-        base_tilt = _quat_tilt_deg(data.xmat[pm.base_body])
+        base_tilt = _tilt_deg(data.xmat[pm.base_body])
         height = float(data.xpos[pm.base_body][2])
         out.max_tilt_deg = max(out.max_tilt_deg, base_tilt)
         if height < 0.6 * h0 or base_tilt > 45.0:
@@ -239,7 +240,7 @@ def play(
         for side, body in enumerate(pm.sole_bodies):
             R = data.xmat[body].reshape(3, 3)
             if force[side] > 0:
-                out.max_foot_tilt_deg = max(out.max_foot_tilt_deg, _quat_tilt_deg(data.xmat[body]))
+                out.max_foot_tilt_deg = max(out.max_foot_tilt_deg, _tilt_deg(data.xmat[body]))
             if force[side] >= LOADED_SHARE * weight:
                 yaw = math.atan2(R[1, 0], R[0, 0])
                 if anchor[side] is None:

@@ -373,7 +373,7 @@ impl WalkFollower {
         }
     }
 
-    /// How far above its plan the moving sole is held `elapsed` seconds into the walk (m): the
+    /// How far above its plan the moving sole is held at this point of the walk (m): the
     /// landing clearance ([`WalkParams::landing_clearance`]), reached over the second half of a
     /// swing and given up over [`WalkParams::landing_preload_time`] after the touchdown.
     fn landing_clearance(&self) -> f64 {
