@@ -39,11 +39,21 @@
 //!    has a bound it does not want, among bounds no higher level decided on, releases the most
 //!    unwanted one.
 //!
-//! The objective decreases lexicographically at every step, so no active set comes back and the
-//! method ends; an iteration cap (`4 (n + p) + 8` prioritized solves, `p` the inequality rows)
-//! guards against rounding-induced cycles, and the report says whether it was reached. The
-//! iterate keeps every joint interval at every step, so even a capped solve never violates a
-//! limit.
+//! With exact least squares at every level the objective decreases lexicographically at every
+//! step, so no active set comes back and the method ends. A **damped** level (near-singular, see
+//! [`Settings::max_damping`](crate::solver::Settings::max_damping)) does not minimize its exact
+//! residual, so its multipliers can ask for a bound that its own damped solve then crosses
+//! again, and the method comes back to an active set it had: on the NAO a CoM level near a
+//! stretched knee released a bound that the next solve crossed at once (`τ = 0`), on one frame
+//! in fifteen of a walk clip, and two joints of a lifting leg took turns in a six-step loop;
+//! each ran to the cap, 20–35× a frame's median time. The method is deterministic, so an active
+//! set met again at its own optimum (`x = x*`, step 3) would repeat the same steps forever: the
+//! bound it is about to release is **kept** instead (no level may release it for the rest of
+//! the solve) and the next candidate, if any, is released. Only a solve that would otherwise
+//! cycle sees this rule; each bound is kept at most once. An iteration cap (`4 (n + p) + 8`
+//! prioritized solves, `p` the inequality rows) bounds the rest, and the report says whether it
+//! was reached. The iterate keeps every joint interval at every step, so even a capped solve
+//! never violates a limit.
 
 use super::super::householder::{dot, norm, solve_upper};
 use super::{Bound, Solver, UsedRow, apply_chain, used_row};
@@ -67,6 +77,16 @@ pub(crate) struct ActiveSetWorkspace {
     /// Bounds whose fate a higher level already decided.
     decided_rows: Vec<bool>,
     decided_joints: Vec<bool>,
+    /// Bounds held for the rest of the solve, because releasing them led back to an active set
+    /// met before (see the module docs).
+    kept_rows: Vec<bool>,
+    kept_joints: Vec<bool>,
+    /// The active sets met at their optimum since the last kept bound, one [`Self::state_len`]
+    /// slot each (a joint's or row's bound: 0 none, 1 lower, 2 upper), and one slot more for the
+    /// set being checked.
+    seen: Vec<u8>,
+    /// Slots of `seen` in use.
+    seen_count: usize,
 }
 
 impl ActiveSetWorkspace {
@@ -79,7 +99,30 @@ impl ActiveSetWorkspace {
             mu: vec![0.0; level_max],
             decided_rows: vec![false; inequalities],
             decided_joints: vec![false; dof],
+            kept_rows: vec![false; inequalities],
+            kept_joints: vec![false; dof],
+            seen: vec![0; (iteration_cap(dof, inequalities) + 1) * (dof + inequalities)],
+            seen_count: 0,
         }
+    }
+
+    /// Entries of one active set in `seen`.
+    fn state_len(&self) -> usize {
+        self.kept_joints.len() + self.kept_rows.len()
+    }
+}
+
+/// Most steps of the active-set method for `n` joints and `p` inequality rows.
+fn iteration_cap(n: usize, p: usize) -> usize {
+    4 * (n + p) + 8
+}
+
+/// A bound's code in an active-set record.
+fn bound_code(bound: Option<Bound>) -> u8 {
+    match bound {
+        None => 0,
+        Some(Bound::Lower) => 1,
+        Some(Bound::Upper) => 2,
     }
 }
 
@@ -124,7 +167,7 @@ impl Solver {
         let rows = self.stack.total_inequality_rows();
         self.scales.fill(1.0);
         self.start_active_set();
-        let cap = 4 * (n + rows) + 8;
+        let cap = iteration_cap(n, rows);
         let (mut iterations, mut converged) = (0, false);
         while iterations < cap {
             iterations += 1;
@@ -142,6 +185,12 @@ impl Solver {
                 continue;
             }
             self.active_set.point.copy_from_slice(&self.velocity);
+            if self.met_before() {
+                // The same steps would follow again: keep the bound they start by releasing.
+                if let Some(bound) = self.release_candidate() {
+                    self.keep(bound);
+                }
+            }
             match self.release_candidate() {
                 Some(bound) => self.release(bound),
                 None => {
@@ -167,6 +216,9 @@ impl Solver {
         self.fixed_velocity.fill(0.0);
         self.inequality_state.fill(None);
         let ws = &mut self.active_set;
+        ws.kept_rows.fill(false);
+        ws.kept_joints.fill(false);
+        ws.seen_count = 0;
         ws.point.fill(0.0);
         for i in 0..self.stack.dof() {
             let (lo, hi) = (self.step_lo[i], self.step_hi[i]);
@@ -267,11 +319,51 @@ impl Solver {
         }
     }
 
+    /// Whether the current active set was met at its optimum before (since the last kept
+    /// bound); records it if not.
+    fn met_before(&mut self) -> bool {
+        let ws = &mut self.active_set;
+        let len = ws.state_len();
+        let (seen, slot) = ws.seen.split_at_mut(ws.seen_count * len);
+        let slot = &mut slot[..len];
+        let (joints, rows) = slot.split_at_mut(self.clamped.len());
+        for (code, i) in joints.iter_mut().zip(0..) {
+            *code = match self.clamped[i] {
+                false => bound_code(None),
+                true if self.fixed_velocity[i] == self.step_hi[i] => bound_code(Some(Bound::Upper)),
+                true => bound_code(Some(Bound::Lower)),
+            };
+        }
+        for (code, state) in rows.iter_mut().zip(&self.inequality_state) {
+            *code = bound_code(*state);
+        }
+        if seen.chunks_exact(len).any(|old| old == slot) {
+            return true;
+        }
+        // Past the cap's number of slots the loop ends anyway.
+        if (ws.seen_count + 2) * len <= ws.seen.len() {
+            ws.seen_count += 1;
+        }
+        false
+    }
+
+    /// Holds `c` for the rest of the solve; the active sets met so far are forgotten, since the
+    /// kept bound changes what follows them.
+    fn keep(&mut self, c: Constraint) {
+        let ws = &mut self.active_set;
+        match c {
+            Constraint::Joint(i, _) => ws.kept_joints[i] = true,
+            Constraint::Row(r, _) => ws.kept_rows[r] = true,
+        }
+        ws.seen_count = 0;
+    }
+
     /// The bound to release at `x = x*`, if any (step 3 of the method in the module docs).
     fn release_candidate(&mut self) -> Option<Constraint> {
         let levels = self.stack.level_count();
-        self.active_set.decided_rows.fill(false);
-        self.active_set.decided_joints.fill(false);
+        let ws = &mut self.active_set;
+        ws.decided_rows.copy_from_slice(&ws.kept_rows);
+        ws.decided_joints.copy_from_slice(&ws.kept_joints);
         for j in 0..=levels {
             let mut worst: Worst = None;
             if j < levels {
