@@ -1,10 +1,16 @@
 //! `Imitator::step` on real clips, for the NAO and the Unitree G1 and both methods (Poubel's
-//! task tables, Koenemann et al.'s): frames of double support (CMU 02_10, standing gestures)
-//! and of a walk with right and left single supports (CMU 07_04), streamed from memory in a
-//! loop.
+//! task tables, Koenemann et al.'s): frames of double support (CMU 02_10, standing gestures),
+//! of a stand on one leg (CMU 05_02) and of a walk with right and left single supports (CMU
+//! 07_04), streamed from memory in a loop.
+//!
+//! Criterion's figure is the mean step over the laps; the tail is printed before each case:
+//! the median, 99th percentile and largest step time of one timed pass over the clip after a
+//! warm-up pass (`… tail: median … p99 … max … µs`), the frames a controller running at a fixed
+//! rate has to fit.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
+use std::time::Instant;
 use taskstack::human::HumanFrame;
 use taskstack::imitation::config::ImitationMethod;
 use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
@@ -35,6 +41,10 @@ fn bench(c: &mut Criterion) {
             "double_support_02_10",
             "cmu_02_10_wash_self_standing_arm_gestures.bvh",
         ),
+        (
+            "single_support_05_02",
+            "cmu_05_02_stand_arm_gestures_turn_single_leg.bvh",
+        ),
         ("walk_07_04", "cmu_07_04_slow_walk.bvh"),
     ]
     .into_iter()
@@ -58,15 +68,40 @@ fn bench(c: &mut Criterion) {
             frames.len()
         );
         let name = format!("imitator_step/{robot}/{method_name}/{label}");
+        print_tail(&name, &mut imitator, &frames);
         bench_laps(c, &name, &mut imitator, &frames);
     }
 }
 
+/// Times every step of one more pass over `frames` (after the imitator's warm-up on them) and
+/// prints the median, 99th percentile and largest (µs).
+fn print_tail(name: &str, imitator: &mut Imitator, frames: &[HumanFrame]) {
+    let duration = frames.last().unwrap().time - frames[0].time + 1.0 / 120.0;
+    let mut times: Vec<f64> = frames
+        .iter()
+        .map(|f| {
+            let mut frame = *f;
+            frame.time += duration;
+            let start = Instant::now();
+            black_box(imitator.step(&frame).unwrap().q[0]);
+            start.elapsed().as_secs_f64() * 1e6
+        })
+        .collect();
+    times.sort_by(f64::total_cmp);
+    let at = |p: f64| times[((times.len() - 1) as f64 * p).round() as usize];
+    eprintln!(
+        "{name} tail: median {:.1} p99 {:.1} max {:.1} µs",
+        at(0.5),
+        at(0.99),
+        at(1.0)
+    );
+}
+
 /// Benches `imitator.step` on `frames` replayed in laps with increasing times, so the imitator
-/// sees a continuous stream.
+/// sees a continuous stream (after the warm-up pass and [`print_tail`]'s).
 fn bench_laps(c: &mut Criterion, name: &str, imitator: &mut Imitator, frames: &[HumanFrame]) {
     let duration = frames.last().unwrap().time - frames[0].time + 1.0 / 120.0;
-    let (mut i, mut lap) = (0, 1.0);
+    let (mut i, mut lap) = (0, 2.0);
     c.bench_function(name, |b| {
         b.iter(|| {
             let mut frame = frames[i];
@@ -97,12 +132,9 @@ fn dynamic_walk(c: &mut Criterion) {
         "nao poubel dynamic walk 07_04: {} frames, {walking} walking on the first pass",
         frames.len()
     );
-    bench_laps(
-        c,
-        "imitator_step/nao/poubel/dynamic_walk_07_04",
-        &mut imitator,
-        &frames,
-    );
+    let name = "imitator_step/nao/poubel/dynamic_walk_07_04";
+    print_tail(name, &mut imitator, &frames);
+    bench_laps(c, name, &mut imitator, &frames);
 }
 
 criterion_group!(benches, bench, dynamic_walk);

@@ -1,6 +1,9 @@
-//! The position-level driver's per-task error limits ([`TaskModel::max_task_error`]).
+//! The position-level driver: per-task error limits ([`TaskModel::max_task_error`]) and the
+//! patience rule ([`DriverSettings::patience`]).
 
-use taskstack::solver::driver::{DriverSettings, PositionDriver, TaskModel};
+use taskstack::solver::driver::{
+    DriverReport, DriverSettings, PositionDriver, StopReason, TaskModel,
+};
 use taskstack::solver::{JointBounds, Solver, SolverError, StackShape, TaskStack};
 
 /// Two joints, two tasks of one level, `x_k = q_k` with target 1; task 1's error limit is
@@ -71,4 +74,52 @@ fn a_limit_that_is_not_positive_falls_back_to_the_driver_setting() {
             "{limit:?}: {q:?}"
         );
     }
+}
+
+/// One joint, `x(q) = q`, target 0.1, but the model reports the slope as 0.4: each full
+/// Gauss–Newton step (errors clipped to 0.05) overshoots. By hand from q = 0: q₁ = 0.05/0.4 =
+/// 0.125 (error −0.025, the smallest), q₂ = 0.0625, q₃ = 0.15625, q₄ = 0.03125, then q
+/// alternates between 0.15625 and 0.03125 (errors 0.05625 and 0.06875) and never stalls.
+struct Overshooting;
+
+impl TaskModel for Overshooting {
+    type Error = SolverError;
+    fn evaluate(&mut self, q: &[f64], stack: &mut TaskStack) -> Result<(), SolverError> {
+        stack.level_mut(0).set_row(0, &[0.4], 0.1 - q[0])?;
+        stack.clear_gradient();
+        Ok(())
+    }
+}
+
+fn run_overshooting(patience: usize) -> (f64, DriverReport) {
+    let shape = StackShape::new(1).with_level("x", &[("x", 1)]);
+    let mut solver = Solver::new(&shape).unwrap();
+    let settings = DriverSettings {
+        max_joint_step: f64::INFINITY,
+        patience,
+        ..DriverSettings::default()
+    };
+    let mut driver = PositionDriver::new(&solver, settings).unwrap();
+    let mut q = [0.0];
+    let bounds = JointBounds::unbounded(1);
+    let report = (driver.run(&mut solver, &mut Overshooting, &mut q, &bounds))
+        .unwrap()
+        .clone();
+    (q[0], report)
+}
+
+#[test]
+fn patience_ends_a_circling_run_at_its_best_iterate() {
+    let (q, report) = run_overshooting(10);
+    assert!((q - 0.125).abs() < 1e-12, "{q}");
+    assert_eq!(report.stop, StopReason::Stalled);
+    assert_eq!(report.iterations, 11);
+    assert!((report.task_errors()[0] - 0.025).abs() < 1e-12);
+    // Without patience the same run circles to the cap and ends on a worse iterate.
+    let (q, report) = run_overshooting(0);
+    assert_eq!(report.stop, StopReason::IterationLimit);
+    assert!(
+        (q - 0.15625).abs() < 1e-12 || (q - 0.03125).abs() < 1e-12,
+        "{q}"
+    );
 }

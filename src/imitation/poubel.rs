@@ -471,6 +471,7 @@ impl PoubelImitator {
             stall_tolerance: 0.0,
             max_task_error: self.max_task_speed * step_dt,
             max_joint_step: f64::INFINITY,
+            patience: 0,
         };
         let targets = FrameTargets {
             reference: &self.shared.output.reference,

@@ -61,6 +61,13 @@ pub struct DriverSettings {
     /// Default 0.05: on the NAO benchmark's stress files (conflicting levels) larger steps let
     /// the second-order effect of the lower levels' motion push the top level past 1e-4 m.
     pub max_joint_step: f64,
+    /// Stop after this many iterations in a row that found no iterate better than the best so
+    /// far, and return the best (see [`PositionDriver::run`]); 0 (default): never. For an IK
+    /// run to convergence that may circle instead of stalling when it cannot meet a lower task:
+    /// the G1's legs in Koenemann et al.'s method went round three iterates, one of them 1.1 mm
+    /// off the held sole, until their cap of 200. Not for runs whose higher tasks must give a
+    /// little while a lower one makes its way (their iterates are not "better" until the end).
+    pub patience: usize,
 }
 
 impl DriverSettings {
@@ -98,6 +105,7 @@ impl Default for DriverSettings {
             max_iterations: 50,
             max_task_error: 0.05,
             max_joint_step: 0.05,
+            patience: 0,
         }
     }
 }
@@ -107,7 +115,8 @@ impl Default for DriverSettings {
 pub enum StopReason {
     /// Every task error is within tolerance.
     Converged,
-    /// No task error changed by more than the stall tolerance in the last iteration.
+    /// No task error changed by more than the stall tolerance in the last iteration, or
+    /// [`DriverSettings::patience`] iterations found nothing better than the best iterate.
     Stalled,
     /// The iteration cap was reached.
     IterationLimit,
@@ -139,6 +148,10 @@ pub struct PositionDriver {
     previous: Vec<f64>,
     /// The inequality violation of the previous iteration (task units).
     previous_violation: f64,
+    /// The best iterate of this run so far, its task errors and inequality violation.
+    best_q: Vec<f64>,
+    best_errors: Vec<f64>,
+    best_violation: f64,
     /// The caller's bounds with the per-iteration step limit as a velocity cap.
     step_bounds: JointBounds,
     report: DriverReport,
@@ -160,6 +173,9 @@ impl PositionDriver {
             task_start,
             previous: vec![0.0; tasks],
             previous_violation: 0.0,
+            best_q: vec![0.0; solver.stack().dof()],
+            best_errors: vec![0.0; tasks],
+            best_violation: 0.0,
             step_bounds: JointBounds::unbounded(solver.stack().dof()),
             report: DriverReport {
                 iterations: 0,
@@ -187,7 +203,11 @@ impl PositionDriver {
     }
 
     /// Moves `q` (in place, warm start) toward the model's targets. Every iterate, including the
-    /// result, is within the position limits of `bounds`. Errors: wrong sizes, a non-finite `q`,
+    /// result, is within the position limits of `bounds`. The result is the last iterate, except
+    /// when [`DriverSettings::patience`] stops the run: then it is the best one, comparing task
+    /// errors in stack order (the first that differs by more than the stall tolerance decides,
+    /// then the inequality violation; an error within the tolerance counts as met), and the
+    /// model was evaluated there last. Errors: wrong sizes, a non-finite `q`,
     /// a non-finite Jacobian entry, task error or gradient from the model
     /// ([`SolverError::NonFinite`], naming the place), or the model's own error.
     pub fn run<M: TaskModel>(
@@ -209,13 +229,22 @@ impl PositionDriver {
         )?;
         let s = self.settings;
         let mut iterations = 0;
+        let mut since_best = 0;
         let stop = loop {
             model.evaluate(q, solver.stack_mut())?;
             // Before measuring: a NaN task error must not pass the tolerance test as converged.
             solver.stack().check_finite()?;
             self.measure_errors(solver.stack());
-            let errors = &self.report.task_errors;
             let violation = inequality_violation(solver.stack());
+            if iterations == 0 || self.beats_best(violation) {
+                self.best_q.copy_from_slice(q);
+                self.best_errors.copy_from_slice(&self.report.task_errors);
+                self.best_violation = violation;
+                since_best = 0;
+            } else {
+                since_best += 1;
+            }
+            let errors = &self.report.task_errors;
             if errors.iter().all(|&e| e <= s.tolerance) && violation <= s.tolerance {
                 break StopReason::Converged;
             }
@@ -226,6 +255,12 @@ impl PositionDriver {
                     .all(|(e, p)| (e - p).abs() <= s.stall_tolerance)
                 && (violation - self.previous_violation).abs() <= s.stall_tolerance
             {
+                break StopReason::Stalled;
+            }
+            if s.patience > 0 && since_best >= s.patience {
+                q.copy_from_slice(&self.best_q);
+                model.evaluate(q, solver.stack_mut())?;
+                self.report.task_errors.copy_from_slice(&self.best_errors);
                 break StopReason::Stalled;
             }
             if iterations >= s.max_iterations {
@@ -247,6 +282,22 @@ impl PositionDriver {
         self.report.iterations = iterations;
         self.report.stop = stop;
         Ok(&self.report)
+    }
+
+    /// Whether this iterate (task errors measured, inequality violation `violation`) is better
+    /// than the best: the first task error, or last the violation, that differs from the best's
+    /// by more than the stall tolerance decides, errors within the tolerance counting as met.
+    fn beats_best(&self, violation: f64) -> bool {
+        let s = &self.settings;
+        let pairs = (self.report.task_errors.iter().zip(&self.best_errors))
+            .chain([(&violation, &self.best_violation)]);
+        for (now, best) in pairs {
+            let (now, best) = (now.max(s.tolerance), best.max(s.tolerance));
+            if (now - best).abs() > s.stall_tolerance {
+                return now < best;
+            }
+        }
+        false
     }
 
     /// `ẋ = K e`, with each task's error clipped to the model's limit for it or to

@@ -418,6 +418,7 @@ impl WalkFollower {
             stall_tolerance: 1e-10,
             max_task_error: f64::INFINITY,
             max_joint_step: f64::INFINITY,
+            patience: 0,
         };
         let solver = &mut self.solvers[self.root.index()];
         solver.run(model, data, targets, criteria, q, &self.bounds, settings)

@@ -46,13 +46,13 @@
 //! again, and the method comes back to an active set it had: on the NAO a CoM level near a
 //! stretched knee released a bound that the next solve crossed at once (`τ = 0`), on one frame
 //! in fifteen of a walk clip, and two joints of a lifting leg took turns in a six-step loop;
-//! each ran to the cap, 20–35× a frame's median time. The method is deterministic, so an active
-//! set met again at its own optimum (`x = x*`, step 3) would repeat the same steps forever: the
-//! bound it is about to release is **kept** instead (no level may release it for the rest of
-//! the solve) and the next candidate, if any, is released. Only a solve that would otherwise
-//! cycle sees this rule; each bound is kept at most once. An iteration cap (`4 (n + p) + 8`
-//! prioritized solves, `p` the inequality rows) bounds the rest, and the report says whether it
-//! was reached. The iterate keeps every joint interval at every step, so even a capped solve
+//! each ran to the cap, 20–35× a frame's median time. The method is deterministic and its
+//! iterate at an active set's optimum (`x = x*`, step 3) depends on the set alone, so a set met
+//! there again would only repeat the same steps: the solve **ends** at once with that iterate,
+//! not converged (in the `τ = 0` cycles the iterate the cap would have returned). Keeping the
+//! bound and going on instead changed where other solves ended and let a placed hand sink into
+//! its support in a test. An iteration cap (`4 (n + p) + 8` prioritized solves, `p` the
+//! inequality rows) bounds any other cycle; the report says whether the method converged. The iterate keeps every joint interval at every step, so even a capped solve
 //! never violates a limit.
 
 use super::super::householder::{dot, norm, solve_upper};
@@ -77,13 +77,12 @@ pub(crate) struct ActiveSetWorkspace {
     /// Bounds whose fate a higher level already decided.
     decided_rows: Vec<bool>,
     decided_joints: Vec<bool>,
-    /// Bounds held for the rest of the solve, because releasing them led back to an active set
-    /// met before (see the module docs).
-    kept_rows: Vec<bool>,
-    kept_joints: Vec<bool>,
-    /// The active sets met at their optimum since the last kept bound, one [`Self::state_len`]
-    /// slot each (a joint's or row's bound: 0 none, 1 lower, 2 upper), and one slot more for the
-    /// set being checked.
+    /// Joints and inequality rows (for the size of an active-set record).
+    dof: usize,
+    inequalities: usize,
+    /// The active sets met at their optimum in this solve, one [`Self::state_len`] slot each
+    /// (a joint's or row's bound: 0 none, 1 lower, 2 upper), and one slot more for the set
+    /// being checked.
     seen: Vec<u8>,
     /// Slots of `seen` in use.
     seen_count: usize,
@@ -99,8 +98,8 @@ impl ActiveSetWorkspace {
             mu: vec![0.0; level_max],
             decided_rows: vec![false; inequalities],
             decided_joints: vec![false; dof],
-            kept_rows: vec![false; inequalities],
-            kept_joints: vec![false; dof],
+            dof,
+            inequalities,
             seen: vec![0; (iteration_cap(dof, inequalities) + 1) * (dof + inequalities)],
             seen_count: 0,
         }
@@ -108,7 +107,7 @@ impl ActiveSetWorkspace {
 
     /// Entries of one active set in `seen`.
     fn state_len(&self) -> usize {
-        self.kept_joints.len() + self.kept_rows.len()
+        self.dof + self.inequalities
     }
 }
 
@@ -186,10 +185,8 @@ impl Solver {
             }
             self.active_set.point.copy_from_slice(&self.velocity);
             if self.met_before() {
-                // The same steps would follow again: keep the bound they start by releasing.
-                if let Some(bound) = self.release_candidate() {
-                    self.keep(bound);
-                }
+                // The same steps would follow again, and end here again.
+                break;
             }
             match self.release_candidate() {
                 Some(bound) => self.release(bound),
@@ -216,8 +213,6 @@ impl Solver {
         self.fixed_velocity.fill(0.0);
         self.inequality_state.fill(None);
         let ws = &mut self.active_set;
-        ws.kept_rows.fill(false);
-        ws.kept_joints.fill(false);
         ws.seen_count = 0;
         ws.point.fill(0.0);
         for i in 0..self.stack.dof() {
@@ -319,8 +314,8 @@ impl Solver {
         }
     }
 
-    /// Whether the current active set was met at its optimum before (since the last kept
-    /// bound); records it if not.
+    /// Whether the current active set was met at its optimum before in this solve; records it
+    /// if not.
     fn met_before(&mut self) -> bool {
         let ws = &mut self.active_set;
         let len = ws.state_len();
@@ -347,23 +342,11 @@ impl Solver {
         false
     }
 
-    /// Holds `c` for the rest of the solve; the active sets met so far are forgotten, since the
-    /// kept bound changes what follows them.
-    fn keep(&mut self, c: Constraint) {
-        let ws = &mut self.active_set;
-        match c {
-            Constraint::Joint(i, _) => ws.kept_joints[i] = true,
-            Constraint::Row(r, _) => ws.kept_rows[r] = true,
-        }
-        ws.seen_count = 0;
-    }
-
     /// The bound to release at `x = x*`, if any (step 3 of the method in the module docs).
     fn release_candidate(&mut self) -> Option<Constraint> {
         let levels = self.stack.level_count();
-        let ws = &mut self.active_set;
-        ws.decided_rows.copy_from_slice(&ws.kept_rows);
-        ws.decided_joints.copy_from_slice(&ws.kept_joints);
+        self.active_set.decided_rows.fill(false);
+        self.active_set.decided_joints.fill(false);
         for j in 0..=levels {
             let mut worst: Worst = None;
             if j < levels {
