@@ -620,8 +620,13 @@ pub fn metrics_json(m: &ImitationMetrics, clip: &Path) -> String {
 /// The metrics of a run of `clip` as a JSON value (the fields of [`ImitationMetrics`] with
 /// their units in the key names; non-finite numbers become `null`).
 pub fn metrics_value(m: &ImitationMetrics, clip: &Path) -> Value {
-    let mean_max = |m: &MeanMax| json!({ "mean": m.mean, "max": m.max, "frames": m.count });
-    let spread = |s: &Spread| json!({ "min": s.min, "median": s.median, "p99": s.p99, "max": s.max, "count": s.count });
+    // A cell with no samples has no mean or maximum: `null`, not a 0 that reads as perfect.
+    let some = |count: usize, v: f64| (count > 0).then_some(v);
+    let mean_max = |m: &MeanMax| json!({ "mean": some(m.count, m.mean), "max": some(m.count, m.max), "frames": m.count });
+    let spread = |s: &Spread| {
+        let v = |x| some(s.count, x);
+        json!({ "min": v(s.min), "median": v(s.median), "p99": v(s.p99), "max": v(s.max), "count": s.count })
+    };
     let effector_map = |effectors: &[EffectorError]| -> serde_json::Map<String, Value> {
         effectors
             .iter()
@@ -665,6 +670,10 @@ pub fn metrics_value(m: &ImitationMetrics, clip: &Path) -> Value {
             "frames_below_margin": c.frames_below_margin,
         })),
         "tracking_error_clip": effector_map(&m.effectors_clip),
+        "clip_support_frames": {
+            "single": m.clip_support_frames.single,
+            "double": m.clip_support_frames.double,
+        },
         "tracking_error_clip_lag_removed": effector_map(&m.hands_clip_lag_removed),
         "hand_lag_s": m.hand_lag_s,
         "travel": {

@@ -258,3 +258,40 @@ fn the_automatic_hold_waits_for_the_robot_to_finish() {
     );
     assert_eq!(auto.queued_steps_at_end, 0);
 }
+
+/// A metrics cell with no frames has no mean or maximum: `null` in `metrics.json`, not a 0 that
+/// reads as perfect tracking. The NAO stands through the Kinect wave (no single support), so
+/// every single-support cell is empty and `clip_support_frames` says why.
+#[test]
+fn empty_metrics_cells_are_null() {
+    use taskstack::batch::metrics_value;
+    use taskstack::human::HumanFrame;
+    use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
+    use taskstack::imitation::metrics::MetricsRecorder;
+    use taskstack::io::clip::Clip;
+    use taskstack::robots::nao;
+
+    let path = mocap(SHORT[0]);
+    let mut clip = Clip::open(&path).unwrap();
+    let mut imitator = Imitator::new(nao::profile(), ImitatorConfig::default()).unwrap();
+    let mut recorder = MetricsRecorder::new(&imitator);
+    let mut human = HumanFrame::new(0.0);
+    while clip.read_frame(&mut human).unwrap() {
+        recorder.record(imitator.step(&human).unwrap());
+    }
+    let m = recorder.finish();
+    let json = metrics_value(&m, &path);
+    assert_eq!(json["clip_support_frames"]["single"], 0);
+    assert_eq!(json["clip_support_frames"]["double"], m.clip_frames);
+    for effector in ["l_hand", "r_hand", "l_ankle", "r_ankle"] {
+        let cell = &json["tracking_error_clip"][effector]["single_support_m"];
+        assert_eq!(cell["frames"], 0, "{effector}");
+        assert!(
+            cell["mean"].is_null() && cell["max"].is_null(),
+            "{effector}: {cell}"
+        );
+    }
+    // The hands are tracked in double support: numbers there.
+    let hand = &json["tracking_error_clip"]["l_hand"]["double_support_m"];
+    assert!(hand["mean"].as_f64().is_some_and(|v| v > 0.0), "{hand}");
+}

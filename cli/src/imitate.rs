@@ -302,6 +302,7 @@ fn unfinished(m: &ImitationMetrics) -> String {
 }
 
 fn print_tracking(text: &mut String, m: &ImitationMetrics) {
+    let frames = m.clip_support_frames;
     let _ = writeln!(
         text,
         "distance of each effector to the scaled human over the clip, while its phase tracks it (cm):"
@@ -309,24 +310,28 @@ fn print_tracking(text: &mut String, m: &ImitationMetrics) {
     let _ = writeln!(
         text,
         "  {:8} {:>22} {:>22}",
-        "", "single support", "double support"
+        "",
+        format!("single support ({})", frames.single),
+        format!("double support ({})", frames.double)
     );
     let _ = writeln!(
         text,
         "  {:8} {:>22} {:>22}",
         "", "mean / max (frames)", "mean / max (frames)"
     );
+    // An empty cell says why: the robot never stood that way, or its phase does not track it.
+    let cell = |s: &taskstack::imitation::metrics::MeanMax, support_frames: usize| match s.count {
+        0 if support_frames == 0 => "no frames".to_owned(),
+        0 => "not tracked".to_owned(),
+        n => format!("{:.1} / {:.1} ({n})", s.mean * 100.0, s.max * 100.0),
+    };
     for e in &m.effectors_clip {
-        let cell = |s: &taskstack::imitation::metrics::MeanMax| match s.count {
-            0 => "not tracked".to_owned(),
-            n => format!("{:.1} / {:.1} ({n})", s.mean * 100.0, s.max * 100.0),
-        };
         let _ = writeln!(
             text,
             "  {:8} {:>22} {:>22}",
             e.name,
-            cell(&e.single_support),
-            cell(&e.double_support)
+            cell(&e.single_support, frames.single),
+            cell(&e.double_support, frames.double)
         );
     }
 }

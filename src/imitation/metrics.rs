@@ -46,6 +46,15 @@ pub fn sole_on_floor(outline: &[[f64; 2]], sole: &IsometryMatrix3<f64>) -> bool 
         .all(|&[x, y]| sole.transform_point(&[x, y, 0.0].into()).z.abs() <= CONTACT_HEIGHT)
 }
 
+/// Frames of a run by the robot's continuous support phase.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct SupportFrames {
+    /// Frames in RS or LS.
+    pub single: usize,
+    /// Frames in DS.
+    pub double: usize,
+}
+
 /// Mean and maximum of a series.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct MeanMax {
@@ -248,6 +257,10 @@ pub struct ImitationMetrics {
     /// Tracking error per effector over the clip's frames only (before
     /// [`MetricsRecorder::mark_clip_end`]; all frames if it was never called).
     pub effectors_clip: Vec<EffectorError>,
+    /// The clip's frames in single support (RS or LS) and in double support (DS): a cell of
+    /// [`Self::effectors_clip`] with no frames is empty because the phase does not track that
+    /// effector, or because the robot never was in that support.
+    pub clip_support_frames: SupportFrames,
     /// Hand errors over the clip's frames once the best time shift is removed (`l_hand`,
     /// `r_hand`).
     pub hands_clip_lag_removed: Vec<EffectorError>,
@@ -323,6 +336,7 @@ pub struct MetricsRecorder {
     times: TimeHistogram,
     single_clip: Vec<Series>,
     double_clip: Vec<Series>,
+    clip_support_frames: SupportFrames,
     hands: HandTrace,
     clearance: Option<ClearanceMeter>,
     travel: TravelRecorder,
@@ -435,6 +449,7 @@ impl MetricsRecorder {
             held_turn: 0.0,
             times: TimeHistogram::default(),
             single_clip: vec![Series::default(); EFFECTORS.len()],
+            clip_support_frames: SupportFrames::default(),
             double_clip: vec![Series::default(); EFFECTORS.len()],
             hands: HandTrace::default(),
             // The imitator validated its profile, so its pairs resolve.
@@ -512,10 +527,19 @@ impl MetricsRecorder {
         }
         let tracked = self.tracked[frame.phase.index()];
         let in_clip = !self.travel.clip_ended();
-        let (all, clip) = match single {
-            true => (&mut self.single, &mut self.single_clip),
-            false => (&mut self.double, &mut self.double_clip),
+        let (all, clip, count) = match single {
+            true => (
+                &mut self.single,
+                &mut self.single_clip,
+                &mut self.clip_support_frames.single,
+            ),
+            false => (
+                &mut self.double,
+                &mut self.double_clip,
+                &mut self.clip_support_frames.double,
+            ),
         };
+        *count += usize::from(in_clip);
         for (e, (_, joint)) in EFFECTORS.iter().enumerate() {
             let Some(reference) = frame.reference[joint.index()].filter(|_| tracked[e]) else {
                 continue;
@@ -665,6 +689,7 @@ impl MetricsRecorder {
             max_held_foot_turn: self.held_turn,
             solve_time_us: self.times.spread(),
             effectors_clip: effector_errors(&self.single_clip, &self.double_clip),
+            clip_support_frames: self.clip_support_frames,
             hands_clip_lag_removed: {
                 let cell = |(mean, max, count): (f64, f64, usize)| MeanMax { mean, max, count };
                 EFFECTORS[..2]
