@@ -105,6 +105,8 @@ pub(super) struct PhaseSolver {
     /// them (moved by the whole body's least-norm step, a hand resting on a stool sank 4 mm
     /// into it, and a CoM came 1.4 mm nearer the edge of the support).
     movable: Vec<bool>,
+    /// A contact row with only the movable joints' entries.
+    row: Vec<f64>,
     other_ankle: FrameId,
     other_sole: FrameId,
 }
@@ -185,10 +187,8 @@ impl PhaseSolver {
             .filter(|level| level.name == "contact")
             .map(|level| {
                 let rows: usize = level.tasks.iter().map(Task::rows).sum();
-                Solver::with_settings(
-                    &StackShape::new(model.nv()).with_level("contact", &[("contact", rows)]),
-                    settings,
-                )
+                let shape = StackShape::new(model.nv()).with_level("contact", &[("contact", rows)]);
+                Solver::with_settings(&shape, settings)
             })
             .transpose()?;
         let other = profile.foot(table.model_root.other());
@@ -202,6 +202,7 @@ impl PhaseSolver {
             frame_start: vec![0.0; model.nv()],
             reach: JointBounds::unbounded(model.nv()),
             movable: free_leg(model, &initial, profile, table.model_root.other())?,
+            row: vec![0.0; model.nv()],
             other_ankle: model.frame_id(&other.ankle)?,
             other_sole: model.frame_id(&other.sole)?,
         })
@@ -331,17 +332,20 @@ impl PhaseSolver {
         let Some(contact) = &mut self.contact else {
             return Ok(());
         };
-
         self.reach
             .copy_within_reach(bounds, &self.frame_start, frame_dt);
-        for (i, _) in self.movable.iter().enumerate().filter(|(_, m)| !**m) {
-            self.reach.pin(i, q[i]);
-        }
         let stack = self.solver.stack();
         let errors = &stack.stacked_target()[..stack.level_start(1)];
         let mut level = contact.stack_mut().level_mut(0);
         for (r, &error) in errors.iter().enumerate() {
-            level.set_row(r, stack.row(r), error)?;
+            // The other joints' columns are zero: the least-norm step leaves them where they are
+            // (pinning them instead cost the clamping loop a solve per joint).
+            for ((entry, &row), &movable) in
+                self.row.iter_mut().zip(stack.row(r)).zip(&self.movable)
+            {
+                *entry = if movable { row } else { 0.0 };
+            }
+            level.set_row(r, &self.row, error)?;
         }
         contact.stack_mut().clear_gradient();
         let step = contact.solve(q, &self.reach, 1.0)?.velocity;

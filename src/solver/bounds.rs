@@ -122,11 +122,6 @@ impl JointBounds {
     /// min(q_max, q + v Δt)]`, or the nearest position limit when `q` is outside its range by
     /// more than that; the velocity limits are copied too. For a position-level solve that must
     /// end within one frame's motion. Allocation-free.
-    /// Pins joint `joint` at `at` (a zero-width position interval).
-    pub(crate) fn pin(&mut self, joint: usize, at: f64) {
-        (self.lower[joint], self.upper[joint]) = (at, at);
-    }
-
     pub(crate) fn copy_within_reach(&mut self, other: &JointBounds, q: &[f64], dt: f64) {
         for i in 0..self.lower.len() {
             let reach = other.velocity[i] * dt;
