@@ -25,6 +25,12 @@ const COLORS: [&str; 6] = [
     "#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b",
 ];
 const SUPPORT_COLORS: [&str; 3] = ["#1982c4", "#6a4c93", "#8ac926"];
+/// The transition steps' shading, as the viewer's timeline: the CoM steps (CoM to foot, CoM to
+/// middle) and the foot steps (lift, lower).
+const COM_STEP_COLOR: &str = "#ffca3a";
+const FOOT_STEP_COLOR: &str = "#ff924c";
+/// The effector traces: a colour no phase shading uses.
+const TRACE_COLOR: &str = "#222";
 
 /// A row of the phase plot: the support colour index of a sample (`None`: transition).
 type SupportOf = fn(&Sample) -> Option<usize>;
@@ -150,21 +156,11 @@ impl PlotRecorder {
         (t0, if t1 > t0 { t1 } else { t0 + 1.0 })
     }
 
-    /// Shades the robot's continuous phases behind a time chart.
+    /// Shades every phase of the robot, transitions included, behind a time chart.
     fn shade_phases(&self, svg: &mut Svg, axes: &Axes) {
-        for run in runs(&self.samples, |s| continuous(s.phase)) {
-            let (start, end, value) = run;
-            if let Some(k) = value {
-                let (x0, x1) = (axes.px(start), axes.px(end));
-                svg.rect(
-                    x0,
-                    axes.top,
-                    (x1 - x0).max(0.5),
-                    axes.height,
-                    SUPPORT_COLORS[k],
-                    0.12,
-                );
-            }
+        for (start, end, color) in runs(&self.samples, |s| phase_color(s.phase)) {
+            let (x0, x1) = (axes.px(start), axes.px(end));
+            svg.rect(x0, axes.top, (x1 - x0).max(0.5), axes.height, color, 0.15);
         }
     }
 
@@ -182,9 +178,12 @@ impl PlotRecorder {
             left,
             44.0,
             &[
-                ("right support (RS)", SUPPORT_COLORS[0], false),
-                ("left support (LS)", SUPPORT_COLORS[1], false),
-                ("double support (DS)", SUPPORT_COLORS[2], false),
+                ("RS", SUPPORT_COLORS[0], false),
+                ("LS", SUPPORT_COLORS[1], false),
+                ("DS", SUPPORT_COLORS[2], false),
+                ("CoM step", COM_STEP_COLOR, false),
+                ("lift / lower", FOOT_STEP_COLOR, false),
+                ("distance", TRACE_COLOR, false),
             ],
         );
         let x = self.time_range();
@@ -208,7 +207,7 @@ impl PlotRecorder {
             let points: Vec<_> = (self.samples.iter())
                 .map(|s| s.errors[e].map(|v| axes.point(s.time, v * 100.0)))
                 .collect();
-            svg.path(&points, COLORS[e], 1.5, false);
+            svg.path(&points, TRACE_COLOR, 1.5, false);
         }
         svg.finish()
     }
@@ -394,6 +393,21 @@ fn limb_variables(model: &Model, hand: &str, torso: &str) -> Vec<usize> {
 }
 
 /// Index into the support colours of a continuous phase (RS, LS, DS); `None` in transitions.
+/// The shading colour of a phase (see [`SUPPORT_COLORS`], [`COM_STEP_COLOR`]).
+fn phase_color(phase: SupportPhase) -> &'static str {
+    use taskstack::imitation::phase::{Landing, TakeOff};
+    match phase {
+        SupportPhase::Right => SUPPORT_COLORS[0],
+        SupportPhase::Left => SUPPORT_COLORS[1],
+        SupportPhase::Double => SUPPORT_COLORS[2],
+        SupportPhase::DoubleToRight(TakeOff::ComToFoot)
+        | SupportPhase::DoubleToLeft(TakeOff::ComToFoot)
+        | SupportPhase::RightToDouble(Landing::ComToMiddle)
+        | SupportPhase::LeftToDouble(Landing::ComToMiddle) => COM_STEP_COLOR,
+        _ => FOOT_STEP_COLOR,
+    }
+}
+
 fn continuous(phase: SupportPhase) -> Option<usize> {
     match phase {
         SupportPhase::Right => Some(0),
