@@ -25,8 +25,8 @@ const COLORS: [&str; 6] = [
     "#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b",
 ];
 const SUPPORT_COLORS: [&str; 3] = ["#1982c4", "#6a4c93", "#8ac926"];
-/// The transition steps' shading, as the viewer's timeline: the CoM steps (CoM to foot, CoM to
-/// middle) and the foot steps (lift, lower).
+/// The transition steps' shading (the viewer's timeline uses the same): the CoM steps (CoM to
+/// foot, CoM to middle) and the foot steps (lift, lower).
 const COM_STEP_COLOR: &str = "#ffca3a";
 const FOOT_STEP_COLOR: &str = "#ff924c";
 /// The effector traces: a colour no phase shading uses.
