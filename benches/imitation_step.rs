@@ -73,10 +73,15 @@ fn bench(c: &mut Criterion) {
     }
 }
 
+/// How far one lap of `frames` shifts the next lap's times (s): the clip plus one frame.
+fn lap_duration(frames: &[HumanFrame]) -> f64 {
+    frames.last().unwrap().time - frames[0].time + 1.0 / 120.0
+}
+
 /// Times every step of one more pass over `frames` (after the imitator's warm-up on them) and
 /// prints the median, 99th percentile and largest (µs).
 fn print_tail(name: &str, imitator: &mut Imitator, frames: &[HumanFrame]) {
-    let duration = frames.last().unwrap().time - frames[0].time + 1.0 / 120.0;
+    let duration = lap_duration(frames);
     let mut times: Vec<f64> = frames
         .iter()
         .map(|f| {
@@ -100,7 +105,7 @@ fn print_tail(name: &str, imitator: &mut Imitator, frames: &[HumanFrame]) {
 /// Benches `imitator.step` on `frames` replayed in laps with increasing times, so the imitator
 /// sees a continuous stream (after the warm-up pass and [`print_tail`]'s).
 fn bench_laps(c: &mut Criterion, name: &str, imitator: &mut Imitator, frames: &[HumanFrame]) {
-    let duration = frames.last().unwrap().time - frames[0].time + 1.0 / 120.0;
+    let duration = lap_duration(frames);
     let (mut i, mut lap) = (0, 2.0);
     c.bench_function(name, |b| {
         b.iter(|| {

@@ -392,7 +392,6 @@ fn limb_variables(model: &Model, hand: &str, torso: &str) -> Vec<usize> {
     arm
 }
 
-/// Index into the support colours of a continuous phase (RS, LS, DS); `None` in transitions.
 /// The shading colour of a phase (see [`SUPPORT_COLORS`], [`COM_STEP_COLOR`]).
 fn phase_color(phase: SupportPhase) -> &'static str {
     use taskstack::imitation::phase::{Landing, TakeOff};
@@ -408,6 +407,7 @@ fn phase_color(phase: SupportPhase) -> &'static str {
     }
 }
 
+/// Index into the support colours of a continuous phase (RS, LS, DS); `None` in transitions.
 fn continuous(phase: SupportPhase) -> Option<usize> {
     match phase {
         SupportPhase::Right => Some(0),

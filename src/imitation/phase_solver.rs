@@ -93,8 +93,8 @@ pub(super) struct PhaseSolver {
     constraints: Vec<ResolvedConstraint>,
     solver: Solver,
     driver: PositionDriver,
-    /// The "contact" level alone (the standing feet, and hands resting on a support), when the
-    /// table has one: its Newton step ends every frame ([`PhaseSolver::run`]).
+    /// The "contact" level alone (the standing foot), when the table has one: its Newton step
+    /// ends every frame ([`PhaseSolver::settle_contact`]).
     contact: Option<Solver>,
     /// The posture at the start of the frame, and the joint bounds within the frame's reach of
     /// it: the contact step stays inside the frame's velocity budget.

@@ -236,13 +236,16 @@ impl PositionDriver {
             solver.stack().check_finite()?;
             self.measure_errors(solver.stack());
             let violation = inequality_violation(solver.stack());
-            if iterations == 0 || self.beats_best(violation) {
-                self.best_q.copy_from_slice(q);
-                self.best_errors.copy_from_slice(&self.report.task_errors);
-                self.best_violation = violation;
-                since_best = 0;
-            } else {
-                since_best += 1;
+            // The best iterate is kept only for the patience rule to return.
+            if s.patience > 0 {
+                if iterations == 0 || self.beats_best(violation) {
+                    self.best_q.copy_from_slice(q);
+                    self.best_errors.copy_from_slice(&self.report.task_errors);
+                    self.best_violation = violation;
+                    since_best = 0;
+                } else {
+                    since_best += 1;
+                }
             }
             let errors = &self.report.task_errors;
             if errors.iter().all(|&e| e <= s.tolerance) && violation <= s.tolerance {

@@ -52,8 +52,9 @@
 //! not converged (in the `τ = 0` cycles the iterate the cap would have returned). Keeping the
 //! bound and going on instead changed where other solves ended and let a placed hand sink into
 //! its support in a test. An iteration cap (`4 (n + p) + 8` prioritized solves, `p` the
-//! inequality rows) bounds any other cycle; the report says whether the method converged. The iterate keeps every joint interval at every step, so even a capped solve
-//! never violates a limit.
+//! inequality rows) bounds any other cycle; the report says whether the method converged. The
+//! iterate keeps every joint interval at every step, so even a capped solve never violates a
+//! limit.
 
 use super::super::householder::{dot, norm, solve_upper};
 use super::{Bound, Solver, UsedRow, apply_chain, used_row};
@@ -77,9 +78,6 @@ pub(crate) struct ActiveSetWorkspace {
     /// Bounds whose fate a higher level already decided.
     decided_rows: Vec<bool>,
     decided_joints: Vec<bool>,
-    /// Joints and inequality rows (for the size of an active-set record).
-    dof: usize,
-    inequalities: usize,
     /// The active sets met at their optimum in this solve, one [`Self::state_len`] slot each
     /// (a joint's or row's bound: 0 none, 1 lower, 2 upper), and one slot more for the set
     /// being checked.
@@ -98,8 +96,6 @@ impl ActiveSetWorkspace {
             mu: vec![0.0; level_max],
             decided_rows: vec![false; inequalities],
             decided_joints: vec![false; dof],
-            dof,
-            inequalities,
             seen: vec![0; (iteration_cap(dof, inequalities) + 1) * (dof + inequalities)],
             seen_count: 0,
         }
@@ -107,7 +103,7 @@ impl ActiveSetWorkspace {
 
     /// Entries of one active set in `seen`.
     fn state_len(&self) -> usize {
-        self.dof + self.inequalities
+        self.decided_joints.len() + self.decided_rows.len()
     }
 }
 
