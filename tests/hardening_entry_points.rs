@@ -6,6 +6,7 @@
 use taskstack::human::{HumanFrame, HumanJoint};
 use taskstack::imitation::imitator::{ImitationError, Imitator, ImitatorConfig, RobotFrame};
 use taskstack::imitation::scaler::ScaleError;
+use taskstack::imitation::shaping::MotionLimits;
 use taskstack::io::clip::Clip;
 use taskstack::model::ModelError;
 use taskstack::robots::nao;
@@ -349,11 +350,29 @@ fn imitator_config_out_of_range_is_refused_by_name() {
         ("upper_body_velocity_fraction", |c, v| {
             c.upper_body_velocity_fraction = Some(v)
         }),
-        ("com_speed", |c, v| c.motion.com_speed = v),
-        ("com_acceleration", |c, v| c.motion.com_acceleration = v),
-        ("foot_speed", |c, v| c.motion.foot_speed = v),
-        ("touchdown_speed", |c, v| c.motion.touchdown_speed = v),
-        ("landing_time", |c, v| c.motion.landing_time = v),
+        ("com_speed", |c, v| {
+            c.motion.get_or_insert_with(MotionLimits::default).com_speed = v
+        }),
+        ("com_acceleration", |c, v| {
+            c.motion
+                .get_or_insert_with(MotionLimits::default)
+                .com_acceleration = v
+        }),
+        ("foot_speed", |c, v| {
+            c.motion
+                .get_or_insert_with(MotionLimits::default)
+                .foot_speed = v
+        }),
+        ("touchdown_speed", |c, v| {
+            c.motion
+                .get_or_insert_with(MotionLimits::default)
+                .touchdown_speed = v
+        }),
+        ("landing_time", |c, v| {
+            c.motion
+                .get_or_insert_with(MotionLimits::default)
+                .landing_time = v
+        }),
     ];
     // Each setter with each bad value must be refused, naming the field.
     let refused = |name: &str, set: Set, values: &[f64]| {

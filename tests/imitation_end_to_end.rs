@@ -360,12 +360,12 @@ fn a_walk_at_full_speed_keeps_the_invariants() {
         upper_body_velocity_fraction: Some(1.0),
         max_task_speed: Some(1.0),
         iterations_per_frame: 2,
-        motion: MotionLimits {
+        motion: Some(MotionLimits {
             com_speed: 0.1,
             com_acceleration: 0.6,
             foot_speed: 0.1,
             ..MotionLimits::default()
-        },
+        }),
         ..ImitatorConfig::default()
     };
     // Steps larger than by default: the held foot's second-order error grows with their square.

@@ -352,7 +352,7 @@ fn bad_config_is_rejected_naming_the_field() {
         ),
         (
             PhaseConfig {
-                support_margin: f64::INFINITY,
+                support_margin: Some(f64::INFINITY),
                 ..PhaseConfig::default()
             },
             "support_margin",

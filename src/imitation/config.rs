@@ -9,7 +9,7 @@ use super::phase::PhaseConfig;
 use super::shaping::MotionLimits;
 use super::support::SupportConfig;
 use super::tables::TaskTables;
-use crate::robots::FootArea;
+use crate::robots::{FootArea, MotionTuning};
 use crate::solver::Settings;
 
 /// Which method imitates.
@@ -62,8 +62,9 @@ pub struct ImitatorConfig {
     /// rated speed in 5 cm steps of 1 s); `velocity_fraction` still bounds the support phases.
     pub walking_velocity_fraction: f64,
     /// Speed and acceleration bounds of the CoM reference and of the swing foot (see
-    /// [`super::shaping`]).
-    pub motion: MotionLimits,
+    /// [`super::shaping`]); `None` (default): [`MotionLimits::default`] with the profile's
+    /// CoM bounds ([`MotionLimits::with_com_of`]).
+    pub motion: Option<MotionLimits>,
     /// Gauss–Newton steps per frame (default 1, as the paper: one IK per time step). Each step
     /// is limited to the velocity budget of the whole frame divided by this count.
     pub iterations_per_frame: usize,
@@ -116,7 +117,7 @@ impl Default for ImitatorConfig {
             velocity_fraction: 0.1,
             upper_body_velocity_fraction: None,
             walking_velocity_fraction: 1.0,
-            motion: MotionLimits::default(),
+            motion: None,
             iterations_per_frame: 1,
             max_task_speed: None,
             max_tracking_speed: None,
@@ -131,6 +132,12 @@ impl Default for ImitatorConfig {
 }
 
 impl ImitatorConfig {
+    /// [`ImitatorConfig::motion`], or the default with the CoM bounds of `tuning`.
+    pub(super) fn motion_for(&self, tuning: &MotionTuning) -> MotionLimits {
+        self.motion
+            .unwrap_or_else(|| MotionLimits::with_com_of(tuning))
+    }
+
     /// Checks the imitator's own settings (the phase, table, support and solver settings are
     /// checked by their owners): every speed, fraction and time finite and > 0, footstep
     /// thresholds ≥ 0, at least one iteration per frame. The error names the field.
@@ -184,7 +191,7 @@ impl ImitatorConfig {
         if let Some((name, value)) = self.footsteps.invalid_field() {
             return invalid(name, value, "must be >= 0");
         }
-        if let Some((name, value)) = self.motion.invalid_field() {
+        if let Some((name, value)) = self.motion.and_then(|m| m.invalid_field()) {
             return invalid(name, value, "motion limits must be finite and > 0");
         }
         if let ImitationMethod::Koenemann(k) = &self.method

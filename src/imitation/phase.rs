@@ -262,11 +262,11 @@ pub struct PhaseConfig {
     /// IK closes the last millimetres in a few frames.
     pub foot_height_tolerance: f64,
     /// Distance (m) between the CoM goal of a single support and the inner edge of the support
-    /// foot's contact area, where the contact area is narrower than twice this, its middle. The
-    /// least lateral shift that keeps this margin: the stance hip's roll torque grows with how
-    /// far the CoM goes past the hip, and with the CoM at the sole's centre the hip-roll servo of
-    /// a 5 kg robot with 0.1 m hip spacing works at 88 % of its rated torque (Poubel's [0, 0] under the ankle is worse). Default 15 mm.
-    pub support_margin: f64,
+    /// foot's contact area (its middle where the area is narrower than twice this) in the
+    /// executable tables. `None` (default): the profile's
+    /// [`MotionTuning::support_margin`](crate::robots::MotionTuning::support_margin) (15 mm for
+    /// the NAO).
+    pub support_margin: Option<f64>,
     /// A CoM step also waits until the torso is within this angle (rad) of its target
     /// orientation: a foot lifts only once the torso leans over the stance foot, because until
     /// then the stance hip's roll servo holds the upper body out to the side (on a small robot
@@ -275,15 +275,15 @@ pub struct PhaseConfig {
 }
 
 impl Default for PhaseConfig {
-    /// The paper's λ = 15 mm and ρ = 30 mm, with a 5 mm CoM and a 1 µm foot height tolerance
-    /// a 15 mm support margin and a 0.03 rad posture tolerance.
+    /// The paper's λ = 15 mm and ρ = 30 mm, with a 5 mm CoM and a 1 µm foot height tolerance,
+    /// the profile's support margin and a 0.03 rad posture tolerance.
     fn default() -> Self {
         Self {
             com_tolerance: 0.005,
             lambda: 0.015,
             rho: 0.030,
             foot_height_tolerance: 0.000001,
-            support_margin: 0.015,
+            support_margin: None,
             posture_tolerance: 0.03,
         }
     }
@@ -309,7 +309,7 @@ impl PhaseConfig {
         if !(self.lambda.is_finite() && self.lambda >= 0.0) {
             return Err(PhaseError::Config("lambda", "must be finite and ≥ 0"));
         }
-        if !(self.support_margin.is_finite() && self.support_margin >= 0.0) {
+        if (self.support_margin).is_some_and(|m| !(m.is_finite() && m >= 0.0)) {
             return Err(PhaseError::Config(
                 "support_margin",
                 "must be finite and ≥ 0",

@@ -219,7 +219,7 @@ impl PoubelImitator {
             },
             posture_settling: Settling::new(),
             footsteps,
-            motion: config.motion,
+            motion: config.motion_for(&tuning),
             com_reference: None,
             swing: SwingHeight::at(0.0),
             hands,

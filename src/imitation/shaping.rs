@@ -27,13 +27,17 @@
 
 use nalgebra::Vector2;
 
+use crate::robots::MotionTuning;
+
 /// Speed and acceleration bounds of the shaped references (m/s, m/s², s).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MotionLimits {
-    /// Largest speed of the CoM reference (m/s). Default 0.05.
+    /// Largest speed of the CoM reference (m/s). Default 0.05 (the imitator's default: the
+    /// profile's [`MotionTuning::com_speed`]).
     pub com_speed: f64,
-    /// Largest acceleration of the CoM reference (m/s²). Default 0.3 (ZMP within ≈ 8 mm of the
-    /// CoM for a 0.26 m CoM height).
+    /// Largest acceleration of the CoM reference (m/s²). Default 0.3: ZMP within ≈ 8 mm of the
+    /// CoM for a 0.27 m CoM height (the imitator's default: the profile's
+    /// [`MotionTuning::com_acceleration`]).
     pub com_acceleration: f64,
     /// Largest speed of the swing foot's height (m/s). Default 0.05.
     pub foot_speed: f64,
@@ -45,6 +49,8 @@ pub struct MotionLimits {
 }
 
 impl Default for MotionLimits {
+    /// The NAO's CoM bounds ([`crate::robots::nao::TUNING`]) and the swing foot's speeds (the
+    /// same for every robot, whose lift height is the paper's ρ = 30 mm).
     fn default() -> Self {
         Self {
             com_speed: 0.05,
@@ -57,6 +63,15 @@ impl Default for MotionLimits {
 }
 
 impl MotionLimits {
+    /// The defaults with the CoM bounds of a robot's `tuning`.
+    pub fn with_com_of(tuning: &MotionTuning) -> Self {
+        Self {
+            com_speed: tuning.com_speed,
+            com_acceleration: tuning.com_acceleration,
+            ..Self::default()
+        }
+    }
+
     /// The first field that is not finite and > 0, with its value.
     pub fn invalid_field(&self) -> Option<(&'static str, f64)> {
         [

@@ -478,15 +478,6 @@ fn foot_frames(profile: &BipedProfile, foot: Side) -> [&str; 3] {
     [f.ankle.as_str(), f.toe.as_str(), f.heel.as_str()]
 }
 
-/// Sideways lean of the torso over the foot the robot stands or is about to stand on in the
-/// executable tables (rad). With an upright pelvis the stance hip ends up outside the CoM and
-/// its roll servo holds the whole upper body (88 % of the rated hip-roll torque of a 5 kg biped
-/// with 0.1 m hip spacing, beyond the limit of a weak servo); leaning 0.25 rad brings the upper
-/// body over the hip (static hip-roll torque 2.55 → 1.7 N·m there; 0.15 rad was not enough for the judge's weak model). A
-/// foot lifts only once the lean is reached ([`PhaseConfig::posture_tolerance`]). Large leans (Table I's free torso leant 16°) put
-/// the swing foot on the floor early when a servo sags.
-pub const TORSO_LEAN: f64 = 0.25;
-
 /// How far below standing the executable tables carry the torso in `phase` (m): the profile's
 /// [`MotionTuning::torso_lowering`](crate::robots::MotionTuning::torso_lowering) while the free
 /// leg has to reach the ground (both feet down, and while a foot is lowered), none while a foot
@@ -505,8 +496,10 @@ fn torso_lowering(phase: SupportPhase, profile: &BipedProfile) -> f64 {
 }
 
 /// The executable tables' torso lean in `phase` (rad about the root sole's x axis, + toward +y):
-/// toward the foot the robot stands on or shifts its weight to, 0 in DS and "CoM to middle".
-fn lean_toward_support(phase: SupportPhase) -> f64 {
+/// the profile's [`MotionTuning::torso_lean`](crate::robots::MotionTuning::torso_lean) toward
+/// the foot the robot stands on or shifts its weight to, 0 in DS and "CoM to middle". A foot
+/// lifts only once the lean is reached ([`PhaseConfig::posture_tolerance`]).
+fn lean_toward_support(phase: SupportPhase, profile: &BipedProfile) -> f64 {
     let support = match phase {
         SupportPhase::Right
         | SupportPhase::DoubleToRight(_)
@@ -520,8 +513,8 @@ fn lean_toward_support(phase: SupportPhase) -> f64 {
     };
     // The right foot is toward −y, the left toward +y, whichever sole is the root.
     match support {
-        Side::Right => -TORSO_LEAN,
-        Side::Left => TORSO_LEAN,
+        Side::Right => -profile.tuning.torso_lean,
+        Side::Left => profile.tuning.torso_lean,
     }
 }
 
@@ -773,7 +766,9 @@ impl TaskTable {
             target: OrientationTarget::HeldFlat,
         };
         let held_foot = |lift| vec![point(ankle, PointTarget::Held { lift }), flat()];
-        let margin = config.support_margin;
+        let margin = config
+            .support_margin
+            .unwrap_or(profile.tuning.support_margin);
         let support = ComGoal::SupportPoint(profile.stance_point(root, margin));
         let other = ComGoal::OtherPoint(profile.stance_point(free, margin));
         let middle = ComGoal::BetweenPoints {
@@ -826,7 +821,7 @@ impl TaskTable {
                 Task::Orientation {
                     frame: profile.torso.clone(),
                     target: OrientationTarget::Upright {
-                        lean: lean_toward_support(phase),
+                        lean: lean_toward_support(phase, profile),
                     },
                 },
                 Task::Point {

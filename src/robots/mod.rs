@@ -7,9 +7,11 @@ pub mod nao;
 pub mod profile;
 pub mod profile_toml;
 pub mod self_collision;
+pub mod tuning;
 
 pub use profile::{
-    BipedProfile, FootArea, FootFrames, HumanJointAngles, JointAnglesFactory, MotionTuning,
-    ProfileError, RobotPoint, SolePlacement, outline_bounds,
+    BipedProfile, FootArea, FootFrames, HumanJointAngles, JointAnglesFactory, ProfileError,
+    RobotPoint, SolePlacement, outline_bounds,
 };
 pub use self_collision::{BodyCapsule, FramePoint, SelfCollision};
+pub use tuning::{BipedSize, MotionTuning};

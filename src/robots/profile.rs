@@ -22,6 +22,7 @@ use nalgebra::{Rotation3, Vector2, Vector3};
 use thiserror::Error;
 
 use super::self_collision::SelfCollision;
+use super::tuning::MotionTuning;
 use crate::human::{HumanJoint, SegmentDirections, Side};
 use crate::model::{Model, ModelError, UrdfError};
 
@@ -206,61 +207,6 @@ pub trait HumanJointAngles: Send + Sync + fmt::Debug {
 /// Builds a robot's [`HumanJointAngles`] for one of its models.
 pub type JointAnglesFactory = fn(&Model) -> Result<Box<dyn HumanJointAngles>, ProfileError>;
 
-/// How the imitation moves a robot: the defaults of the imitator's speed settings that depend on
-/// the robot's size and actuators (`ImitatorConfig::max_task_speed`, `max_tracking_speed` and
-/// `upper_body_velocity_fraction` override them), and how low the executable task tables carry
-/// the torso.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct MotionTuning {
-    /// Largest speed a task asks for (m/s): each frame a task's error is clipped to this times
-    /// the time step, so the velocity limits are rarely hit.
-    pub task_speed: f64,
-    /// Largest speed the tasks that follow the human (the hands) ask for (m/s).
-    pub tracking_speed: f64,
-    /// Fraction of the rated velocity of every joint off the sole-to-sole chain (arms, head);
-    /// the legs keep the imitator's `velocity_fraction`.
-    pub upper_body_velocity_fraction: f64,
-    /// How far below its standing height the executable task tables keep the torso (m, ≥ 0).
-    /// Shifting the hips over one foot with the torso upright lengthens the far leg: at the
-    /// standing height the free leg ends up straight, a singular posture it cannot lift from
-    /// quickly, and a straight leg cannot reach down the last micrometres of a landing.
-    pub torso_lowering: f64,
-}
-
-impl Default for MotionTuning {
-    /// Tuned on the NAO (0.57 m tall, 0.2 m arms and legs, rated joint speeds 4–8 rad/s): tasks
-    /// at up to 0.15 m/s (about what 10 % of the rated speeds give at the hands), the arms at
-    /// half their rated speeds, the torso 0.02 m low (with 0.1 m shanks both knees end up
-    /// straight at the standing height).
-    fn default() -> Self {
-        MotionTuning {
-            task_speed: 0.15,
-            tracking_speed: 0.15,
-            upper_body_velocity_fraction: 0.5,
-            torso_lowering: 0.02,
-        }
-    }
-}
-
-impl MotionTuning {
-    /// The first field out of range (speeds and fraction finite and > 0, the lowering finite
-    /// and ≥ 0), with its value.
-    pub fn invalid_field(&self) -> Option<(&'static str, f64)> {
-        let positive = [
-            ("task_speed", self.task_speed),
-            ("tracking_speed", self.tracking_speed),
-            (
-                "upper_body_velocity_fraction",
-                self.upper_body_velocity_fraction,
-            ),
-        ];
-        let lowering = ("torso_lowering", self.torso_lowering);
-        (positive.into_iter())
-            .find(|(_, v)| !(v.is_finite() && *v > 0.0))
-            .or_else(|| Some(lowering).filter(|(_, v)| !(v.is_finite() && *v >= 0.0)))
-    }
-}
-
 /// Everything the imitation needs to know about a biped (see the module docs).
 #[derive(Clone, Debug)]
 pub struct BipedProfile {
@@ -361,10 +307,10 @@ impl BipedProfile {
                 ));
             }
         }
-        if let Some((field, value)) = self.tuning.invalid_field() {
+        if let Some((field, value, need)) = self.tuning.invalid_field() {
             return Err(invalid(
                 &format!("tuning.{field}"),
-                format!("{value} is not finite and > 0"),
+                format!("{value} is not {need}"),
             ));
         }
         if let Some((field, value)) = self.step_envelope.invalid_field() {

@@ -39,11 +39,16 @@
 //! [frames]                           # optional extra frames: a link and an offset
 //! l_hand = { link = "l_forearm", xyz = [0.1, 0.0, 0.0] }
 //!
-//! [tuning]                           # optional, each field too (defaults: MotionTuning's)
+//! [tuning]                           # optional, each field too (default: the NAO's values
+//!                                    # scaled to this robot's size, crate::robots::tuning)
 //! task_speed = 0.15                  # m/s
 //! tracking_speed = 0.15              # m/s, the hands
 //! upper_body_velocity_fraction = 0.5
 //! torso_lowering = 0.02              # m, the torso below its standing height
+//! torso_lean = 0.25                  # rad, over the stance foot
+//! support_margin = 0.015             # m, CoM goal from the sole's inner edge
+//! com_speed = 0.05                   # m/s, the CoM reference
+//! com_acceleration = 0.3             # m/s²
 //! ```
 //!
 //! The soles become links named `left_sole` and `right_sole` (added to the URDF text before it
@@ -56,8 +61,10 @@ use std::path::Path;
 use nalgebra::{IsometryMatrix3, Translation3};
 use serde::Deserialize;
 
-use super::profile::{BipedProfile, FootArea, FootFrames, MotionTuning, ProfileError, RobotPoint};
+use super::nao;
+use super::profile::{BipedProfile, FootArea, FootFrames, ProfileError, RobotPoint};
 use super::self_collision::SelfCollision;
+use super::tuning::{BipedSize, MotionTuning};
 use crate::human::{HumanJoint, Side};
 use crate::model::{Model, UrdfError, UrdfFrame, UrdfOptions};
 
@@ -88,6 +95,10 @@ struct Tuning {
     tracking_speed: Option<f64>,
     upper_body_velocity_fraction: Option<f64>,
     torso_lowering: Option<f64>,
+    torso_lean: Option<f64>,
+    support_margin: Option<f64>,
+    com_speed: Option<f64>,
+    com_acceleration: Option<f64>,
 }
 
 #[derive(Deserialize)]
@@ -280,7 +291,7 @@ fn build(file: File, urdf: &str) -> Result<BipedProfile, ProfileError> {
         }
     };
     let e = file.step_envelope;
-    let profile = BipedProfile {
+    let mut profile = BipedProfile {
         name: file.name,
         models,
         feet: [foot(Side::Left, feet[0]), foot(Side::Right, feet[1])],
@@ -296,23 +307,29 @@ fn build(file: File, urdf: &str) -> Result<BipedProfile, ProfileError> {
             yaw_max: e.yaw_max,
         },
         joint_angles: None,
-        tuning: tuning(file.tuning),
+        tuning: nao::TUNING,
         self_collision: SelfCollision::default(),
     };
+    profile.validate()?;
+    let scaled = nao::TUNING.scaled(&nao::SIZE, &BipedSize::of(&profile)?);
+    profile.tuning = tuning(file.tuning, scaled);
     profile.validate()?;
     Ok(profile)
 }
 
-/// The `[tuning]` table over the defaults.
-fn tuning(file: Option<Tuning>) -> MotionTuning {
-    let default = MotionTuning::default();
-    let Some(t) = file else { return default };
+/// The `[tuning]` table over `scaled`, the NAO's values scaled to this robot's size.
+fn tuning(file: Option<Tuning>, scaled: MotionTuning) -> MotionTuning {
+    let Some(t) = file else { return scaled };
     MotionTuning {
-        task_speed: t.task_speed.unwrap_or(default.task_speed),
-        tracking_speed: t.tracking_speed.unwrap_or(default.tracking_speed),
+        task_speed: t.task_speed.unwrap_or(scaled.task_speed),
+        tracking_speed: t.tracking_speed.unwrap_or(scaled.tracking_speed),
         upper_body_velocity_fraction: (t.upper_body_velocity_fraction)
-            .unwrap_or(default.upper_body_velocity_fraction),
-        torso_lowering: t.torso_lowering.unwrap_or(default.torso_lowering),
+            .unwrap_or(scaled.upper_body_velocity_fraction),
+        torso_lowering: t.torso_lowering.unwrap_or(scaled.torso_lowering),
+        torso_lean: t.torso_lean.unwrap_or(scaled.torso_lean),
+        support_margin: t.support_margin.unwrap_or(scaled.support_margin),
+        com_speed: t.com_speed.unwrap_or(scaled.com_speed),
+        com_acceleration: t.com_acceleration.unwrap_or(scaled.com_acceleration),
     }
 }
 

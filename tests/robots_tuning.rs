@@ -1,0 +1,115 @@
+//! The size-dependent tuning (`robots::tuning`): the sizes read off a profile against the
+//! robots' published dimensions, the scaling rules against the invariants they state, and a
+//! profile file without a `[tuning]` table getting values for its own size.
+
+use approx::assert_relative_eq;
+use taskstack::robots::{BipedProfile, BipedSize, MotionTuning, g1, nao};
+
+const TINY: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/tiny_biped/");
+
+#[test]
+fn the_nao_sizes_match_its_dimensions_and_the_stored_constant() {
+    let size = BipedSize::of(&nao::profile()).unwrap();
+    // Aldebaran's NAO H25 V5 dimensions: HipOffsetY = 50 mm; the FSRs of a foot span
+    // 29.9 mm + 23.1 mm laterally (left foot, URDF `LFoot/FSR/*`).
+    assert_relative_eq!(size.half_stance, 0.050, epsilon = 1e-9);
+    assert_relative_eq!(size.sole_width, 0.0299 + 0.0231, epsilon = 1e-9);
+    // Hip height: foot height 45.19 mm + tibia 102.9 mm + thigh 100 mm with the standing
+    // posture's bends lowering it, so between the straight-leg 248 mm and 200 mm.
+    assert!(
+        size.hip_height > 0.20 && size.hip_height < 0.2481,
+        "{size:?}"
+    );
+    let stored = nao::SIZE;
+    for (got, kept, tolerance) in [
+        (size.com_height, stored.com_height, 5e-5),
+        (size.half_stance, stored.half_stance, 5e-5),
+        (size.hip_height, stored.hip_height, 5e-5),
+        (size.sole_width, stored.sole_width, 5e-5),
+        (size.arm_length, stored.arm_length, 5e-5),
+        (size.upper_body_speed, stored.upper_body_speed, 5e-3),
+    ] {
+        assert_relative_eq!(got, kept, epsilon = tolerance);
+    }
+}
+
+#[test]
+fn the_scaling_rules_keep_the_invariants_they_state() {
+    let from = nao::SIZE;
+    let to = BipedSize::of(&g1::profile()).unwrap();
+    let (a, b) = (nao::TUNING, nao::TUNING.scaled(&from, &to));
+    // The same ZMP–CoM distance a·h/g (cart-table model).
+    assert_relative_eq!(
+        a.com_acceleration * from.com_height,
+        b.com_acceleration * to.com_height,
+        max_relative = 1e-12
+    );
+    // The same Froude number v²/(g h).
+    for (v, w) in [(a.com_speed, b.com_speed), (a.task_speed, b.task_speed)] {
+        assert_relative_eq!(
+            v * v / from.com_height,
+            w * w / to.com_height,
+            max_relative = 1e-12
+        );
+    }
+    // The lean as the same multiple of the stance angle.
+    let angle = |s: &BipedSize| (s.half_stance / s.com_height).atan();
+    assert_relative_eq!(
+        a.torso_lean / angle(&from),
+        b.torso_lean / angle(&to),
+        max_relative = 1e-12
+    );
+    // Lengths in proportion.
+    assert_relative_eq!(
+        b.support_margin / to.sole_width,
+        a.support_margin / from.sole_width
+    );
+    assert_relative_eq!(
+        b.torso_lowering / to.hip_height,
+        a.torso_lowering / from.hip_height
+    );
+    assert_relative_eq!(
+        b.tracking_speed / to.arm_length,
+        a.tracking_speed / from.arm_length
+    );
+    // Faster motors: the same joint speeds, never a larger fraction.
+    assert!(b.upper_body_velocity_fraction <= a.upper_body_velocity_fraction);
+    // A robot of the same size keeps its values.
+    assert_eq!(a.scaled(&from, &from), a);
+}
+
+#[test]
+fn the_rules_give_the_g1_what_was_tuned_on_it_independently() {
+    // The G1's hand speed (0.3 m/s) and torso lowering (0.05 m) were tuned on the G1 in the
+    // judge before the rules existed (`g1::TUNING`): the rules land within 10 % of both.
+    let rules = nao::TUNING.scaled(&nao::SIZE, &BipedSize::of(&g1::profile()).unwrap());
+    assert_relative_eq!(
+        rules.tracking_speed,
+        g1::TUNING.tracking_speed,
+        max_relative = 0.1
+    );
+    assert_relative_eq!(
+        rules.torso_lowering,
+        g1::TUNING.torso_lowering,
+        max_relative = 0.1
+    );
+}
+
+#[test]
+fn a_profile_file_without_tuning_gets_values_for_its_own_size() {
+    let profile = BipedProfile::from_toml_file(format!("{TINY}tiny_biped.toml")).unwrap();
+    let size = BipedSize::of(&profile).unwrap();
+    let expected: MotionTuning = nao::TUNING.scaled(&nao::SIZE, &size);
+    assert_eq!(profile.tuning, expected);
+    assert_ne!(profile.tuning, nao::TUNING, "not the NAO's values");
+    // A [tuning] field still wins over the scaled value.
+    let urdf = std::fs::read_to_string(format!("{TINY}tiny_biped.urdf")).unwrap();
+    let toml = std::fs::read_to_string(format!("{TINY}tiny_biped.toml")).unwrap();
+    let text = format!("{toml}\n[tuning]\ntorso_lean = 0.1\n");
+    let tuned = BipedProfile::from_toml_str(&text, &urdf).unwrap();
+    assert_eq!(tuned.tuning.torso_lean, 0.1);
+    assert_eq!(tuned.tuning.com_speed, expected.com_speed);
+    let err = BipedProfile::from_toml_str(&format!("{toml}\n[tuning]\ncom_speed = 0\n"), &urdf)
+        .unwrap_err();
+    assert!(err.to_string().contains("tuning.com_speed"), "{err}");
+}
