@@ -153,15 +153,13 @@ fn profiles_without_self_collision_pairs_imitate_with_both_methods() {
 
 #[test]
 fn a_biped_described_by_a_profile_file_imitates_without_crate_changes() {
+    // No [tuning] table: every size-dependent number comes from the scaling rules.
     let profile = BipedProfile::from_toml_file(format!("{TINY}tiny_biped.toml")).unwrap();
     assert_eq!(profile.name, "tiny_biped");
     assert_eq!(profile.models[0].nv(), 18);
-    for clip in [
-        "cmu_05_12_slow_dance_tendu_arms_high.bvh",
-        "kinect2_labanotation_ges01_wavehand.csv",
-    ] {
-        let m = imitate(profile.clone(), clip);
-        assert_executable(&m, clip);
+    for clip in clips() {
+        let m = imitate(profile.clone(), &clip);
+        assert_executable(&m, &clip);
     }
 }
 
