@@ -52,6 +52,22 @@ fn the_scaling_rules_keep_the_invariants_they_state() {
             max_relative = 1e-12
         );
     }
+    // Koenemann's offset (a fraction of the stance): the CoM speed it gives Froude-scaled, the
+    // CoM acceleration it gives keeping a·h.
+    let (cv, dv) = (
+        a.offset_rate * from.half_stance,
+        b.offset_rate * to.half_stance,
+    );
+    assert_relative_eq!(
+        cv * cv / from.com_height,
+        dv * dv / to.com_height,
+        max_relative = 1e-12
+    );
+    assert_relative_eq!(
+        a.offset_acceleration * from.half_stance * from.com_height,
+        b.offset_acceleration * to.half_stance * to.com_height,
+        max_relative = 1e-12
+    );
     // The lean as the same multiple of the stance angle.
     let angle = |s: &BipedSize| (s.half_stance / s.com_height).atan();
     assert_relative_eq!(

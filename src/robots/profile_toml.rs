@@ -49,6 +49,8 @@
 //! support_margin = 0.015             # m, CoM goal from the sole's inner edge
 //! com_speed = 0.05                   # m/s, the CoM reference
 //! com_acceleration = 0.3             # m/s²
+//! offset_rate = 1.5                  # 1/s, Koenemann's CoM offset between the feet
+//! offset_acceleration = 6.0          # 1/s²
 //! ```
 //!
 //! The soles become links named `left_sole` and `right_sole` (added to the URDF text before it
@@ -99,6 +101,8 @@ struct Tuning {
     support_margin: Option<f64>,
     com_speed: Option<f64>,
     com_acceleration: Option<f64>,
+    offset_rate: Option<f64>,
+    offset_acceleration: Option<f64>,
 }
 
 #[derive(Deserialize)]
@@ -330,6 +334,8 @@ fn tuning(file: Option<Tuning>, scaled: MotionTuning) -> MotionTuning {
         support_margin: t.support_margin.unwrap_or(scaled.support_margin),
         com_speed: t.com_speed.unwrap_or(scaled.com_speed),
         com_acceleration: t.com_acceleration.unwrap_or(scaled.com_acceleration),
+        offset_rate: t.offset_rate.unwrap_or(scaled.offset_rate),
+        offset_acceleration: t.offset_acceleration.unwrap_or(scaled.offset_acceleration),
     }
 }
 

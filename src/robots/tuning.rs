@@ -14,6 +14,8 @@
 //! |---|---|---|
 //! | `com_acceleration` | `× h / h'` | same ZMP–CoM distance `a·h/g` (cart-table model): 0.3 m/s² at 0.27 m is 8 mm |
 //! | `com_speed`, `task_speed` | `× √(h'/h)` | same Froude number `v²/(g h)`: pendulum time scales as `√(h/g)` |
+//! | `offset_rate` | `× √(h'/h) · w/w'` | the CoM speed it gives (offset rate × stance width) Froude-scaled |
+//! | `offset_acceleration` | `× w h / (w' h')` | the CoM acceleration it gives, as `com_acceleration` |
 //! | `torso_lean` | `× atan(w'/h') / atan(w/h)` | the same multiple of the angle under which the stance hip is seen from the CoM |
 //! | `support_margin` | `× s'/s` | the same fraction of the sole's width |
 //! | `torso_lowering` | `× l'/l` | the same fraction of the leg |
@@ -62,6 +64,11 @@ pub struct MotionTuning {
     /// Largest acceleration of the CoM reference (m/s²): in the cart-table model the ZMP is
     /// `h/g` times it away from the CoM.
     pub com_acceleration: f64,
+    /// Largest rate of Koenemann's CoM offset (the CoM's place between the feet, 0 at the left
+    /// foot, 1 at the right), at the middle (1/s).
+    pub offset_rate: f64,
+    /// Largest change of that rate (1/s²).
+    pub offset_acceleration: f64,
 }
 
 impl MotionTuning {
@@ -77,6 +84,8 @@ impl MotionTuning {
             ),
             ("com_speed", self.com_speed),
             ("com_acceleration", self.com_acceleration),
+            ("offset_rate", self.offset_rate),
+            ("offset_acceleration", self.offset_acceleration),
         ];
         let non_negative = [
             ("torso_lowering", self.torso_lowering),
@@ -114,6 +123,9 @@ impl MotionTuning {
             support_margin: self.support_margin * to.sole_width / from.sole_width,
             com_speed: self.com_speed * froude,
             com_acceleration: self.com_acceleration * from.com_height / to.com_height,
+            offset_rate: self.offset_rate * froude * (from.half_stance / to.half_stance),
+            offset_acceleration: self.offset_acceleration
+                * ((from.half_stance * from.com_height) / (to.half_stance * to.com_height)),
         }
     }
 }

@@ -8,7 +8,7 @@ use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 use super::KoenemannConfig;
 use super::goals::{Distances, Goal, GoalIk, in_torso};
 use super::mapping::{Limbs, Posture, PostureMapping};
-use super::offset::offset;
+use super::offset::{OffsetSpeed, offset};
 use super::retarget::{FootRetargeting, retarget_double, support_normal};
 use super::support_mode::{SupportMode, target_offset};
 use crate::human::{HumanFrame, HumanJoint, Side, centre_of_mass};
@@ -73,6 +73,8 @@ struct Body {
 pub(crate) struct KoenemannImitator {
     pub(crate) shared: Shared,
     config: KoenemannConfig,
+    /// The offset's speed limit: the config's, or the profile's.
+    offset_speed: OffsetSpeed,
     frames: [Frames; 2],
     body: Body,
     mapping: Option<PostureMapping>,
@@ -328,6 +330,7 @@ impl KoenemannImitator {
             motion: config.motion_for(&tuning),
             step_envelope: config.step_envelope.unwrap_or(profile.step_envelope),
             q_start: shared.q.clone(),
+            offset_speed: (method.offset_speed).unwrap_or_else(|| OffsetSpeed::of_robot(&tuning)),
             config: method,
             frames,
             body,
@@ -418,8 +421,7 @@ impl KoenemannImitator {
                 }
             };
             (self.command, self.command_rate) =
-                self.config
-                    .offset_speed
+                self.offset_speed
                     .step(self.command, self.command_rate, target, dt);
         }
         let root = match (next, self.landing) {

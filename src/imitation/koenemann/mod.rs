@@ -62,8 +62,10 @@ pub struct KoenemannConfig {
     pub calibration: Calibration,
     /// How double support meets the commanded offset (default: both feet shift, no slide).
     pub retargeting: FootRetargeting,
-    /// The offset's speed limit.
-    pub offset_speed: OffsetSpeed,
+    /// The offset's speed limit; `None` (default): [`OffsetSpeed::default`]'s border with the
+    /// profile's [`MotionTuning::offset_rate`](crate::robots::MotionTuning::offset_rate) and
+    /// [`MotionTuning::offset_acceleration`](crate::robots::MotionTuning::offset_acceleration).
+    pub offset_speed: Option<OffsetSpeed>,
     /// The offset counts as at a foot within this of 0 or 1. Default 0.05.
     pub offset_tolerance: f64,
     /// Damping `λ` of the arms' least-squares IK (m). Default 0.01 (the paper's 0.3 is for its
@@ -83,7 +85,7 @@ impl Default for KoenemannConfig {
         KoenemannConfig {
             calibration: Calibration::Auto,
             retargeting: FootRetargeting::ShiftBothFeet,
-            offset_speed: OffsetSpeed::default(),
+            offset_speed: None,
             offset_tolerance: 0.05,
             damping: 0.01,
             arm_iterations: 30,
@@ -96,7 +98,7 @@ impl Default for KoenemannConfig {
 impl KoenemannConfig {
     /// The first invalid field, with its value and why.
     pub(super) fn invalid_field(&self) -> Option<(&'static str, f64, &'static str)> {
-        if let Some((name, value)) = self.offset_speed.invalid_field() {
+        if let Some((name, value)) = self.offset_speed.and_then(|s| s.invalid_field()) {
             return Some((
                 name,
                 value,

@@ -13,6 +13,8 @@
 
 use nalgebra::Vector3;
 
+use crate::robots::MotionTuning;
+
 /// Eq. 6: the offset of `com` between the foot centres `left` and `right` (any common frame);
 /// `None` when the feet coincide.
 pub fn offset(com: &Vector3<f64>, left: &Vector3<f64>, right: &Vector3<f64>) -> Option<f64> {
@@ -35,6 +37,7 @@ pub struct OffsetSpeed {
 }
 
 impl Default for OffsetSpeed {
+    /// The NAO's ([`crate::robots::nao::TUNING`]).
     fn default() -> Self {
         OffsetSpeed {
             max: 1.5,
@@ -45,6 +48,16 @@ impl Default for OffsetSpeed {
 }
 
 impl OffsetSpeed {
+    /// The default border with a robot's rate and acceleration (its
+    /// [`MotionTuning::offset_rate`] and [`MotionTuning::offset_acceleration`]).
+    pub fn of_robot(tuning: &MotionTuning) -> Self {
+        OffsetSpeed {
+            max: tuning.offset_rate,
+            acceleration: tuning.offset_acceleration,
+            ..Self::default()
+        }
+    }
+
     /// The largest speed at offset `o` (clamped to [0, 1]), 1/s.
     pub fn at(&self, o: f64) -> f64 {
         let o = o.clamp(0.0, 1.0);

@@ -299,6 +299,8 @@ pub fn self_collision() -> SelfCollision {
 ///   its 53 mm-wide contact area): at the centre the hip-roll servo works at 88 % of its rating.
 /// * The CoM reference at up to 0.05 m/s and 0.3 m/s²: the ZMP within 8 mm of the CoM at its
 ///   0.27 m height.
+/// * Koenemann's CoM offset at up to 1.5 /s and 6 /s²: a shift from the middle to a foot in
+///   about 0.6 s, 0.15 m/s and 0.6 m/s² of the CoM on the 0.1 m stance.
 pub const TUNING: MotionTuning = MotionTuning {
     task_speed: 0.15,
     tracking_speed: 0.15,
@@ -308,6 +310,8 @@ pub const TUNING: MotionTuning = MotionTuning {
     support_margin: 0.015,
     com_speed: 0.05,
     com_acceleration: 0.3,
+    offset_rate: 1.5,
+    offset_acceleration: 6.0,
 };
 
 /// The NAO's sizes ([`BipedSize::of`] its profile, rounded to 0.1 mm and 0.01 rad/s; a test
