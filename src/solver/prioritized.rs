@@ -189,6 +189,8 @@ struct LevelFactor {
     rank: usize,
     /// Rows used: the level's equality rows and its active inequality rows.
     rows: usize,
+    /// Damping `μ_j` of the level's least-squares solve (0: undamped).
+    damping: f64,
 }
 
 /// A row a pass uses: an equality row (stacked index), or an active inequality row held at one of
@@ -265,6 +267,10 @@ pub struct Solver {
     qr: Vec<f64>,
     tau: Vec<f64>,
     perm: Vec<usize>,
+    /// Per used row (at `n · (seg_j + t)`): its coordinates along the range bases of the levels
+    /// above, `U_iᵀ J_rowᵀ` for i < j (the first `Σ_{i<j} k_i` entries), kept from the pass that
+    /// factored them, so that a new right-hand side needs no new projection.
+    projections: Vec<f64>,
     /// Right-hand side `b_j` per row, then `w_j` per level (at the level's start).
     rhs: Vec<f64>,
     coeff: Vec<f64>,
@@ -327,6 +333,7 @@ impl Solver {
             inequality_state: vec![None; inequalities],
             active_set: ActiveSetWorkspace::new(n, capacity, inequalities, m_max),
             qr: vec![0.0; n * capacity],
+            projections: vec![0.0; n * capacity],
             tau: vec![0.0; capacity],
             perm: vec![0; capacity],
             rhs: vec![0.0; capacity],
@@ -429,12 +436,16 @@ impl Solver {
         if let Method::WeightedDls { .. } = self.settings.method {
             self.update_limit_weights(q, bounds);
         }
-        if self.settings.scale_to_fit {
-            self.fit_scales();
-        }
+        // fit_scales leaves the factorization of the free joints it ends with.
+        let mut factored = self.settings.scale_to_fit && self.fit_scales();
         loop {
             self.report.clamping_iterations += 1;
-            self.pass();
+            if factored {
+                self.repeat_pass();
+                factored = false;
+            } else {
+                self.pass();
+            }
             // Clamp the worst violator only, then solve again: clamping every violator at once
             // lets a near-singular raw solution decide the fate of joints it would not need.
             let mut worst: Option<(usize, f64, f64)> = None;
@@ -497,19 +508,23 @@ impl Solver {
     /// one prioritized pass. A free joint at a position limit that the unscaled step pushes
     /// through it is clamped first (no scale can help it); then, highest level first, each scale
     /// is the largest in [0, 1] that keeps the running sum inside every free joint's interval.
-    fn fit_scales(&mut self) {
+    /// Returns whether the last factorization is of the joints still free (false only when the
+    /// clamping ran out of joints to clamp).
+    fn fit_scales(&mut self) -> bool {
         let n = self.stack.dof();
         let parts = self.scales.len();
+        let mut factored = false;
         for _ in 0..=n {
             self.scales.fill(0.0);
             self.pass();
             self.base_velocity.copy_from_slice(&self.velocity);
             self.saved_fixed.copy_from_slice(&self.fixed_velocity);
             self.fixed_velocity.fill(0.0);
+            // Each part is the same factorization with another right-hand side.
             for k in 0..parts {
                 self.scales.fill(0.0);
                 self.scales[k] = 1.0;
-                self.pass();
+                self.repeat_pass();
                 self.contributions[k * n..(k + 1) * n].copy_from_slice(&self.velocity);
             }
             self.fixed_velocity.copy_from_slice(&self.saved_fixed);
@@ -545,6 +560,7 @@ impl Solver {
                 }
             }
             if !blocked {
+                factored = true;
                 break;
             }
         }
@@ -570,6 +586,7 @@ impl Solver {
                 *v += scale * c;
             }
         }
+        factored
     }
 
     /// One solve by the configured method over the joints not clamped; writes `self.velocity`.
@@ -588,16 +605,35 @@ impl Solver {
         let mut dim = self.free.len();
         for j in 0..self.stack.level_count() {
             let rows = self.project_level_rows(j, dim);
-            let rank = self.factor_and_solve_level(j, dim, rows);
-            self.factors[j] = LevelFactor { dim, rank, rows };
+            let (rank, damping) = self.factor_level(j, dim, rows);
+            self.factors[j] = LevelFactor {
+                dim,
+                rank,
+                rows,
+                damping,
+            };
+            self.solve_level(j);
             dim -= rank;
         }
         self.assemble_velocity();
     }
 
+    /// The last prioritized pass again for the current scales and fixed velocities, on its
+    /// factorization (same free joints, same used rows): the velocity a new pass would give,
+    /// bit for bit, without projecting and factoring the levels again.
+    fn repeat_pass(&mut self) {
+        if !matches!(self.settings.method, Method::Prioritized) {
+            return self.pass();
+        }
+        for j in 0..self.stack.level_count() {
+            self.solve_level(j);
+        }
+        self.assemble_velocity();
+    }
+
     /// Lists the rows level `j` uses in this pass (its equality rows, then its active inequality
-    /// rows), writes `A_jᵀ = Z_{j−1}ᵀ J_jᵀ` into level j's QR buffer and the right-hand side
-    /// `b_j = ẋ_j − J_j q̇_{j−1}` into `rhs`. Returns the number of rows.
+    /// rows), writes `A_jᵀ = Z_{j−1}ᵀ J_jᵀ` into level j's QR buffer and each row's
+    /// coordinates along the levels above into `projections`. Returns the number of rows.
     fn project_level_rows(&mut self, j: usize, dim: usize) -> usize {
         let n = self.stack.dof();
         let seg = self.seg_start[j];
@@ -605,9 +641,8 @@ impl Solver {
         let (head, tail) = self.qr.split_at_mut(n * seg);
         self.row_scale = 0.0;
         for t in 0..rows {
-            let (row, target) = used_row(&self.stack, self.used[seg + t], self.scales[j]);
+            let (row, _) = used_row(&self.stack, self.used[seg + t], self.scales[j]);
             self.row_scale = self.row_scale.max(norm(row));
-            let mut b = target - dot(row, &self.fixed_velocity);
             for (c, &i) in self.coords.iter_mut().zip(&self.free) {
                 *c = row[i];
             }
@@ -619,19 +654,32 @@ impl Solver {
                 &self.seg_start,
                 &mut self.coords,
             );
+            let at = n * (seg + t);
+            self.projections[at..at + offset].copy_from_slice(&self.coords[..offset]);
+            tail[t * dim..(t + 1) * dim].copy_from_slice(&self.coords[offset..offset + dim]);
+        }
+        rows
+    }
+
+    /// Writes level j's right-hand side `b_j = ẋ_j − J_j q̇_{j−1}` into `rhs`: the scaled
+    /// targets less the clamped joints' and the levels above's velocities along each row.
+    fn level_rhs(&mut self, j: usize) {
+        let (n, seg) = (self.stack.dof(), self.seg_start[j]);
+        for t in 0..self.factors[j].rows {
+            let (row, target) = used_row(&self.stack, self.used[seg + t], self.scales[j]);
+            let mut b = target - dot(row, &self.fixed_velocity);
+            let projection = &self.projections[n * (seg + t)..];
             let mut level_offset = 0;
             for (i, f) in self.factors[..j].iter().enumerate() {
                 let level_seg = self.seg_start[i];
                 b -= dot(
-                    &self.coords[level_offset..level_offset + f.rank],
+                    &projection[level_offset..level_offset + f.rank],
                     &self.coeff[level_seg..level_seg + f.rank],
                 );
                 level_offset += f.rank;
             }
-            tail[t * dim..(t + 1) * dim].copy_from_slice(&self.coords[offset..offset + dim]);
             self.rhs[seg + t] = b;
         }
-        rows
     }
 
     /// Fills `used[seg_start[j]..]` with level j's equality rows, then its active inequality rows.
@@ -656,9 +704,9 @@ impl Solver {
         t - seg
     }
 
-    /// Factorizes level j's `rows` projected rows and stores its least-squares coefficients
-    /// `w_j`. Returns the rank used.
-    fn factor_and_solve_level(&mut self, j: usize, dim: usize, rows: usize) -> usize {
+    /// Factorizes level j's `rows` projected rows. Returns the rank used and the damping its
+    /// smallest kept singular value calls for.
+    fn factor_level(&mut self, j: usize, dim: usize, rows: usize) -> (usize, f64) {
         let n = self.stack.dof();
         let start = self.seg_start[j];
         let a = &mut self.qr[n * start..n * start + dim * rows];
@@ -671,8 +719,6 @@ impl Solver {
             .rank_tolerance
             .max(RELATIVE_RANK_TOLERANCE * self.row_scale);
         let rank = qr_col_pivoting(a, dim, rows, tolerance, tau, perm);
-        let w = &mut self.coeff[start..start + rows];
-        w.fill(0.0);
         let mut damping = 0.0;
         if rank > 0 {
             let sigma = a[(rank - 1) * dim + rank - 1].abs();
@@ -681,6 +727,30 @@ impl Solver {
                 let ratio = sigma / eps;
                 damping = self.settings.max_damping * (1.0 - ratio * ratio).sqrt();
             }
+        }
+        self.report.levels[j].rank = rank;
+        self.report.levels[j].rows = rows;
+        self.report.levels[j].damping = damping;
+        (rank, damping)
+    }
+
+    /// Level j's right-hand side ([`Solver::level_rhs`]) and its least-squares coefficients
+    /// `w_j` from the level's factorization.
+    fn solve_level(&mut self, j: usize) {
+        self.level_rhs(j);
+        let n = self.stack.dof();
+        let start = self.seg_start[j];
+        let LevelFactor {
+            dim,
+            rank,
+            rows,
+            damping,
+        } = self.factors[j];
+        let a = &self.qr[n * start..n * start + dim * rows];
+        let perm = &self.perm[start..start + rows];
+        let w = &mut self.coeff[start..start + rows];
+        w.fill(0.0);
+        if rank > 0 {
             let c = &mut self.ls_rhs[..rows + rank];
             for (ck, &p) in c.iter_mut().zip(perm.iter()) {
                 *ck = self.rhs[start + p];
@@ -707,10 +777,6 @@ impl Solver {
             }
             w[..rank].copy_from_slice(&c[..rank]);
         }
-        self.report.levels[j].rank = rank;
-        self.report.levels[j].rows = rows;
-        self.report.levels[j].damping = damping;
-        rank
     }
 
     /// `q̇ = q̇_clamped + Z_0 (Σ_j Z-chain [w_j] + Z_N Z_Nᵀ g)`, folding the levels back from the
