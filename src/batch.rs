@@ -634,6 +634,7 @@ pub fn metrics_value(m: &ImitationMetrics, clip: &Path) -> Value {
                 let value = json!({
                     "single_support_m": mean_max(&e.single_support),
                     "double_support_m": mean_max(&e.double_support),
+                    "transitions_m": mean_max(&e.transitions),
                 });
                 (e.name.to_string(), value)
             })
@@ -673,6 +674,7 @@ pub fn metrics_value(m: &ImitationMetrics, clip: &Path) -> Value {
         "clip_support_frames": {
             "single": m.clip_support_frames.single,
             "double": m.clip_support_frames.double,
+            "transitions": m.clip_support_frames.transitions,
         },
         "tracking_error_clip_lag_removed": effector_map(&m.hands_clip_lag_removed),
         "hand_lag_s": m.hand_lag_s,

@@ -309,15 +309,16 @@ fn print_tracking(text: &mut String, m: &ImitationMetrics) {
     );
     let _ = writeln!(
         text,
-        "  {:8} {:>22} {:>22}",
+        "  {:8} {:>22} {:>22} {:>22}",
         "",
         format!("single support ({})", frames.single),
-        format!("double support ({})", frames.double)
+        format!("double support ({})", frames.double),
+        format!("transitions ({})", frames.transitions)
     );
     let _ = writeln!(
         text,
-        "  {:8} {:>22} {:>22}",
-        "", "mean / max (frames)", "mean / max (frames)"
+        "  {:8} {:>22} {:>22} {:>22}",
+        "", "mean / max (frames)", "mean / max (frames)", "mean / max (frames)"
     );
     // An empty cell says why: the robot never stood that way, or its phase does not track it.
     let cell = |s: &taskstack::imitation::metrics::MeanMax, support_frames: usize| match s.count {
@@ -328,10 +329,11 @@ fn print_tracking(text: &mut String, m: &ImitationMetrics) {
     for e in &m.effectors_clip {
         let _ = writeln!(
             text,
-            "  {:8} {:>22} {:>22}",
+            "  {:8} {:>22} {:>22} {:>22}",
             e.name,
             cell(&e.single_support, frames.single),
-            cell(&e.double_support, frames.double)
+            cell(&e.double_support, frames.double),
+            cell(&e.transitions, frames.transitions)
         );
     }
 }

@@ -1,7 +1,8 @@
 //! What an imitation run achieved, measured frame by frame from the [`RobotFrame`]s.
 //!
 //! * **Tracking**: distance between each tracked effector (hands, free ankle) and its scaled
-//!   reference, in the model root's frame (m), split by single and double support.
+//!   reference, in the model root's frame (m), split by single support, double support and the
+//!   transition steps ([`SupportKind`]): on every frame whose phase tracks it.
 //! * **Static stability**: the signed distance of the CoM ground projection to the edge of the
 //!   support polygon (positive inside, m): the convex hull of the sole outlines
 //!   ([`FootFrames::outline`](crate::robots::FootFrames::outline)) of the feet on the ground, a foot being on the ground when all its
@@ -26,7 +27,7 @@ use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 
 use super::clearance::{ClearanceMeter, SelfClearance};
 use super::imitator::{Imitator, RobotFrame};
-use super::phase::SupportPhase;
+use super::phase::{SupportKind, SupportPhase};
 use super::support::HumanSupport;
 use super::travel::{
     FootTiming, HandTrace, Stance, StepCounter, Travel, TravelRecorder, robot_stance,
@@ -46,13 +47,26 @@ pub fn sole_on_floor(outline: &[[f64; 2]], sole: &IsometryMatrix3<f64>) -> bool 
         .all(|&[x, y]| sole.transform_point(&[x, y, 0.0].into()).z.abs() <= CONTACT_HEIGHT)
 }
 
-/// Frames of a run by the robot's continuous support phase.
+/// Frames of a run by the kind of the robot's phase.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct SupportFrames {
     /// Frames in RS or LS.
     pub single: usize,
     /// Frames in DS.
     pub double: usize,
+    /// Frames in a transition step (CoM to a foot, lift, lower, CoM to the middle).
+    pub transitions: usize,
+}
+
+impl SupportFrames {
+    /// The count of `kind`, mutable.
+    fn of_kind(&mut self, kind: SupportKind) -> &mut usize {
+        match kind {
+            SupportKind::Single => &mut self.single,
+            SupportKind::Double => &mut self.double,
+            SupportKind::Transition => &mut self.transitions,
+        }
+    }
 }
 
 /// Mean and maximum of a series.
@@ -198,15 +212,32 @@ pub struct EffectorError {
     pub single_support: MeanMax,
     /// Over frames of double support where it was tracked (m).
     pub double_support: MeanMax,
+    /// Over frames of the transition steps where it was tracked (m).
+    pub transitions: MeanMax,
 }
 
 impl EffectorError {
-    /// Mean over the frames of single and double support together (m); `None` if it was never
-    /// tracked.
+    /// From its cells in [`SupportKind::index`] order.
+    fn of_kinds(name: &'static str, [single, double, transitions]: [MeanMax; 3]) -> Self {
+        EffectorError {
+            name,
+            single_support: single,
+            double_support: double,
+            transitions,
+        }
+    }
+
+    /// Mean over every frame where it was tracked, whatever the phase (m); `None` if it was
+    /// never tracked.
     pub fn mean(&self) -> Option<f64> {
-        let (s, d) = (&self.single_support, &self.double_support);
-        let count = s.count + d.count;
-        (count > 0).then(|| (s.mean * s.count as f64 + d.mean * d.count as f64) / count as f64)
+        let cells = [
+            &self.single_support,
+            &self.double_support,
+            &self.transitions,
+        ];
+        let count: usize = cells.iter().map(|c| c.count).sum();
+        let sum: f64 = cells.iter().map(|c| c.mean * c.count as f64).sum();
+        (count > 0).then(|| sum / count as f64)
     }
 }
 
@@ -257,9 +288,10 @@ pub struct ImitationMetrics {
     /// Tracking error per effector over the clip's frames only (before
     /// [`MetricsRecorder::mark_clip_end`]; all frames if it was never called).
     pub effectors_clip: Vec<EffectorError>,
-    /// The clip's frames in single support (RS or LS) and in double support (DS): a cell of
-    /// [`Self::effectors_clip`] with no frames is empty because the phase does not track that
-    /// effector, or because the robot never was in that support.
+    /// The clip's frames in single support (RS or LS), in double support (DS) and in the
+    /// transition steps (together `clip_frames`): a cell of [`Self::effectors_clip`] with no
+    /// frames is empty because the phase does not track that effector, or because the robot
+    /// never was in that support.
     pub clip_support_frames: SupportFrames,
     /// Hand errors over the clip's frames once the best time shift is removed (`l_hand`,
     /// `r_hand`).
@@ -321,8 +353,8 @@ pub struct MetricsRecorder {
     sequence: Vec<&'static str>,
     transition_start: Option<f64>,
     transitions: Vec<f64>,
-    single: Vec<Series>,
-    double: Vec<Series>,
+    /// Per [`SupportKind`], per effector: the errors over every frame.
+    errors: [Vec<Series>; SupportKind::COUNT],
     min_margin: f64,
     outside: usize,
     joint_violations: usize,
@@ -334,8 +366,8 @@ pub struct MetricsRecorder {
     held_slip: f64,
     held_turn: f64,
     times: TimeHistogram,
-    single_clip: Vec<Series>,
-    double_clip: Vec<Series>,
+    /// The same over the clip's frames.
+    errors_clip: [Vec<Series>; SupportKind::COUNT],
     clip_support_frames: SupportFrames,
     hands: HandTrace,
     clearance: Option<ClearanceMeter>,
@@ -360,15 +392,11 @@ fn continuous_name(phase: SupportPhase) -> Option<&'static str> {
     }
 }
 
-/// The tracking errors of [`EFFECTORS`] from their single- and double-support series.
-fn effector_errors(single: &[Series], double: &[Series]) -> Vec<EffectorError> {
-    EFFECTORS
-        .iter()
-        .zip(single.iter().zip(double))
-        .map(|((name, _), (single, double))| EffectorError {
-            name,
-            single_support: single.summary(),
-            double_support: double.summary(),
+/// The tracking errors of [`EFFECTORS`] from their series per [`SupportKind`].
+fn effector_errors(series: &[Vec<Series>; SupportKind::COUNT]) -> Vec<EffectorError> {
+    (EFFECTORS.iter().enumerate())
+        .map(|(e, (name, _))| {
+            EffectorError::of_kinds(name, series.each_ref().map(|s| s[e].summary()))
         })
         .collect()
 }
@@ -436,8 +464,7 @@ impl MetricsRecorder {
             sequence: Vec::new(),
             transition_start: None,
             transitions: Vec::new(),
-            single: vec![Series::default(); EFFECTORS.len()],
-            double: vec![Series::default(); EFFECTORS.len()],
+            errors: std::array::from_fn(|_| vec![Series::default(); EFFECTORS.len()]),
             min_margin: f64::INFINITY,
             outside: 0,
             joint_violations: 0,
@@ -448,9 +475,8 @@ impl MetricsRecorder {
             held_slip: 0.0,
             held_turn: 0.0,
             times: TimeHistogram::default(),
-            single_clip: vec![Series::default(); EFFECTORS.len()],
+            errors_clip: std::array::from_fn(|_| vec![Series::default(); EFFECTORS.len()]),
             clip_support_frames: SupportFrames::default(),
-            double_clip: vec![Series::default(); EFFECTORS.len()],
             hands: HandTrace::default(),
             // The imitator validated its profile, so its pairs resolve.
             clearance: ClearanceMeter::new(profile).ok().flatten(),
@@ -520,26 +546,14 @@ impl MetricsRecorder {
 
     /// Tracking errors of the effectors the phase tracks, against their scaled references.
     fn record_tracking(&mut self, frame: &RobotFrame) {
-        let single = matches!(frame.phase, SupportPhase::Right | SupportPhase::Left);
-        let double = frame.phase == SupportPhase::Double;
-        if !(single || double) {
-            return;
-        }
+        let kind = frame.phase.kind();
         let tracked = self.tracked[frame.phase.index()];
         let in_clip = !self.travel.clip_ended();
-        let (all, clip, count) = match single {
-            true => (
-                &mut self.single,
-                &mut self.single_clip,
-                &mut self.clip_support_frames.single,
-            ),
-            false => (
-                &mut self.double,
-                &mut self.double_clip,
-                &mut self.clip_support_frames.double,
-            ),
-        };
-        *count += usize::from(in_clip);
+        let (all, clip) = (
+            &mut self.errors[kind.index()],
+            &mut self.errors_clip[kind.index()],
+        );
+        *self.clip_support_frames.of_kind(kind) += usize::from(in_clip);
         for (e, (_, joint)) in EFFECTORS.iter().enumerate() {
             let Some(reference) = frame.reference[joint.index()].filter(|_| tracked[e]) else {
                 continue;
@@ -653,12 +667,7 @@ impl MetricsRecorder {
         let robot = [world(&frame.effectors[0]), world(&frame.effectors[1])];
         let reference = [EFFECTORS[0].1, EFFECTORS[1].1]
             .map(|joint| frame.reference[joint.index()].as_ref().map(world));
-        let kind = match frame.phase {
-            SupportPhase::Right | SupportPhase::Left => 1,
-            SupportPhase::Double => 2,
-            _ => 0,
-        };
-        self.hands.record(frame.time, robot, reference, kind);
+        (self.hands).record(frame.time, robot, reference, frame.phase.kind());
     }
 
     /// The metrics of the frames recorded so far.
@@ -678,7 +687,7 @@ impl MetricsRecorder {
             robot_support_changes: self.sequence.len().saturating_sub(1),
             robot_support_sequence: self.sequence.clone(),
             transition_durations: Spread::of(&mut transitions),
-            effectors: effector_errors(&self.single, &self.double),
+            effectors: effector_errors(&self.errors),
             min_com_margin: self.min_margin,
             frames_com_outside: self.outside,
             joint_limit_violations: self.joint_violations,
@@ -688,18 +697,14 @@ impl MetricsRecorder {
             max_held_foot_slip: self.held_slip,
             max_held_foot_turn: self.held_turn,
             solve_time_us: self.times.spread(),
-            effectors_clip: effector_errors(&self.single_clip, &self.double_clip),
+            effectors_clip: effector_errors(&self.errors_clip),
             clip_support_frames: self.clip_support_frames,
             hands_clip_lag_removed: {
                 let cell = |(mean, max, count): (f64, f64, usize)| MeanMax { mean, max, count };
                 EFFECTORS[..2]
                     .iter()
                     .zip(lag_errors)
-                    .map(|((name, _), [single, double])| EffectorError {
-                        name,
-                        single_support: cell(single),
-                        double_support: cell(double),
-                    })
+                    .map(|((name, _), cells)| EffectorError::of_kinds(name, cells.map(cell)))
                     .collect()
             },
             hand_lag_s,

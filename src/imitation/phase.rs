@@ -110,7 +110,37 @@ pub enum SupportPhase {
     LeftToDouble(Landing),
 }
 
+/// What a phase is for the metrics: a continuous single or double support, or a transition step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum SupportKind {
+    /// RS or LS.
+    Single,
+    /// DS.
+    Double,
+    /// One of the eight transition steps.
+    Transition,
+}
+
+impl SupportKind {
+    /// Number of kinds.
+    pub const COUNT: usize = 3;
+
+    /// 0 single, 1 double, 2 transition.
+    pub const fn index(self) -> usize {
+        self as usize
+    }
+}
+
 impl SupportPhase {
+    /// The phase's [`SupportKind`].
+    pub const fn kind(self) -> SupportKind {
+        match self {
+            SupportPhase::Right | SupportPhase::Left => SupportKind::Single,
+            SupportPhase::Double => SupportKind::Double,
+            _ => SupportKind::Transition,
+        }
+    }
+
     /// Number of phases (3 continuous supports + 8 transition steps).
     pub const COUNT: usize = 11;
 

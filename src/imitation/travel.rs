@@ -23,6 +23,7 @@
 use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 
 use super::footsteps::wrap;
+use super::phase::SupportKind;
 use crate::human::Side;
 
 /// Largest distance (m) between the robot's and the scaled human's stance at which the robot has
@@ -235,8 +236,8 @@ fn pair(human: &[Vec<f64>; 2], robot: &[Vec<f64>; 2]) -> Lags {
 /// Most lags (frames) the hand-lag search tries: [`MAX_LAG`] at up to 500 frames per second.
 const LAG_CAPACITY: usize = 1024;
 
-/// Per lag, per hand, per support kind (single, double): error sum, maximum, count.
-type LagCells = [[(f64, f64, usize); 2]; 2];
+/// Per lag, per hand, per support kind ([`SupportKind::index`]): error sum, maximum, count.
+type LagCells = [[(f64, f64, usize); SupportKind::COUNT]; 2];
 
 /// The hand-lag search, run as the frames come in memory bounded by [`LAG_CAPACITY`]: for every
 /// lag `k` it accumulates the errors between the robot's hands at frame `i + k` and the
@@ -246,9 +247,9 @@ pub(crate) struct HandTrace {
     /// Times of the first frames: a lag `k` is searched if `first_times[k]` is within
     /// [`MAX_LAG`] of the first.
     first_times: Vec<f64>,
-    /// The references and support kinds (1 single, 2 double, 0 a transition) of the last
-    /// [`LAG_CAPACITY`] frames, frame `i` at `i % LAG_CAPACITY`.
-    recent: Vec<([Option<Vector3<f64>>; 2], u8)>,
+    /// The references and support kinds of the last [`LAG_CAPACITY`] frames, frame `i` at
+    /// `i % LAG_CAPACITY`.
+    recent: Vec<([Option<Vector3<f64>>; 2], SupportKind)>,
     frames: usize,
     /// Per lag: error sum and count over both hands.
     totals: Vec<(f64, usize)>,
@@ -256,19 +257,19 @@ pub(crate) struct HandTrace {
     cells: Vec<LagCells>,
 }
 
-/// Mean hand errors (m) once the best lag is removed: `[hand][single, double]` as (mean, max,
-/// count), and the lag (s).
+/// Mean hand errors (m) once the best lag is removed: `[hand][kind]` as (mean, max, count), and
+/// the lag (s).
 pub(crate) type LagRemoved = (LagCells, f64);
 
 impl HandTrace {
     /// Adds a frame at `time` (s): the robot's hands (left, right), their references, and the
-    /// support kind (1 single, 2 double, 0 a transition).
+    /// support kind of the reference's frame.
     pub(crate) fn record(
         &mut self,
         time: f64,
         robot: [Vector3<f64>; 2],
         reference: [Option<Vector3<f64>>; 2],
-        kind: u8,
+        kind: SupportKind,
     ) {
         let j = self.frames;
         if j < LAG_CAPACITY {
@@ -292,12 +293,10 @@ impl HandTrace {
                 let e = (robot[h] - reference).norm();
                 self.totals[k].0 += e;
                 self.totals[k].1 += 1;
-                if kind != 0 {
-                    let cell = &mut self.cells[k][h][usize::from(kind == 2)];
-                    cell.0 += e;
-                    cell.1 = cell.1.max(e);
-                    cell.2 += 1;
-                }
+                let cell = &mut self.cells[k][h][kind.index()];
+                cell.0 += e;
+                cell.1 = cell.1.max(e);
+                cell.2 += 1;
             }
         }
         self.frames += 1;
@@ -413,7 +412,12 @@ mod tests {
         let path = |t: f64| Vector3::new(t.sin(), 0.0, 0.0);
         for i in 0..100 {
             let t = i as f64 * 0.1;
-            trace.record(t, [path(t - 0.5); 2], [Some(path(t)); 2], 2);
+            trace.record(
+                t,
+                [path(t - 0.5); 2],
+                [Some(path(t)); 2],
+                SupportKind::Double,
+            );
         }
         let (errors, lag) = trace.lag_removed();
         assert!((lag - 0.5).abs() < 1e-9, "{lag}");
