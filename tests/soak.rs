@@ -213,12 +213,12 @@ type Robot = (fn() -> BipedProfile, f64);
 /// The NAO: its standing feet within 1e-6 m.
 const NAO: Robot = (nao::profile, 1e-6);
 
-/// The G1: within 1 mm. Inside a clip its held foot stays within a few micrometres; at the clip
+/// The G1: within 1e-5 m. Inside a clip its held foot stays within 1e-7 m. At the clip
 /// boundaries, where the human jumps and the whole body moves at its speed limits, a frame's
-/// step is so large that its second-order error moves the held foot 0.5–0.8 mm, and the other
-/// leg has no velocity left to close it (7.8e-4 m on the short soak; 1.6e-3 m without the
-/// contact step).
-const G1: Robot = (g1::profile, 1e-3);
+/// step is so large that its second-order error moved the held foot by 0.5–0.8 mm while the
+/// other leg had no velocity left to close it; with the contact step over both legs when the
+/// other leg alone cannot finish, 3.7e-6 m is left there (7.8e-4 m before).
+const G1: Robot = (g1::profile, 1e-5);
 
 fn soak((profile, held_slip): Robot, clips: &[Vec<HumanFrame>], passes: usize) -> Soak {
     let start_bytes = live_bytes();

@@ -25,6 +25,10 @@ use crate::tasks::{
     upright_rows,
 };
 
+/// Residual of the contact step's linear system (m and rad, the rows' units) above which a
+/// second step over both legs takes the rest.
+const CONTACT_RESIDUAL: f64 = 1e-9;
+
 /// A task of a table, resolved against a model: frame, axes, where its rows are.
 #[derive(Debug, Clone)]
 struct ResolvedTask {
@@ -105,8 +109,13 @@ pub(super) struct PhaseSolver {
     /// them (moved by the whole body's least-norm step, a hand resting on a stool sank 4 mm
     /// into it, and a CoM came 1.4 mm nearer the edge of the support).
     movable: Vec<bool>,
+    /// The joints that turn the other sole (both legs): a second contact step may move them
+    /// when the other leg alone cannot finish (a joint of it at a limit).
+    legs: Vec<bool>,
     /// A contact row with only the movable joints' entries.
     row: Vec<f64>,
+    /// The first contact step (rad).
+    step: Vec<f64>,
     other_ankle: FrameId,
     other_sole: FrameId,
 }
@@ -202,7 +211,9 @@ impl PhaseSolver {
             frame_start: vec![0.0; model.nv()],
             reach: JointBounds::unbounded(model.nv()),
             movable: free_leg(model, &initial, profile, table.model_root.other())?,
+            legs: turns(model, &initial, &other.sole)?,
             row: vec![0.0; model.nv()],
+            step: vec![0.0; model.nv()],
             other_ankle: model.frame_id(&other.ankle)?,
             other_sole: model.frame_id(&other.sole)?,
         })
@@ -298,6 +309,8 @@ impl PhaseSolver {
     ) -> Result<(), ImitationError> {
         self.driver.set_settings(settings)?;
         self.frame_start.copy_from_slice(q);
+        // A hand placed on a support moves with the pelvis: then only the other leg settles.
+        let legs_may_settle = targets.hand_contacts.iter().all(Option::is_none);
         let mut tasks = PhaseTasks {
             model,
             data,
@@ -309,7 +322,7 @@ impl PhaseSolver {
         };
         self.driver.run(&mut self.solver, &mut tasks, q, bounds)?;
         let frame_dt = settings.dt * settings.max_iterations as f64;
-        self.settle_contact(model, data, q, bounds, frame_dt)
+        self.settle_contact(model, data, q, bounds, frame_dt, legs_may_settle)
     }
 
     /// One Newton step of the contact level alone, from its rows at the final `q` (the driver
@@ -319,8 +332,13 @@ impl PhaseSolver {
     /// the contact level to first order only, and on the G1 the lower levels' large steps (a
     /// near-singular hand level) left a standing foot up to 0.19 mm off its place (the NAO's
     /// up to 1.8 µm); after this step the error is second order in that one (G1 under 3 µm,
-    /// NAO 1e-11 m on the bundled clips). The task errors of the frame's report are those
-    /// before this step.
+    /// NAO 1e-11 m on the bundled clips). When a joint of that leg is at a limit and the step
+    /// leaves a residual (a leg of six joints with one clamped cannot place a foot in six
+    /// coordinates), a second step over both legs takes the rest unless a hand is placed on a
+    /// support (`legs_may_settle`: a placed hand moves with the pelvis, and sank 4.5 mm into
+    /// its stool): the pelvis moves by that residual and the foot stays put (the G1's held foot
+    /// had crept 17 µm with its ankle roll at its limit). The task errors of the frame's report are those before
+    /// this step.
     fn settle_contact(
         &mut self,
         model: &Model,
@@ -328,6 +346,7 @@ impl PhaseSolver {
         q: &mut [f64],
         bounds: &JointBounds,
         frame_dt: f64,
+        legs_may_settle: bool,
     ) -> Result<(), ImitationError> {
         let Some(contact) = &mut self.contact else {
             return Ok(());
@@ -336,23 +355,34 @@ impl PhaseSolver {
             .copy_within_reach(bounds, &self.frame_start, frame_dt);
         let stack = self.solver.stack();
         let errors = &stack.stacked_target()[..stack.level_start(1)];
-        let mut level = contact.stack_mut().level_mut(0);
-        for (r, &error) in errors.iter().enumerate() {
-            // The other joints' columns are zero: the least-norm step leaves them where they are
-            // (pinning them instead cost the clamping loop a solve per joint).
-            for ((entry, &row), &movable) in
-                self.row.iter_mut().zip(stack.row(r)).zip(&self.movable)
-            {
-                *entry = if movable { row } else { 0.0 };
+        self.step.fill(0.0);
+        for movable in [&self.movable, &self.legs] {
+            let mut level = contact.stack_mut().level_mut(0);
+            for (r, &error) in errors.iter().enumerate() {
+                // The other joints' columns are zero: the least-norm step leaves them where
+                // they are (pinning them instead cost the clamping loop a solve per joint).
+                // What the steps so far left of the error is this step's target.
+                let mut left = error;
+                for (((entry, &row), &moves), &done) in
+                    (self.row.iter_mut().zip(stack.row(r)).zip(movable)).zip(&self.step)
+                {
+                    *entry = if moves { row } else { 0.0 };
+                    left -= row * done;
+                }
+                level.set_row(r, &self.row, left)?;
             }
-            level.set_row(r, &self.row, error)?;
+            contact.stack_mut().clear_gradient();
+            let solution = contact.solve(q, &self.reach, 1.0)?;
+            for ((qi, total), &d) in q.iter_mut().zip(&mut self.step).zip(solution.velocity) {
+                *qi += d;
+                *total += d;
+            }
+            self.reach.clamp_position(q);
+            let residual = solution.report.levels()[0].residual;
+            if !legs_may_settle || residual <= CONTACT_RESIDUAL {
+                break;
+            }
         }
-        contact.stack_mut().clear_gradient();
-        let step = contact.solve(q, &self.reach, 1.0)?.velocity;
-        for (qi, d) in q.iter_mut().zip(step) {
-            *qi += d;
-        }
-        self.reach.clamp_position(q);
         model.forward_kinematics(data, q)?;
         Ok(())
     }
@@ -371,15 +401,19 @@ fn free_leg(
     profile: &BipedProfile,
     foot: Side,
 ) -> Result<Vec<bool>, ImitationError> {
-    let turns = |frame: &str| -> Result<Vec<bool>, ImitationError> {
-        let mut jacobian = faer::Mat::<f64>::zeros(3, model.nv());
-        model.orientation_jacobian(data, model.frame_id(frame)?, jacobian.as_mut())?;
-        Ok((0..model.nv())
-            .map(|i| (0..3).any(|r| jacobian[(r, i)] != 0.0))
-            .collect())
-    };
-    let (sole, torso) = (turns(&profile.foot(foot).sole)?, turns(&profile.torso)?);
+    let sole = turns(model, data, &profile.foot(foot).sole)?;
+    let torso = turns(model, data, &profile.torso)?;
     Ok(sole.iter().zip(torso).map(|(&s, t)| s && !t).collect())
+}
+
+/// Per joint of `model` (posture in `data`): whether it turns `frame` (its axis shows in the
+/// frame's orientation Jacobian).
+fn turns(model: &Model, data: &ModelData, frame: &str) -> Result<Vec<bool>, ImitationError> {
+    let mut jacobian = faer::Mat::<f64>::zeros(3, model.nv());
+    model.orientation_jacobian(data, model.frame_id(frame)?, jacobian.as_mut())?;
+    Ok((0..model.nv())
+        .map(|i| (0..3).any(|r| jacobian[(r, i)] != 0.0))
+        .collect())
 }
 
 /// The table's constraints as inequality tasks on `model`, the bodies from the profile's
