@@ -264,23 +264,7 @@ fn the_automatic_hold_waits_for_the_robot_to_finish() {
 /// every single-support cell is empty and `clip_support_frames` says why.
 #[test]
 fn empty_metrics_cells_are_null() {
-    use taskstack::batch::metrics_value;
-    use taskstack::human::HumanFrame;
-    use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
-    use taskstack::imitation::metrics::MetricsRecorder;
-    use taskstack::io::clip::Clip;
-    use taskstack::robots::nao;
-
-    let path = mocap(SHORT[0]);
-    let mut clip = Clip::open(&path).unwrap();
-    let mut imitator = Imitator::new(nao::profile(), ImitatorConfig::default()).unwrap();
-    let mut recorder = MetricsRecorder::new(&imitator);
-    let mut human = HumanFrame::new(0.0);
-    while clip.read_frame(&mut human).unwrap() {
-        recorder.record(imitator.step(&human).unwrap());
-    }
-    let m = recorder.finish();
-    let json = metrics_value(&m, &path);
+    let (m, json) = nao_clip_metrics(SHORT[0]);
     assert_eq!(json["clip_support_frames"]["single"], 0);
     assert_eq!(json["clip_support_frames"]["double"], m.clip_frames);
     for effector in ["l_hand", "r_hand", "l_ankle", "r_ankle"] {
@@ -301,31 +285,15 @@ fn empty_metrics_cells_are_null() {
 /// to `clip_frames` and each hand's cells count all of them.
 #[test]
 fn the_hands_are_measured_on_every_clip_frame() {
-    use taskstack::batch::metrics_value;
-    use taskstack::human::HumanFrame;
-    use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
-    use taskstack::imitation::metrics::MetricsRecorder;
-    use taskstack::io::clip::Clip;
-    use taskstack::robots::nao;
-
     // A walk: the robot is in double support and in transition steps during the clip (on the
     // NAO at default speeds it reaches single support only in the hold).
-    let path = mocap("cmu_07_04_slow_walk.bvh");
-    let mut clip = Clip::open(&path).unwrap();
-    let mut imitator = Imitator::new(nao::profile(), ImitatorConfig::default()).unwrap();
-    let mut recorder = MetricsRecorder::new(&imitator);
-    let mut human = HumanFrame::new(0.0);
-    while clip.read_frame(&mut human).unwrap() {
-        recorder.record(imitator.step(&human).unwrap());
-    }
-    let m = recorder.finish();
+    let (m, json) = nao_clip_metrics("cmu_07_04_slow_walk.bvh");
     let kinds = m.clip_support_frames;
     assert!(kinds.double > 0 && kinds.transitions > 0, "{kinds:?}");
     assert_eq!(
         kinds.single + kinds.double + kinds.transitions,
         m.clip_frames
     );
-    let json = metrics_value(&m, &path);
     assert_eq!(
         json["clip_support_frames"]["transitions"],
         kinds.transitions
@@ -338,4 +306,32 @@ fn the_hands_are_measured_on_every_clip_frame() {
             .sum();
         assert_eq!(frames as usize, m.clip_frames, "{hand}: {cells}");
     }
+}
+
+/// The NAO's metrics over the bundled clip `name` at default settings (no hold), and their
+/// `metrics.json` value.
+fn nao_clip_metrics(
+    name: &str,
+) -> (
+    taskstack::imitation::metrics::ImitationMetrics,
+    serde_json::Value,
+) {
+    use taskstack::batch::metrics_value;
+    use taskstack::human::HumanFrame;
+    use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
+    use taskstack::imitation::metrics::MetricsRecorder;
+    use taskstack::io::clip::Clip;
+    use taskstack::robots::nao;
+
+    let path = mocap(name);
+    let mut clip = Clip::open(&path).unwrap();
+    let mut imitator = Imitator::new(nao::profile(), ImitatorConfig::default()).unwrap();
+    let mut recorder = MetricsRecorder::new(&imitator);
+    let mut human = HumanFrame::new(0.0);
+    while clip.read_frame(&mut human).unwrap() {
+        recorder.record(imitator.step(&human).unwrap());
+    }
+    let m = recorder.finish();
+    let json = metrics_value(&m, &path);
+    (m, json)
 }

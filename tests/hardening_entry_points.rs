@@ -350,29 +350,11 @@ fn imitator_config_out_of_range_is_refused_by_name() {
         ("upper_body_velocity_fraction", |c, v| {
             c.upper_body_velocity_fraction = Some(v)
         }),
-        ("com_speed", |c, v| {
-            c.motion.get_or_insert_with(MotionLimits::default).com_speed = v
-        }),
-        ("com_acceleration", |c, v| {
-            c.motion
-                .get_or_insert_with(MotionLimits::default)
-                .com_acceleration = v
-        }),
-        ("foot_speed", |c, v| {
-            c.motion
-                .get_or_insert_with(MotionLimits::default)
-                .foot_speed = v
-        }),
-        ("touchdown_speed", |c, v| {
-            c.motion
-                .get_or_insert_with(MotionLimits::default)
-                .touchdown_speed = v
-        }),
-        ("landing_time", |c, v| {
-            c.motion
-                .get_or_insert_with(MotionLimits::default)
-                .landing_time = v
-        }),
+        ("com_speed", |c, v| motion(c).com_speed = v),
+        ("com_acceleration", |c, v| motion(c).com_acceleration = v),
+        ("foot_speed", |c, v| motion(c).foot_speed = v),
+        ("touchdown_speed", |c, v| motion(c).touchdown_speed = v),
+        ("landing_time", |c, v| motion(c).landing_time = v),
     ];
     // Each setter with each bad value must be refused, naming the field.
     let refused = |name: &str, set: Set, values: &[f64]| {
@@ -503,4 +485,9 @@ fn imitator_treats_non_finite_joint_positions_as_missing() {
         assert_eq!(x.q, y.q);
         assert!(x.q.iter().all(|q| q.is_finite()));
     }
+}
+
+/// The config's motion limits, the defaults put in first when it has none.
+fn motion(c: &mut ImitatorConfig) -> &mut MotionLimits {
+    c.motion.get_or_insert_with(MotionLimits::default)
 }
