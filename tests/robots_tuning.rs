@@ -9,7 +9,7 @@ const TINY: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/tiny_biped/"
 
 #[test]
 fn the_nao_sizes_match_its_dimensions_and_the_stored_constant() {
-    let size = BipedSize::of(&nao::profile()).unwrap();
+    let size = nao::profile().size().unwrap();
     // Aldebaran's NAO H25 V5 dimensions: HipOffsetY = 50 mm; the FSRs of a foot span
     // 29.9 mm + 23.1 mm laterally (left foot, URDF `LFoot/FSR/*`).
     assert_relative_eq!(size.half_stance, 0.050, epsilon = 1e-9);
@@ -36,7 +36,7 @@ fn the_nao_sizes_match_its_dimensions_and_the_stored_constant() {
 #[test]
 fn the_scaling_rules_keep_the_invariants_they_state() {
     let from = nao::SIZE;
-    let to = BipedSize::of(&g1::profile()).unwrap();
+    let to = g1::profile().size().unwrap();
     let (a, b) = (nao::TUNING, nao::TUNING.scaled(&from, &to));
     // The same ZMP–CoM distance a·h/g (cart-table model).
     assert_relative_eq!(
@@ -98,7 +98,7 @@ fn the_scaling_rules_keep_the_invariants_they_state() {
 fn the_rules_give_the_g1_what_was_tuned_on_it_independently() {
     // The G1's hand speed (0.3 m/s) and torso lowering (0.05 m) were tuned on the G1 in the
     // judge before the rules existed (`g1::TUNING`): the rules land within 10 % of both.
-    let rules = nao::TUNING.scaled(&nao::SIZE, &BipedSize::of(&g1::profile()).unwrap());
+    let rules = nao::TUNING.scaled(&nao::SIZE, &g1::profile().size().unwrap());
     assert_relative_eq!(
         rules.tracking_speed,
         g1::TUNING.tracking_speed,
@@ -114,7 +114,7 @@ fn the_rules_give_the_g1_what_was_tuned_on_it_independently() {
 #[test]
 fn a_profile_file_without_tuning_gets_values_for_its_own_size() {
     let profile = BipedProfile::from_toml_file(format!("{TINY}tiny_biped.toml")).unwrap();
-    let size = BipedSize::of(&profile).unwrap();
+    let size = profile.size().unwrap();
     let expected: MotionTuning = nao::TUNING.scaled(&nao::SIZE, &size);
     assert_eq!(profile.tuning, expected);
     assert_ne!(profile.tuning, nao::TUNING, "not the NAO's values");

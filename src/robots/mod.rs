@@ -7,6 +7,7 @@ pub mod nao;
 pub mod profile;
 pub mod profile_toml;
 pub mod self_collision;
+mod size;
 pub mod tuning;
 
 pub use profile::{

@@ -66,7 +66,7 @@ use serde::Deserialize;
 use super::nao;
 use super::profile::{BipedProfile, FootArea, FootFrames, ProfileError, RobotPoint};
 use super::self_collision::SelfCollision;
-use super::tuning::{BipedSize, MotionTuning};
+use super::tuning::MotionTuning;
 use crate::human::{HumanJoint, Side};
 use crate::model::{Model, UrdfError, UrdfFrame, UrdfOptions};
 
@@ -315,7 +315,7 @@ fn build(file: File, urdf: &str) -> Result<BipedProfile, ProfileError> {
         self_collision: SelfCollision::default(),
     };
     profile.validate()?;
-    let scaled = nao::TUNING.scaled(&nao::SIZE, &BipedSize::of(&profile)?);
+    let scaled = nao::TUNING.scaled(&nao::SIZE, &profile.size()?);
     profile.tuning = tuning(file.tuning, scaled);
     profile.validate()?;
     Ok(profile)

@@ -1,6 +1,7 @@
 //! How the imitation moves a biped of a given size: [`MotionTuning`], the size-dependent
 //! numbers, and the rules that carry a tuned robot's numbers to another biped
-//! ([`BipedSize`], [`MotionTuning::scaled`]).
+//! ([`BipedSize`], [`MotionTuning::scaled`]); a profile's sizes come from
+//! [`BipedProfile::size`](super::BipedProfile::size).
 //!
 //! # The scaling rules
 //!
@@ -25,10 +26,6 @@
 //! The rules keep geometric and dynamic similarity; what they cannot see (servo stiffness, the
 //! torque-to-weight ratio) is why a profile may give its own values
 //! ([`crate::robots::g1::TUNING`] says which of the G1's are measured).
-
-use super::profile::{BipedProfile, ProfileError, outline_bounds};
-use crate::human::{HumanJoint, Side};
-use nalgebra::Vector3;
 
 /// How the imitation moves a robot: the size-dependent defaults of the imitator's settings
 /// (`ImitatorConfig`'s `max_task_speed`, `max_tracking_speed`, `upper_body_velocity_fraction`,
@@ -131,12 +128,12 @@ impl MotionTuning {
 }
 
 /// The sizes of a biped that the scaling rules use, read off its profile in the standing
-/// posture (metres, rad/s).
+/// posture ([`BipedProfile::size`](super::BipedProfile::size); metres, rad/s).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BipedSize {
     /// Height of the CoM above the soles (m).
     pub com_height: f64,
-    /// Half the distance between the hip points ([`HumanJoint::LHip`], [`HumanJoint::RHip`]) (m).
+    /// Half the distance between the hip points ([`crate::human::HumanJoint::LHip`] and `RHip`) (m).
     pub half_stance: f64,
     /// Mean height of the hip points above the soles (m).
     pub hip_height: f64,
@@ -148,95 +145,4 @@ pub struct BipedSize {
     /// Mean rated speed of the joints off the sole-to-sole chain (rad/s); the legs' where the
     /// robot has no such joints.
     pub upper_body_speed: f64,
-}
-
-impl BipedSize {
-    /// The sizes of `profile` in its standing posture, in the model rooted at the left sole.
-    ///
-    /// # Errors
-    /// [`ProfileError::Invalid`] when a size is not finite and > 0 (e.g. hip points at one
-    /// place, a massless model); [`ProfileError::Model`] for a frame the model lacks.
-    pub fn of(profile: &BipedProfile) -> Result<Self, ProfileError> {
-        let model = profile.model(Side::Left);
-        let mut data = model.new_data();
-        model.forward_kinematics(&mut data, &profile.stand)?;
-        let frame = |name: &str| -> Result<Vector3<f64>, ProfileError> {
-            Ok(data
-                .frame_placement(model.frame_id(name)?)
-                .translation
-                .vector)
-        };
-        let point = |joint: HumanJoint| -> Result<Option<Vector3<f64>>, ProfileError> {
-            let Some((_, p)) = profile.points.iter().find(|(h, _)| *h == joint) else {
-                return Ok(None);
-            };
-            let frames = p.frames().map(frame).collect::<Result<Vec<_>, _>>()?;
-            Ok(Some(
-                frames.iter().sum::<Vector3<f64>>() / frames.len() as f64,
-            ))
-        };
-        let missing = |joint: HumanJoint| ProfileError::Invalid {
-            field: format!("points.{}", joint.name()),
-            reason: "required".into(),
-        };
-        let hip = |joint| point(joint)?.ok_or_else(|| missing(joint));
-        let (left_hip, right_hip) = (hip(HumanJoint::LHip)?, hip(HumanJoint::RHip)?);
-        let hand = frame(&profile.hands[0])?;
-        let shoulder = match point(HumanJoint::LShoulder)? {
-            Some(p) => p,
-            None => frame(&profile.torso)?,
-        };
-        let widths = Side::BOTH.map(|side| {
-            let [lo, hi] = outline_bounds(&profile.foot(side).outline);
-            hi[1] - lo[1]
-        });
-        let size = BipedSize {
-            com_height: model.com(&data)?.z,
-            half_stance: 0.5 * (left_hip - right_hip).norm(),
-            hip_height: 0.5 * (left_hip.z + right_hip.z),
-            sole_width: 0.5 * (widths[0] + widths[1]),
-            arm_length: (hand - shoulder).norm(),
-            upper_body_speed: upper_body_speed(profile)?,
-        };
-        size.check()
-    }
-
-    /// `self` when every size is finite and > 0.
-    fn check(self) -> Result<Self, ProfileError> {
-        let sizes = [
-            ("com_height", self.com_height),
-            ("half_stance", self.half_stance),
-            ("hip_height", self.hip_height),
-            ("sole_width", self.sole_width),
-            ("arm_length", self.arm_length),
-            ("upper_body_speed", self.upper_body_speed),
-        ];
-        match sizes
-            .into_iter()
-            .find(|(_, v)| !(v.is_finite() && *v > 0.0))
-        {
-            Some((name, v)) => Err(ProfileError::Invalid {
-                field: format!("size.{name}"),
-                reason: format!("{v} read off the standing posture is not finite and > 0"),
-            }),
-            None => Ok(self),
-        }
-    }
-}
-
-/// Mean rated speed (rad/s) of the variables off the sole-to-sole chain, or of all of them
-/// when every variable is on it.
-fn upper_body_speed(profile: &BipedProfile) -> Result<f64, ProfileError> {
-    let chain = profile.sole_chain_variables(&profile.stand)?;
-    let variables = profile.model(Side::Left).variables();
-    let mean = |pick: &dyn Fn(usize) -> bool| {
-        let speeds: Vec<f64> = (0..variables.len())
-            .filter(|&i| pick(i))
-            .map(|i| variables[i].velocity)
-            .collect();
-        (!speeds.is_empty()).then(|| speeds.iter().sum::<f64>() / speeds.len() as f64)
-    };
-    Ok(mean(&|i| !chain[i])
-        .or_else(|| mean(&|_| true))
-        .unwrap_or(0.0))
 }

@@ -314,7 +314,7 @@ pub const TUNING: MotionTuning = MotionTuning {
     offset_acceleration: 6.0,
 };
 
-/// The NAO's sizes ([`BipedSize::of`] its profile, rounded to 0.1 mm and 0.01 rad/s; a test
+/// The NAO's sizes ([`BipedProfile::size`] of its profile, rounded to 0.1 mm and 0.01 rad/s; a test
 /// recomputes them): what the scaling rules scale from.
 pub const SIZE: BipedSize = BipedSize {
     com_height: 0.2725,
