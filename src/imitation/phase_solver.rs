@@ -337,8 +337,8 @@ impl PhaseSolver {
     /// coordinates), a second step over both legs takes the rest unless a hand is placed on a
     /// support (`legs_may_settle`: a placed hand moves with the pelvis, and sank 4.5 mm into
     /// its stool): the pelvis moves by that residual and the foot stays put (the G1's held foot
-    /// had crept 17 µm with its ankle roll at its limit). The task errors of the frame's report are those before
-    /// this step.
+    /// had crept 17 µm with its ankle roll at its limit). The task errors of the frame's report
+    /// are those before this step.
     fn settle_contact(
         &mut self,
         model: &Model,

@@ -133,7 +133,8 @@ impl MotionTuning {
 pub struct BipedSize {
     /// Height of the CoM above the soles (m).
     pub com_height: f64,
-    /// Half the distance between the hip points ([`crate::human::HumanJoint::LHip`] and `RHip`) (m).
+    /// Half the distance between the hip points ([`crate::human::HumanJoint::LHip`] and
+    /// `RHip`) (m).
     pub half_stance: f64,
     /// Mean height of the hip points above the soles (m).
     pub hip_height: f64,
