@@ -109,8 +109,9 @@ pub(super) struct PhaseSolver {
     /// them (moved by the whole body's least-norm step, a hand resting on a stool sank 4 mm
     /// into it, and a CoM came 1.4 mm nearer the edge of the support).
     movable: Vec<bool>,
-    /// The joints that turn the other sole (both legs): a second contact step may move them
-    /// when the other leg alone cannot finish (a joint of it at a limit).
+    /// The joints between the two soles (both legs,
+    /// [`BipedProfile::sole_chain_variables`]): a second contact step may move them when the
+    /// other leg alone cannot finish (a joint of it at a limit).
     legs: Vec<bool>,
     /// A contact row with only the movable joints' entries.
     row: Vec<f64>,
@@ -211,7 +212,7 @@ impl PhaseSolver {
             frame_start: vec![0.0; model.nv()],
             reach: JointBounds::unbounded(model.nv()),
             movable: free_leg(model, &initial, profile, table.model_root.other())?,
-            legs: turns(model, &initial, &other.sole)?,
+            legs: profile.sole_chain_variables(initial_q)?,
             row: vec![0.0; model.nv()],
             step: vec![0.0; model.nv()],
             other_ankle: model.frame_id(&other.ankle)?,
@@ -401,19 +402,15 @@ fn free_leg(
     profile: &BipedProfile,
     foot: Side,
 ) -> Result<Vec<bool>, ImitationError> {
-    let sole = turns(model, data, &profile.foot(foot).sole)?;
-    let torso = turns(model, data, &profile.torso)?;
+    let turns = |frame: &str| -> Result<Vec<bool>, ImitationError> {
+        let mut jacobian = faer::Mat::<f64>::zeros(3, model.nv());
+        model.orientation_jacobian(data, model.frame_id(frame)?, jacobian.as_mut())?;
+        Ok((0..model.nv())
+            .map(|i| (0..3).any(|r| jacobian[(r, i)] != 0.0))
+            .collect())
+    };
+    let (sole, torso) = (turns(&profile.foot(foot).sole)?, turns(&profile.torso)?);
     Ok(sole.iter().zip(torso).map(|(&s, t)| s && !t).collect())
-}
-
-/// Per joint of `model` (posture in `data`): whether it turns `frame` (its axis shows in the
-/// frame's orientation Jacobian).
-fn turns(model: &Model, data: &ModelData, frame: &str) -> Result<Vec<bool>, ImitationError> {
-    let mut jacobian = faer::Mat::<f64>::zeros(3, model.nv());
-    model.orientation_jacobian(data, model.frame_id(frame)?, jacobian.as_mut())?;
-    Ok((0..model.nv())
-        .map(|i| (0..3).any(|r| jacobian[(r, i)] != 0.0))
-        .collect())
 }
 
 /// The table's constraints as inequality tasks on `model`, the bodies from the profile's
