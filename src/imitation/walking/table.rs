@@ -11,8 +11,11 @@ use crate::robots::BipedProfile;
 /// The walking table of the model rooted at `root` (the stance sole; the sole that last stood
 /// alone while both stand), highest priority first:
 ///
-/// 1. **foot**: the other sole's position and orientation as the walk plans them (on the floor,
-///    or on its swing path), 6 rows: a sole on the floor does not move;
+/// 1. **contact**: the other sole's position and orientation as the walk plans them (on the
+///    floor, or on its swing path), 6 rows: a sole on the floor does not move. Named as the
+///    support phases' contact level, so that a contact-only Newton step ends every frame as it
+///    does there (two Gauss–Newton iterations alone left a standing sole up to 1.5e-5 m off;
+///    with the step, under 1e-9 m on the bundled clips);
 /// 2. **balance**: the CoM's ground point on the generator's CoM;
 /// 3. **torso**: the torso's tilt, leaning over the stance hip as the walk plans;
 /// 4. **height**: the CoM at the cart-table's height.
@@ -42,7 +45,7 @@ pub fn walking_table(root: Side, profile: &BipedProfile) -> TaskTable {
     };
     let level = Level::of_tasks;
     let mut levels = vec![level(
-        "foot",
+        "contact",
         vec![
             point(free_sole, Axes::XYZ, PointTarget::Planned),
             Task::Orientation {
