@@ -55,12 +55,13 @@ pub struct FootstepConfig {
     /// passes the physics judge on 28 of the 32 walking runs of the bundled clips, the others
     /// by a loaded foot turning a little over 2°: not yet the default.
     pub follow: bool,
-    /// With `follow`, walk with the pattern generator ([`super::walking`]): dynamic steps of
-    /// the profile's timing (NAO: 0.5 s double + 0.5 s single support) instead of quasi-static
-    /// ones (the CoM moved over the stance foot before each lift). Off by default: **not yet
-    /// physically executable** — on the bundled clips the judge's NAO passes 12 of 16 runs and
-    /// never falls, but on the walks its CoM leaves the real contact area up to 3.4 % of the
-    /// time (1 % allowed), and the arms hold still while the robot walks (see the changelog).
+    /// With `follow`, walk with the pattern generator ([`super::walking`]): dynamic steps
+    /// (NAO: 1.0 s double + 0.67 s single support while following the human) instead of
+    /// quasi-static ones (the CoM moved over the stance foot before each lift). Off by
+    /// default: the judge's NAO passes every bundled clip with a 60 s hold (both models, online
+    /// and offline), but the steps are slow (about 0.02 m/s), the arms hold still while the
+    /// robot walks, a pivot turn is not followed, and the G1 falls at its first steps (see
+    /// the changelog and [`super::walking`]).
     pub dynamic: bool,
     /// A foot farther than this from its target (m) is moved by a step. Default 0.02.
     pub distance: f64,
