@@ -17,9 +17,10 @@ use taskstack::human::{HumanJoint, Side};
 use taskstack::imitation::metrics::CONTACT_HEIGHT;
 use taskstack::imitation::phase::SupportPhase;
 use taskstack::imitation::support::HumanSupport;
+use taskstack::locomotion::Footstep;
 use taskstack::model::{FrameId, Model, ModelData};
 use taskstack::robots::BipedProfile;
-use taskstack::{IsometryMatrix3, RobotFrame, Vector3};
+use taskstack::{IsometryMatrix3, RobotFrame, Vector2, Vector3};
 
 use crate::Report;
 
@@ -96,7 +97,9 @@ impl<W: Write> ViewWriter<W> {
 
     /// Adds robot frame `r` if it is due at [`VIEW_RATE`]. Each frame is
     /// `[time ms, phase, human support, robot points, human points, left sole, right sole,
-    /// CoM xy, grounded bits]`, lengths in mm in the world frame.
+    /// CoM xy, grounded bits, planned ZMP xy or null, footsteps]`, lengths in mm in the world
+    /// frame; each footstep is `[side (0 left, 1 right), corner x, y, …]`, its sole outline
+    /// where it lands.
     pub(crate) fn frame(&mut self, r: &RobotFrame) -> Result<()> {
         let reference = (r.reference.iter())
             .map(|p| p.map(|p| r.world_t_root.transform_point(&p.into()).coords));
@@ -107,6 +110,8 @@ impl<W: Write> ViewWriter<W> {
             q: &r.q,
             soles: [&r.left_sole, &r.right_sole],
             com: r.com,
+            zmp: r.walk.map(|w| w.zmp),
+            footsteps: &r.footsteps,
         };
         self.frame_of(&frame, reference)
     }
@@ -167,11 +172,22 @@ impl<W: Write> ViewWriter<W> {
             line.push(']');
             grounded |= u8::from(on_ground) << i;
         }
-        line.push_str(&format!(
-            ",[{},{}],{grounded}],\n",
-            mm(r.com.x),
-            mm(r.com.y)
-        ));
+        line.push_str(&format!(",[{},{}],{grounded},", mm(r.com.x), mm(r.com.y)));
+        match r.zmp {
+            Some(zmp) => line.push_str(&format!("[{},{}]", mm(zmp.x), mm(zmp.y))),
+            None => line.push_str("null"),
+        }
+        line.push_str(",[");
+        for (k, step) in r.footsteps.iter().enumerate() {
+            line.push_str(if k == 0 { "[" } else { ",[" });
+            line.push_str(&step.side.index().to_string());
+            for &[x, y] in &self.outlines[step.side.index()] {
+                let corner = step.target.to_world([x, y]);
+                line.push_str(&format!(",{},{}", mm(corner.x), mm(corner.y)));
+            }
+            line.push(']');
+        }
+        line.push_str("]],\n");
         self.out.write_all(line.as_bytes())?;
         self.written += 1;
         Ok(())
@@ -208,6 +224,10 @@ pub(crate) struct ViewFrame<'a> {
     pub(crate) soles: [&'a IsometryMatrix3<f64>; 2],
     /// Whole-body CoM (m, world).
     pub(crate) com: Vector3<f64>,
+    /// The walk's planned ZMP (m, world; cart-table model) while the robot walks.
+    pub(crate) zmp: Option<Vector2<f64>>,
+    /// The walk's footsteps not yet landed (world).
+    pub(crate) footsteps: &'a [Footstep],
 }
 
 /// What is drawn of the robot: the link origins and named frames whose world positions each

@@ -15,8 +15,8 @@ use taskstack::imitation::phase::SupportPhase;
 use taskstack::imitation::support::HumanSupport;
 use taskstack::locomotion::footstep::wrap_angle;
 use taskstack::locomotion::{
-    GroundPose, Support, SupportPolygon, WalkParams, WalkerFrame, WholeBodyWalker, goal_feet,
-    plan_steps,
+    Footstep, GroundPose, Support, SupportPolygon, WalkParams, WalkerFrame, WholeBodyWalker,
+    goal_feet, plan_steps,
 };
 use taskstack::nalgebra::Translation3;
 use taskstack::robots::BipedProfile;
@@ -99,7 +99,10 @@ pub(crate) fn run(args: WalkArgs, report: Report) -> Result<ExitCode> {
             walker.push(*step)?;
         }
         let frame = *walker.tick()?;
-        recorder.record(&frame, walker.q())?;
+        let footsteps: Vec<Footstep> = (walker.generator().queued_steps())
+            .map(|(_, _, step)| *step)
+            .collect();
+        recorder.record(&frame, walker.q(), &footsteps)?;
         let time = frame.walk.time;
         if walker.generator().is_stopped() && pending.len() == 0 && stopped_at.is_none() {
             stopped_at = Some(time);
@@ -176,8 +179,8 @@ impl Recorder {
         })
     }
 
-    /// One tick: the joints `q` (rad) that realise `frame`.
-    fn record(&mut self, frame: &WalkerFrame, q: &[f64]) -> Result<()> {
+    /// One tick: the joints `q` (rad) that realise `frame`, the `footsteps` not yet landed.
+    fn record(&mut self, frame: &WalkerFrame, q: &[f64], footsteps: &[Footstep]) -> Result<()> {
         let w = &frame.walk;
         let [left, right] = w.feet.map(|f| f.position);
         let _ = writeln!(
@@ -207,6 +210,8 @@ impl Recorder {
             q,
             soles: [&soles[0], &soles[1]],
             com: w.com,
+            zmp: Some(w.zmp),
+            footsteps,
         };
         self.view
             .frame_of(&view, std::iter::repeat_n(None, HumanJoint::COUNT))

@@ -8,7 +8,7 @@ mod common;
 use std::path::PathBuf;
 use std::process::Command;
 
-use common::{imitated_kinect, s, temp_dir};
+use common::{imitated_kinect, s, taskstack, temp_dir};
 use serde_json::Value;
 
 /// The first browser found: `TASKSTACK_BROWSER`, else chromium, chromium-browser, google-chrome.
@@ -86,6 +86,44 @@ fn the_viewer_draws_and_plays_in_a_headless_browser() {
     );
     let first = |r: &Value| r["drawn"][0].as_f64().unwrap();
     assert!(first(&with_sim) > first(&report), "{with_sim} vs {report}");
+}
+
+/// A walk's page draws the walk's plan too: its frames carry the planned ZMP and the soles of
+/// the steps not yet landed, and the page runs clean and draws more than with the plan taken
+/// out of its frames.
+#[test]
+fn the_viewer_draws_the_walk_plan() {
+    let Some(browser) = browser() else {
+        assert!(std::env::var_os("TASKSTACK_REQUIRE_BROWSER").is_none());
+        eprintln!("viewer test skipped: no browser");
+        return;
+    };
+    let dir = temp_dir("viewer-walk");
+    let out = dir.join("walk");
+    let run = taskstack(&["-q", "walk", "--forward", "0.1", "--out", s(&out)]);
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    let page = out.join("view.html").canonicalize().unwrap();
+    let text = std::fs::read_to_string(&page).unwrap();
+    // A frame with a step queued ends `…,grounded,[zmp x,zmp y],[[side,x,y,…]]],`.
+    let planned = text.lines().filter(|l| l.ends_with("]]],")).count();
+    assert!(planned > 50, "{planned} frames with a footstep");
+    let report = selftest(&browser, &page);
+    assert_eq!(report["errors"], Value::Array(vec![]), "{report}");
+    // The same frames without the plan (every frame's last two entries emptied).
+    let stripped: String = (text.lines())
+        .map(|l| match (l.starts_with('['), l.rfind("],[[")) {
+            (true, Some(cut)) => {
+                let zmp = l[..cut].rfind(",[").unwrap();
+                format!("{},null,[]],\n", &l[..zmp])
+            }
+            _ => format!("{l}\n"),
+        })
+        .collect();
+    std::fs::write(&page, stripped).unwrap();
+    let without = selftest(&browser, &page);
+    assert_eq!(without["errors"], Value::Array(vec![]), "{without}");
+    let first = |r: &Value| r["drawn"][0].as_f64().unwrap();
+    assert!(first(&report) > first(&without), "{report} vs {without}");
 }
 
 /// Loads `page` with `#selftest` in the headless `browser` and returns the page's report; the

@@ -5,8 +5,9 @@ use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 use super::hand_support::HandPlacement;
 use super::phase::SupportPhase;
 use super::support::HumanSupport;
+use super::walking::follower::QUEUE_AHEAD;
 use crate::human::{HumanJoint, Side};
-use crate::locomotion::WalkState;
+use crate::locomotion::{Footstep, WalkState};
 use crate::robots::BipedProfile;
 use crate::solver::driver::{DriverReport, StopReason};
 use crate::solver::{LevelReport, SolveReport};
@@ -94,6 +95,9 @@ pub struct RobotFrame {
     /// The walking pattern generator's state while the robot walks ([`super::walking`]):
     /// the planned CoM, ZMP and soles (world frame); `None` while it stands.
     pub walk: Option<WalkState>,
+    /// The walk's footsteps not yet landed, the one under way first (world frame); empty while
+    /// the robot stands.
+    pub footsteps: Vec<Footstep>,
 }
 
 impl RobotFrame {
@@ -149,6 +153,7 @@ impl RobotFrame {
             effectors: [Vector3::zeros(); 4],
             pending_steps: 0,
             walk: None,
+            footsteps: Vec::with_capacity(QUEUE_AHEAD),
         }
     }
 

@@ -316,6 +316,7 @@ impl PoubelImitator {
         self.measure(phase, changed, goal_distance, dt);
         self.write_output(frame, human, phase)?;
         self.shared.output.walk = None;
+        self.shared.output.footsteps.clear();
         self.phase = phase;
         Ok(())
     }
@@ -404,6 +405,11 @@ impl PoubelImitator {
             walk.phase()
         };
         let state = (!over).then(|| *walk.state());
+        let footsteps = &mut self.shared.output.footsteps;
+        footsteps.clear();
+        if !over {
+            footsteps.extend(walk.queued_steps());
+        }
         self.write_output(frame, human, phase)?;
         self.shared.output.walk = state;
         self.phase = phase;

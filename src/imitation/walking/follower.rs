@@ -22,7 +22,7 @@ use crate::solver::{JointBounds, Settings};
 /// Steps queued ahead of the robot: the generator previews about one and a half steps, so two
 /// queued steps are all it looks at; more would commit the robot to footprints the human may
 /// still change.
-const QUEUE_AHEAD: usize = 2;
+pub(in crate::imitation) const QUEUE_AHEAD: usize = 2;
 
 /// Most solver iterations per frame: the walk's references move smoothly, so a few Gauss–Newton
 /// steps meet the feet and the CoM to the solver's precision.
@@ -146,6 +146,11 @@ impl WalkFollower {
             half_span: 0.0,
             stance_width,
         })
+    }
+
+    /// The footsteps not yet landed, the one under way first (world frame).
+    pub(in crate::imitation) fn queued_steps(&self) -> impl Iterator<Item = Footstep> + '_ {
+        self.generator.queued_steps().map(|(_, _, step)| *step)
     }
 
     /// Whether the robot is walking.
