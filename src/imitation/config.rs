@@ -78,10 +78,14 @@ pub struct ImitatorConfig {
     /// the scaled human ([`PointTarget::Scaled`](super::tables::PointTarget::Scaled), the hands
     /// in the default tables), in place of `max_task_speed`, so that the arms can follow the
     /// human more closely while the CoM, the torso and the feet keep their slow, shaped
-    /// references (the joint velocity bounds still limit the arms). `None` (default): the
-    /// profile's [`MotionTuning::tracking_speed`](crate::robots::MotionTuning::tracking_speed) (0.15 m/s for the NAO: at 0.5 m/s its hands'
-    /// mean errors on the bundled clips drop by a third to a half, but the arms' reaction on the
-    /// body then topples the weak-servo model of the physics judge on one walk).
+    /// references (the joint velocity bounds still limit the arms). `Some`: this speed in every
+    /// phase. `None` (default): the profile's
+    /// [`MotionTuning::tracking_speed`](crate::robots::MotionTuning::tracking_speed) in double
+    /// support and its
+    /// [`stance_tracking_speed`](crate::robots::MotionTuning::stance_tracking_speed) on one foot
+    /// and in the transition steps (NAO 0.45 and 0.15 m/s; faster hands turned loaded feet in
+    /// the physics judge, see [`crate::robots::nao::TUNING`]); Koenemann's method uses the
+    /// latter throughout.
     pub max_tracking_speed: Option<f64>,
     /// When and where the robot steps: the human's footprints, scaled, clipped to the step
     /// envelope, taken one step at a time (see [`super::footsteps`]).

@@ -31,7 +31,7 @@ use super::footsteps::{FootstepPlanner, GroundPose, StepRequest};
 use super::hand_support::{HandSupports, HandView, hand_point};
 use super::imitator::{Shared, effector_ids, ground_pose, human_stance, velocity_bounds};
 use super::metrics::CONTACT_HEIGHT;
-use super::phase::{Measurements, PhaseMachine, Settling, SupportPhase, TakeOff};
+use super::phase::{Measurements, PhaseMachine, Settling, SupportKind, SupportPhase, TakeOff};
 use super::phase_solver::{Criteria, FrameTargets, PhaseSolver};
 use super::scaler::{RobotSkeleton, ScaleConfig, Scaler};
 use super::shaping::{ComReference, MotionLimits, SwingHeight};
@@ -61,7 +61,10 @@ pub(crate) struct PoubelImitator {
     machine: PhaseMachine,
     iterations: usize,
     max_task_speed: f64,
+    /// Largest speed of the hand targets in double support (m/s).
     max_tracking_speed: f64,
+    /// ... in single support and the transition steps (m/s).
+    stance_tracking_speed: f64,
     limits: JointLimitAvoidance,
     tracking: JointTracking,
     human_q: Vec<f64>,
@@ -207,6 +210,8 @@ impl PoubelImitator {
             iterations: config.iterations_per_frame,
             max_task_speed: config.max_task_speed.unwrap_or(tuning.task_speed),
             max_tracking_speed: config.max_tracking_speed.unwrap_or(tuning.tracking_speed),
+            stance_tracking_speed: (config.max_tracking_speed)
+                .unwrap_or(tuning.stance_tracking_speed),
             phases,
             effectors,
             phase: SupportPhase::Double,
@@ -416,6 +421,16 @@ impl PoubelImitator {
         Ok(())
     }
 
+    /// The hands' largest speed in `phase` (m/s): slower on one foot and while the weight
+    /// shifts, where the arms' reaction costs more balance
+    /// ([`MotionTuning::stance_tracking_speed`](crate::robots::MotionTuning::stance_tracking_speed)).
+    fn tracking_speed(&self, phase: SupportPhase) -> f64 {
+        match phase.kind() {
+            SupportKind::Double => self.max_tracking_speed,
+            SupportKind::Single | SupportKind::Transition => self.stance_tracking_speed,
+        }
+    }
+
     /// Scales the human frame into the root frame (`output.reference`) and sets the
     /// joint-tracking reference from its joint angles, the legs at their standing posture.
     fn scale(&mut self, frame: &HumanFrame, human: HumanSupport) -> Result<(), ImitationError> {
@@ -484,7 +499,7 @@ impl PoubelImitator {
             com: com_target,
             swing_lift: self.swing.height(),
             footstep: self.footstep_in_root(),
-            tracking_step: self.max_tracking_speed * step_dt,
+            tracking_step: self.tracking_speed(phase) * step_dt,
             hand_contacts: self.hand_contacts(),
             up: Vector3::z(),
             com_height: 0.0,

@@ -142,6 +142,7 @@ pub const STAND: [f64; 29] = [
 pub const TUNING: MotionTuning = MotionTuning {
     task_speed: 0.15,
     tracking_speed: 0.3,
+    stance_tracking_speed: 0.3,
     upper_body_velocity_fraction: 0.1,
     torso_lowering: 0.05,
     torso_lean: 0.25,

@@ -42,7 +42,8 @@
 //! [tuning]                           # optional, each field too (default: the NAO's values
 //!                                    # scaled to this robot's size, crate::robots::tuning)
 //! task_speed = 0.15                  # m/s
-//! tracking_speed = 0.15              # m/s, the hands
+//! tracking_speed = 0.45              # m/s, the hands in double support
+//! stance_tracking_speed = 0.15       # m/s, the hands on one foot and while the weight shifts
 //! upper_body_velocity_fraction = 0.5
 //! torso_lowering = 0.02              # m, the torso below its standing height
 //! torso_lean = 0.25                  # rad, over the stance foot
@@ -95,6 +96,7 @@ struct File {
 struct Tuning {
     task_speed: Option<f64>,
     tracking_speed: Option<f64>,
+    stance_tracking_speed: Option<f64>,
     upper_body_velocity_fraction: Option<f64>,
     torso_lowering: Option<f64>,
     torso_lean: Option<f64>,
@@ -327,6 +329,7 @@ fn tuning(file: Option<Tuning>, scaled: MotionTuning) -> MotionTuning {
     MotionTuning {
         task_speed: t.task_speed.unwrap_or(scaled.task_speed),
         tracking_speed: t.tracking_speed.unwrap_or(scaled.tracking_speed),
+        stance_tracking_speed: (t.stance_tracking_speed).unwrap_or(scaled.stance_tracking_speed),
         upper_body_velocity_fraction: (t.upper_body_velocity_fraction)
             .unwrap_or(scaled.upper_body_velocity_fraction),
         torso_lowering: t.torso_lowering.unwrap_or(scaled.torso_lowering),

@@ -20,7 +20,7 @@
 //! | `torso_lean` | `× atan(w'/h') / atan(w/h)` | the same multiple of the angle under which the stance hip is seen from the CoM |
 //! | `support_margin` | `× s'/s` | the same fraction of the sole's width |
 //! | `torso_lowering` | `× l'/l` | the same fraction of the leg |
-//! | `tracking_speed` | `× a'/a` | the hands cover the same fraction of the arm per second |
+//! | `tracking_speed`, `stance_tracking_speed` | `× a'/a` | the hands cover the same fraction of the arm per second |
 //! | `upper_body_velocity_fraction` | `× ω/ω'`, at most its value | the same joint speeds (rad/s) on faster motors |
 //!
 //! The rules keep geometric and dynamic similarity; what they cannot see (servo stiffness, the
@@ -35,8 +35,13 @@ pub struct MotionTuning {
     /// Largest speed a task asks for (m/s): each frame a task's error is clipped to this times
     /// the time step, so the velocity limits are rarely hit.
     pub task_speed: f64,
-    /// Largest speed the tasks that follow the human (the hands) ask for (m/s).
+    /// Largest speed the tasks that follow the human (the hands) ask for in double support
+    /// (m/s).
     pub tracking_speed: f64,
+    /// The same in single support and in the transition steps (m/s): standing on one foot, or
+    /// shifting the weight between the feet, the robot has less support to take the arms'
+    /// reaction, so the hands may be held slower there.
+    pub stance_tracking_speed: f64,
     /// Fraction of the rated velocity of every joint off the sole-to-sole chain (arms, head);
     /// the legs keep the imitator's `velocity_fraction`.
     pub upper_body_velocity_fraction: f64,
@@ -75,6 +80,7 @@ impl MotionTuning {
         let positive = [
             ("task_speed", self.task_speed),
             ("tracking_speed", self.tracking_speed),
+            ("stance_tracking_speed", self.stance_tracking_speed),
             (
                 "upper_body_velocity_fraction",
                 self.upper_body_velocity_fraction,
@@ -111,6 +117,7 @@ impl MotionTuning {
         MotionTuning {
             task_speed: self.task_speed * froude,
             tracking_speed: self.tracking_speed * to.arm_length / from.arm_length,
+            stance_tracking_speed: self.stance_tracking_speed * to.arm_length / from.arm_length,
             upper_body_velocity_fraction: (self.upper_body_velocity_fraction
                 * from.upper_body_speed
                 / to.upper_body_speed)

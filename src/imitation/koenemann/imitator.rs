@@ -325,7 +325,9 @@ impl KoenemannImitator {
         let hold = shared.output.left_sole;
         Ok(KoenemannImitator {
             detector: SupportDetector::new(config.support)?,
-            tracking_speed: config.max_tracking_speed.unwrap_or(tuning.tracking_speed),
+            // One speed in every support state: the one judged safe on one foot (the faster
+            // double-support speed of the profile was measured with Poubel's tables only).
+            tracking_speed: (config.max_tracking_speed).unwrap_or(tuning.stance_tracking_speed),
             foot_speed: config.max_task_speed.unwrap_or(tuning.task_speed),
             motion: config.motion_for(&tuning),
             step_envelope: config.step_envelope.unwrap_or(profile.step_envelope),
