@@ -84,8 +84,8 @@ pub struct ImitatorConfig {
     /// support and its
     /// [`stance_tracking_speed`](crate::robots::MotionTuning::stance_tracking_speed) on one foot
     /// and in the transition steps (NAO 0.45 and 0.15 m/s; faster hands turned loaded feet in
-    /// the physics judge, see [`crate::robots::nao::TUNING`]); Koenemann's method uses the
-    /// latter throughout.
+    /// the physics judge, see [`crate::robots::nao::TUNING`]); Koenemann's method, and Poubel's
+    /// with the dynamic walk on ([`FootstepConfig::dynamic`]), use the latter throughout.
     pub max_tracking_speed: Option<f64>,
     /// When and where the robot steps: the human's footprints, scaled, clipped to the step
     /// envelope, taken one step at a time (see [`super::footsteps`]).
