@@ -310,7 +310,7 @@ fn the_hands_are_measured_on_every_clip_frame() {
 
 /// The hands follow the Kinect gestures closely and on time at default settings (issue 31): the
 /// NAO's mean hand error over every clip frame under 6 cm and the lag that best aligns its hands
-/// with the scaled human's at most 0.2 s. With hand targets at 0.15 m/s in double support
+/// with the scaled human's at most 0.2 s. With hand targets at 0.15 m/s while both feet stand
 /// (before) the NAO was 9.6 / 8.9 cm off and 0.47 / 0.40 s late on these clips.
 #[test]
 fn the_hands_follow_the_kinect_gestures_on_time() {

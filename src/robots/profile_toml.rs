@@ -42,7 +42,7 @@
 //! [tuning]                           # optional, each field too (default: the NAO's values
 //!                                    # scaled to this robot's size, crate::robots::tuning)
 //! task_speed = 0.15                  # m/s
-//! tracking_speed = 0.45              # m/s, the hands in double support
+//! tracking_speed = 0.45              # m/s, the hands while both feet stand (settled)
 //! stance_tracking_speed = 0.15       # m/s, the hands on one foot and while the weight shifts
 //! upper_body_velocity_fraction = 0.5
 //! torso_lowering = 0.02              # m, the torso below its standing height

@@ -35,8 +35,8 @@ pub struct MotionTuning {
     /// Largest speed a task asks for (m/s): each frame a task's error is clipped to this times
     /// the time step, so the velocity limits are rarely hit.
     pub task_speed: f64,
-    /// Largest speed the tasks that follow the human (the hands) ask for in double support
-    /// (m/s).
+    /// Largest speed the tasks that follow the human (the hands) ask for in double support,
+    /// once the human has stood on both feet for a second (m/s).
     pub tracking_speed: f64,
     /// The same in single support and in the transition steps (m/s): standing on one foot, or
     /// shifting the weight between the feet, the robot has less support to take the arms'
