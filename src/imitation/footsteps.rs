@@ -322,6 +322,11 @@ impl FootstepPlanner {
         aims
     }
 
+    /// How long the human has stood on both feet (s; 0 while a foot is up).
+    pub(crate) fn double_support_time(&self) -> f64 {
+        self.down_for[0].min(self.down_for[1])
+    }
+
     /// Whether the planner is idle: no step of its own under way.
     pub(crate) fn is_idle(&self) -> bool {
         self.step == Step::Idle

@@ -72,8 +72,6 @@ pub(crate) struct PoubelImitator {
     max_tracking_speed: f64,
     /// ... in single support and the transition steps (m/s).
     stance_tracking_speed: f64,
-    /// How long the human has stood on both feet (s).
-    human_double_for: f64,
     limits: JointLimitAvoidance,
     tracking: JointTracking,
     human_q: Vec<f64>,
@@ -227,7 +225,6 @@ impl PoubelImitator {
             }),
             stance_tracking_speed: (config.max_tracking_speed)
                 .unwrap_or(tuning.stance_tracking_speed),
-            human_double_for: 0.0,
             phases,
             effectors,
             phase: SupportPhase::Double,
@@ -323,10 +320,6 @@ impl PoubelImitator {
         dt: f64,
     ) -> Result<(), ImitationError> {
         let phase = (self.machine).update_gated(wanted.support, wanted.lift, &self.measurements);
-        self.human_double_for = match human {
-            HumanSupport::Double => self.human_double_for + dt,
-            _ => 0.0,
-        };
         let changed = phase != self.phase || self.shared.previous_time.is_none() || self.rehold;
         self.rehold = false;
         self.shared
@@ -447,11 +440,10 @@ impl PoubelImitator {
     /// has just put a foot down may step again
     /// ([`MotionTuning::stance_tracking_speed`](crate::robots::MotionTuning::stance_tracking_speed)).
     fn tracking_speed(&self, phase: SupportPhase) -> f64 {
-        let settled = self.human_double_for >= SETTLED_DOUBLE_SUPPORT;
-        match phase.kind() {
-            SupportKind::Double if settled => self.max_tracking_speed,
-            SupportKind::Double => self.stance_tracking_speed,
-            SupportKind::Single | SupportKind::Transition => self.stance_tracking_speed,
+        let settled = self.footsteps.double_support_time() >= SETTLED_DOUBLE_SUPPORT;
+        match phase.kind() == SupportKind::Double && settled {
+            true => self.max_tracking_speed,
+            false => self.stance_tracking_speed,
         }
     }
 
