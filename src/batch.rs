@@ -678,6 +678,15 @@ pub fn metrics_value(m: &ImitationMetrics, clip: &Path) -> Value {
         },
         "tracking_error_clip_lag_removed": effector_map(&m.hands_clip_lag_removed),
         "hand_lag_s": m.hand_lag_s,
+        "hand_reach": m.hand_reach.map(|arms| {
+            let arm = |r: &crate::imitation::reach::HandReach| json!({
+                "reach_m": r.reach_m,
+                "frames": r.frames,
+                "unreachable_frames": r.unreachable_frames,
+                "shortfall_m": { "mean": r.mean_shortfall_m, "max": r.max_shortfall_m },
+            });
+            json!({ "l_hand": arm(&arms[0]), "r_hand": arm(&arms[1]) })
+        }),
         "travel": {
             "scaled_human_m": m.travel.scaled_human_m,
             "robot_m": m.travel.robot_m,

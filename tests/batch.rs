@@ -329,6 +329,47 @@ fn the_hands_follow_the_kinect_gestures_on_time() {
     }
 }
 
+/// The report tells hand references beyond the arm's reach from lateness (issue 31 item 3). The
+/// NAO's arm, shoulder → elbow → wrist → hand, from Aldebaran's documented link offsets (mm):
+/// √(105² + 15²) + 55.95 + √(57.75² + 12.31²) = 106.07 + 55.95 + 59.05 = 221.07. A hand the
+/// arm cannot bring within its reach of the reference is off by at least the shortfall on that
+/// frame, so over the clip the hand's errors add up to at least the shortfalls.
+#[test]
+fn the_report_counts_hand_references_beyond_the_arms_reach() {
+    let (m, json) = nao_clip_metrics(SHORT[0]);
+    let reach = m.hand_reach.expect("the NAO maps shoulders and hands");
+    for arm in &reach {
+        assert!(
+            (arm.reach_m - 0.22107).abs() < 1e-4,
+            "arm {} m",
+            arm.reach_m
+        );
+        assert_eq!(arm.frames, m.clip_frames);
+    }
+    let waving = &reach[1];
+    assert!(
+        waving.unreachable_frames > 0,
+        "the waving hand reaches over the head"
+    );
+    let shortfall = waving.mean_shortfall_m.unwrap() * waving.unreachable_frames as f64;
+    let hand = m
+        .effectors_clip
+        .iter()
+        .find(|e| e.name == "r_hand")
+        .unwrap();
+    let errors: f64 = [hand.single_support, hand.double_support, hand.transitions]
+        .iter()
+        .map(|c| c.mean * c.count as f64)
+        .sum();
+    assert!(
+        errors >= shortfall,
+        "errors {errors} m < shortfalls {shortfall} m"
+    );
+    let cell = &json["hand_reach"]["r_hand"];
+    assert_eq!(cell["unreachable_frames"], waving.unreachable_frames);
+    assert!(cell["shortfall_m"]["max"].as_f64().unwrap() >= waving.mean_shortfall_m.unwrap());
+}
+
 /// The NAO's metrics over the bundled clip `name` at default settings (no hold), and their
 /// `metrics.json` value.
 fn nao_clip_metrics(

@@ -336,4 +336,30 @@ fn print_tracking(text: &mut String, m: &ImitationMetrics) {
             cell(&e.transitions, frames.transitions)
         );
     }
+    print_reach(text, m);
+}
+
+/// Per hand, the clip frames whose reference lay beyond the arm's reach from the robot's
+/// shoulder: error no speed can remove.
+fn print_reach(text: &mut String, m: &ImitationMetrics) {
+    let Some(arms) = &m.hand_reach else {
+        return;
+    };
+    let hand = |name: &str, a: &taskstack::imitation::reach::HandReach| match a.mean_shortfall_m {
+        Some(mean) => format!(
+            "{name} {} of {} frames (mean {:.1} cm, max {:.1} cm short)",
+            a.unreachable_frames,
+            a.frames,
+            mean * 100.0,
+            a.max_shortfall_m.unwrap_or(mean) * 100.0
+        ),
+        None => format!("{name} none of {} frames", a.frames),
+    };
+    let _ = writeln!(
+        text,
+        "beyond the arm's reach ({:.1} cm) from the robot's shoulder: {}; {}",
+        arms[0].reach_m * 100.0,
+        hand("l_hand", &arms[0]),
+        hand("r_hand", &arms[1])
+    );
 }

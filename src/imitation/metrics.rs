@@ -17,6 +17,8 @@
 //! * **Locomotion and timing** ([`super::travel`]): travel of the scaled human and of the robot,
 //!   steps of both, catch-up time after the clip, the hands' lag; tracking errors over the clip's
 //!   own frames apart from the hold that follows it ([`MetricsRecorder::mark_clip_end`]).
+//! * **Reach** ([`super::reach`]): the clip's frames whose hand reference lay beyond the arm's
+//!   reach from the robot's own shoulder, and by how much (m): error that is not lateness.
 //! * **Self-collision clearance** ([`super::clearance`]): the smallest distance of the
 //!   profile's paired bodies over the run (m), and the frames closer than the margin.
 //! * **Support changes and transitions**: changes of the human's support and of the robot's
@@ -28,6 +30,7 @@ use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 use super::clearance::{ClearanceMeter, SelfClearance};
 use super::imitator::{Imitator, RobotFrame};
 use super::phase::{SupportKind, SupportPhase};
+use super::reach::{HandReach, ReachMeter};
 use super::support::HumanSupport;
 use super::travel::{
     FootTiming, HandTrace, Stance, StepCounter, Travel, TravelRecorder, robot_stance,
@@ -298,6 +301,10 @@ pub struct ImitationMetrics {
     pub hands_clip_lag_removed: Vec<EffectorError>,
     /// The time shift (s) that best aligns the robot's hands with the scaled reference.
     pub hand_lag_s: f64,
+    /// Over the clip's frames, how far the hand references lay beyond the arms' reach from the
+    /// robot's shoulders (`[left, right]`; [`super::reach`]); `None` when the profile maps no
+    /// shoulder or hand.
+    pub hand_reach: Option<[HandReach; 2]>,
     /// How long the human's clock was paused in all while hands were placed on their contacts
     /// (s): the robot's run is that much longer than the human's.
     pub human_clock_pause: f64,
@@ -371,6 +378,7 @@ pub struct MetricsRecorder {
     clip_support_frames: SupportFrames,
     hands: HandTrace,
     clearance: Option<ClearanceMeter>,
+    reach: Option<ReachMeter>,
     travel: TravelRecorder,
     human_steps: StepCounter,
     robot_steps: StepCounter,
@@ -480,6 +488,7 @@ impl MetricsRecorder {
             hands: HandTrace::default(),
             // The imitator validated its profile, so its pairs resolve.
             clearance: ClearanceMeter::new(profile).ok().flatten(),
+            reach: ReachMeter::new(profile),
             travel: TravelRecorder::default(),
             human_steps: StepCounter::default(),
             robot_steps: StepCounter::default(),
@@ -503,6 +512,9 @@ impl MetricsRecorder {
         self.record_tracking(frame);
         if !self.travel.clip_ended() {
             self.trace_hands(frame);
+            if let Some(reach) = &mut self.reach {
+                reach.record(frame);
+            }
         }
         self.record_balance(frame);
         self.record_limits(frame);
@@ -708,6 +720,7 @@ impl MetricsRecorder {
                     .collect()
             },
             hand_lag_s,
+            hand_reach: self.reach.as_ref().map(ReachMeter::reach),
             human_clock_pause: self.clock_pause,
             finished: self.finished,
             walking: self.walking.finish(),

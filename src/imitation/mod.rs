@@ -25,6 +25,7 @@ pub mod output;
 pub mod phase;
 mod phase_solver;
 mod poubel;
+pub mod reach;
 pub mod scaler;
 pub mod shaping;
 pub mod support;
