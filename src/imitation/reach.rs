@@ -23,7 +23,7 @@ use nalgebra::{IsometryMatrix3, Vector3};
 
 use super::imitator::RobotFrame;
 use super::output::EFFECTORS;
-use super::scaler::{RobotSkeleton, reference_points};
+use super::scaler::RobotSkeleton;
 use crate::human::{HumanJoint, Side};
 use crate::model::{FrameId, Model, ModelData};
 use crate::robots::{BipedProfile, RobotPoint};
@@ -43,12 +43,55 @@ pub struct HandReach {
     pub max_shortfall_m: Option<f64>,
 }
 
-/// One arm: the robot's shoulder point and its length.
+/// One robot arm in the meter's model: the frames of its shoulder point and its length.
 #[derive(Debug, Clone, Copy)]
 struct Arm {
     hand: HumanJoint,
-    shoulder: HumanJoint,
+    /// The shoulder point is the mean of these frames' origins (the same frame twice for a
+    /// [`RobotPoint::Frame`]).
+    shoulder: [FrameId; 2],
     reach: f64,
+}
+
+impl Arm {
+    /// The `side` arm of `profile` in `model`; `None` when its hand or shoulder is not mapped or
+    /// a frame is unknown.
+    fn of(
+        profile: &BipedProfile,
+        skeleton: &RobotSkeleton,
+        model: &Model,
+        side: Side,
+    ) -> Option<Self> {
+        let (hand, shoulder) = match side {
+            Side::Left => (EFFECTORS[0].1, HumanJoint::LShoulder),
+            Side::Right => (EFFECTORS[1].1, HumanJoint::RShoulder),
+        };
+        let mut reach = 0.0;
+        let mut joint = hand;
+        while joint != shoulder {
+            reach += skeleton.length(joint)?;
+            joint = skeleton.antecedent(joint)?;
+        }
+        let frame = |name: &str| model.frame_id(name).ok();
+        let shoulder = match &profile.points.iter().find(|(j, _)| *j == shoulder)?.1 {
+            RobotPoint::Frame(a) => [frame(a)?; 2],
+            RobotPoint::Midpoint(a, b) => [frame(a)?, frame(b)?],
+        };
+        Some(Self {
+            hand,
+            shoulder,
+            reach,
+        })
+    }
+
+    /// How far `target` (model base frame, m) lies beyond the arm's reach from the shoulder
+    /// point of the kinematics in `data` (m; negative within it).
+    fn shortfall(&self, data: &ModelData, target: &Vector3<f64>) -> f64 {
+        let [a, b] = self
+            .shoulder
+            .map(|f| data.frame_placement(f).translation.vector);
+        (target - (a + b) * 0.5).norm() - self.reach
+    }
 }
 
 /// Measures [`HandReach`] frame by frame (see the module docs).
@@ -56,7 +99,6 @@ struct Arm {
 pub struct ReachMeter {
     model: Model,
     data: ModelData,
-    points: Vec<(HumanJoint, RobotPoint)>,
     /// The soles in the left-rooted model (`[left, right]`): where a frame's root is.
     soles: [FrameId; 2],
     arms: [Arm; 2],
@@ -68,30 +110,14 @@ impl ReachMeter {
     /// cannot be measured (the imitator validated its profile, so that is the unmapped case).
     pub fn new(profile: &BipedProfile) -> Option<Self> {
         let skeleton = RobotSkeleton::of(profile).ok()?;
-        let arm = |hand: HumanJoint, shoulder: HumanJoint| -> Option<Arm> {
-            let mut reach = 0.0;
-            let mut joint = hand;
-            while joint != shoulder {
-                reach += skeleton.length(joint)?;
-                joint = skeleton.antecedent(joint)?;
-            }
-            Some(Arm {
-                hand,
-                shoulder,
-                reach,
-            })
-        };
-        let arms = [
-            arm(EFFECTORS[0].1, HumanJoint::LShoulder)?,
-            arm(EFFECTORS[1].1, HumanJoint::RShoulder)?,
-        ];
         let model = profile.models[Side::Left.index()].clone();
+        let arm = |side| Arm::of(profile, &skeleton, &model, side);
+        let arms = [arm(Side::Left)?, arm(Side::Right)?];
         let sole = |side: Side| model.frame_id(&profile.foot(side).sole).ok();
         Some(Self {
             data: model.new_data(),
             soles: [sole(Side::Left)?, sole(Side::Right)?],
             model,
-            points: profile.points.clone(),
             arms,
             counts: [(0, 0, 0.0, 0.0); 2],
         })
@@ -106,20 +132,14 @@ impl ReachMeter {
         {
             return;
         }
-        let Ok(points) = reference_points(&self.model, &self.data, &self.points) else {
-            return;
-        };
         let base_t_root: IsometryMatrix3<f64> =
             *self.data.frame_placement(self.soles[frame.root.index()]);
         for (arm, counts) in self.arms.iter().zip(&mut self.counts) {
-            let (Some(reference), Some(shoulder)) = (
-                frame.reference[arm.hand.index()],
-                points[arm.shoulder.index()],
-            ) else {
+            let Some(reference) = frame.reference[arm.hand.index()] else {
                 continue;
             };
-            let reference: Vector3<f64> = base_t_root.transform_point(&reference.into()).coords;
-            let shortfall = (reference - shoulder).norm() - arm.reach;
+            let reference = base_t_root.transform_point(&reference.into()).coords;
+            let shortfall = arm.shortfall(&self.data, &reference);
             counts.0 += 1;
             if shortfall > 0.0 {
                 counts.1 += 1;
