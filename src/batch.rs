@@ -648,6 +648,14 @@ pub fn metrics_value(m: &ImitationMetrics, clip: &Path) -> Value {
         "clip_frames": m.clip_frames,
         "clip_duration_s": m.clip_duration,
         "human_clock_pause_s": m.human_clock_pause,
+        "held_hands": m.held_hands.map(|hands| {
+            let hand = |h: &crate::imitation::metrics::HeldHand| json!({
+                "contacts": h.contacts,
+                "time_to_place_s": spread(&h.time_to_place),
+                "held_distance_m": mean_max(&h.held_distance),
+            });
+            json!({ "l_hand": hand(&hands[0]), "r_hand": hand(&hands[1]) })
+        }),
         "hold_s": m.duration - m.clip_duration,
         "finished": m.finished,
         "human_support_changes": m.human_support_changes,

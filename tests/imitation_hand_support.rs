@@ -228,6 +228,40 @@ fn the_human_clock_pauses_only_while_a_hand_is_placed() {
     assert!((metrics.human_clock_pause - lead).abs() < 1e-12);
 }
 
+/// The report gives each held hand its own numbers (issue 31 item 5), checked against the frames
+/// themselves: one contact per hand, the robot time from the first placing frame to the first
+/// held one, and the largest distance of the held hand from its point.
+#[test]
+fn the_report_gives_each_held_hand_its_numbers() {
+    let frames = clip();
+    let out = imitate(&frames, HandSupportConfig::new(plan(&frames)));
+    let mut recorder =
+        MetricsRecorder::new(&Imitator::new(nao::profile(), ImitatorConfig::default()).unwrap());
+    for f in &out {
+        recorder.record(f);
+    }
+    let held = recorder.finish().held_hands.expect("hands were placed");
+    for side in Side::BOTH {
+        let report = &held[side.index()];
+        let placement = |f: &&RobotFrame| f.hand_supports[side.index()];
+        let placing = out.iter().find(|f| placement(f).is_some()).unwrap();
+        let holding: Vec<&RobotFrame> = (out.iter())
+            .filter(|f| placement(f).is_some_and(|h| h.holding))
+            .collect();
+        assert_eq!(report.contacts, 1, "{side:?}");
+        let time = holding[0].time - placing.time;
+        assert!((report.time_to_place.median - time).abs() < 1e-12, "{side:?}: {time} s");
+        let worst = (holding.iter())
+            .map(|f| (hand_in_world(f, side) - placement(f).unwrap().point).norm())
+            .fold(0.0, f64::max);
+        assert!((report.held_distance.max - worst).abs() < 1e-12, "{side:?}");
+        assert_eq!(report.held_distance.count, holding.len());
+    }
+    // Without hand supports there is nothing to report.
+    let plain = Imitator::new(nao::profile(), ImitatorConfig::default()).unwrap();
+    assert_eq!(MetricsRecorder::new(&plain).finish().held_hands, None);
+}
+
 #[test]
 fn without_a_pause_budget_the_contact_starts_where_the_hand_is() {
     let frames = clip();

@@ -213,6 +213,23 @@ fn print_summary(
             m.human_clock_pause
         );
     }
+    if let Some(hands) = &m.held_hands {
+        let hand = |name: &str, h: &taskstack::imitation::metrics::HeldHand| match h.contacts {
+            0 => format!("{name} never reached its contact"),
+            n => format!(
+                "{name} {n} contact(s), placed in {:.2} s (median), held {:.1} mm from its point (max {:.1})",
+                h.time_to_place.median,
+                h.held_distance.mean * 1000.0,
+                h.held_distance.max * 1000.0
+            ),
+        };
+        let _ = writeln!(
+            text,
+            "hand supports: {}; {}",
+            hand("l_hand", &hands[0]),
+            hand("r_hand", &hands[1])
+        );
+    }
     let _ = writeln!(
         text,
         "support changes: human {}, robot {} ({})",

@@ -19,6 +19,9 @@
 //!   own frames apart from the hold that follows it ([`MetricsRecorder::mark_clip_end`]).
 //! * **Reach** ([`super::reach`]): the clip's frames whose hand reference lay beyond the arm's
 //!   reach from the robot's own shoulder, and by how much (m): error that is not lateness.
+//! * **Hands held as supports** ([`super::hand_support`]): per hand, the contacts made, the
+//!   time from the start of placing to the contact (s, robot clock), and the distance of the
+//!   held hand from its contact point (m).
 //! * **Self-collision clearance** ([`super::clearance`]): the smallest distance of the
 //!   profile's paired bodies over the run (m), and the frames closer than the margin.
 //! * **Support changes and transitions**: changes of the human's support and of the robot's
@@ -28,6 +31,7 @@
 use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 
 use super::clearance::{ClearanceMeter, SelfClearance};
+use super::hand_support::HandPlacement;
 use super::imitator::{Imitator, RobotFrame};
 use super::phase::{SupportKind, SupportPhase};
 use super::reach::{HandReach, ReachMeter};
@@ -81,6 +85,17 @@ pub struct MeanMax {
     pub max: f64,
     /// Number of samples.
     pub count: usize,
+}
+
+/// What one hand held as a support achieved ([`super::hand_support`]).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct HeldHand {
+    /// Contacts made: the hand reached its contact point and held it.
+    pub contacts: usize,
+    /// Robot time from the start of placing to the contact, per contact (s).
+    pub time_to_place: Spread,
+    /// Distance of the hand from its contact point while held (m), over the held frames.
+    pub held_distance: MeanMax,
 }
 
 /// Minimum, median and maximum of a series.
@@ -204,6 +219,49 @@ impl Series {
     }
 }
 
+/// One hand's support record: when its current placing started, its contacts and their times,
+/// and its distance from the point while held.
+#[derive(Debug, Clone, Default)]
+struct HeldHandTally {
+    /// Whether the hand was ever placed.
+    placed: bool,
+    /// Robot time the current placing started, until the contact is made.
+    placing_since: Option<f64>,
+    /// Whether the hand held its point in the previous frame.
+    holding: bool,
+    place_times: Vec<f64>,
+    distance: Series,
+}
+
+impl HeldHandTally {
+    /// Records one frame: the hand's placement (if any) and the hand (world frame, m) at `time`.
+    fn record(&mut self, placement: Option<HandPlacement>, hand: Vector3<f64>, time: f64) {
+        let Some(placement) = placement else {
+            (self.placing_since, self.holding) = (None, false);
+            return;
+        };
+        self.placed = true;
+        if placement.holding {
+            if !self.holding {
+                let start = self.placing_since.take().unwrap_or(time);
+                self.place_times.push(time - start);
+            }
+            self.distance.push((hand - placement.point).norm());
+        } else {
+            self.placing_since.get_or_insert(time);
+        }
+        self.holding = placement.holding;
+    }
+
+    fn summary(&self) -> HeldHand {
+        HeldHand {
+            contacts: self.place_times.len(),
+            time_to_place: Spread::of(&mut self.place_times.clone()),
+            held_distance: self.distance.summary(),
+        }
+    }
+}
+
 pub use super::output::EFFECTORS;
 
 /// Tracking error of one effector.
@@ -308,6 +366,8 @@ pub struct ImitationMetrics {
     /// How long the human's clock was paused in all while hands were placed on their contacts
     /// (s): the robot's run is that much longer than the human's.
     pub human_clock_pause: f64,
+    /// The hands held as supports (`[left, right]`); `None` when no hand was placed.
+    pub held_hands: Option<[HeldHand; 2]>,
     /// How late the robot lifted each foot after the human lifted the same foot (s; one value
     /// per paired lift, [`super::travel`]), and `human_lifts` how many the human made.
     pub lift_lag: Spread,
@@ -377,6 +437,7 @@ pub struct MetricsRecorder {
     errors_clip: [Vec<Series>; SupportKind::COUNT],
     clip_support_frames: SupportFrames,
     hands: HandTrace,
+    held: [HeldHandTally; 2],
     clearance: Option<ClearanceMeter>,
     reach: Option<ReachMeter>,
     travel: TravelRecorder,
@@ -486,6 +547,7 @@ impl MetricsRecorder {
             errors_clip: std::array::from_fn(|_| vec![Series::default(); EFFECTORS.len()]),
             clip_support_frames: SupportFrames::default(),
             hands: HandTrace::default(),
+            held: Default::default(),
             // The imitator validated its profile, so its pairs resolve.
             clearance: ClearanceMeter::new(profile).ok().flatten(),
             reach: ReachMeter::new(profile),
@@ -593,6 +655,12 @@ impl MetricsRecorder {
         }
         let held = frame.hand_supports.iter().flatten().filter(|h| h.holding);
         self.points.extend(held.map(|h| h.point.xy()));
+        for (side, tally) in self.held.iter_mut().enumerate() {
+            let hand = frame
+                .world_t_root
+                .transform_point(&frame.effectors[side].into());
+            tally.record(frame.hand_supports[side], hand.coords, frame.time);
+        }
         let margin = convex_margin(&self.points, frame.com.xy());
         self.min_margin = self.min_margin.min(margin);
         if margin < 0.0 {
@@ -722,6 +790,8 @@ impl MetricsRecorder {
             hand_lag_s,
             hand_reach: self.reach.as_ref().map(ReachMeter::reach),
             human_clock_pause: self.clock_pause,
+            held_hands: (self.held.iter().any(|h| h.placed))
+                .then(|| self.held.each_ref().map(HeldHandTally::summary)),
             finished: self.finished,
             walking: self.walking.finish(),
             lift_lag: Spread::of(&mut lift_lag),
