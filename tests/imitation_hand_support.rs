@@ -250,7 +250,10 @@ fn the_report_gives_each_held_hand_its_numbers() {
             .collect();
         assert_eq!(report.contacts, 1, "{side:?}");
         let time = holding[0].time - placing.time;
-        assert!((report.time_to_place.median - time).abs() < 1e-12, "{side:?}: {time} s");
+        assert!(
+            (report.time_to_place.median - time).abs() < 1e-12,
+            "{side:?}: {time} s"
+        );
         let worst = (holding.iter())
             .map(|f| (hand_in_world(f, side) - placement(f).unwrap().point).norm())
             .fold(0.0, f64::max);

@@ -14,6 +14,7 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use serde_json::json;
 use taskstack::human::{HumanJoint, Side};
+use taskstack::imitation::hand_support::HandPlacement;
 use taskstack::imitation::metrics::CONTACT_HEIGHT;
 use taskstack::imitation::phase::SupportPhase;
 use taskstack::imitation::support::HumanSupport;
@@ -97,9 +98,10 @@ impl<W: Write> ViewWriter<W> {
 
     /// Adds robot frame `r` if it is due at [`VIEW_RATE`]. Each frame is
     /// `[time ms, phase, human support, robot points, human points, left sole, right sole,
-    /// CoM xy, grounded bits, planned ZMP xy or null, footsteps]`, lengths in mm in the world
+    /// CoM xy, grounded bits, planned ZMP xy or null, footsteps, hand supports]`, lengths in mm in the world
     /// frame; each footstep is `[side (0 left, 1 right), corner x, y, …]`, its sole outline
-    /// where it lands.
+    /// where it lands; then the hands placed on or held at a surface (see
+    /// `push_hand_supports`).
     pub(crate) fn frame(&mut self, r: &RobotFrame) -> Result<()> {
         let reference = (r.reference.iter())
             .map(|p| p.map(|p| r.world_t_root.transform_point(&p.into()).coords));
@@ -112,6 +114,7 @@ impl<W: Write> ViewWriter<W> {
             com: r.com,
             zmp: r.walk.map(|w| w.zmp),
             footsteps: &r.footsteps,
+            hand_supports: r.hand_supports,
         };
         self.frame_of(&frame, reference)
     }
@@ -187,6 +190,8 @@ impl<W: Write> ViewWriter<W> {
             }
             line.push(']');
         }
+        line.push_str("],[");
+        push_hand_supports(line, &r.hand_supports);
         line.push_str("]],\n");
         self.out.write_all(line.as_bytes())?;
         self.written += 1;
@@ -228,6 +233,8 @@ pub(crate) struct ViewFrame<'a> {
     pub(crate) zmp: Option<Vector2<f64>>,
     /// The walk's footsteps not yet landed (world).
     pub(crate) footsteps: &'a [Footstep],
+    /// The hands placed on or held at a surface (world), `[left, right]`.
+    pub(crate) hand_supports: [Option<HandPlacement>; 2],
 }
 
 /// What is drawn of the robot: the link origins and named frames whose world positions each
@@ -287,6 +294,34 @@ fn split_template() -> Result<(&'static str, &'static str)> {
     TEMPLATE
         .split_once(DATA_MARK)
         .context("the viewer template has no data mark")
+}
+
+/// Each hand placed on or held at a surface as `[side (0 left, 1 right), holding (0/1), point x,
+/// y, z, surface height, corner x, y, …]` (mm, world; no corners for an unbounded surface).
+fn push_hand_supports(line: &mut String, hands: &[Option<HandPlacement>; 2]) {
+    let placed = hands.iter().enumerate();
+    for (k, (side, hand)) in placed.filter_map(|(i, h)| h.map(|h| (i, h))).enumerate() {
+        let p = hand.point;
+        let surface = &hand.surface;
+        line.push_str(if k == 0 { "[" } else { ",[" });
+        line.push_str(&format!(
+            "{side},{},{},{},{},{}",
+            u8::from(hand.holding),
+            mm(p.x),
+            mm(p.y),
+            mm(p.z),
+            mm(surface.height())
+        ));
+        if let Some(half) = surface.half_size() {
+            let (sin, cos) = surface.yaw().sin_cos();
+            for [sx, sy] in [[1.0, 1.0], [-1.0, 1.0], [-1.0, -1.0], [1.0, -1.0]] {
+                let (x, y) = (sx * half.x, sy * half.y);
+                let c = surface.centre() + Vector2::new(cos * x - sin * y, sin * x + cos * y);
+                line.push_str(&format!(",{},{}", mm(c.x), mm(c.y)));
+            }
+        }
+        line.push(']');
+    }
 }
 
 fn mm(v: f64) -> i64 {

@@ -212,6 +212,7 @@ impl Recorder {
             com: w.com,
             zmp: Some(w.zmp),
             footsteps,
+            hand_supports: [None; 2],
         };
         self.view
             .frame_of(&view, std::iter::repeat_n(None, HumanJoint::COUNT))

@@ -104,17 +104,18 @@ fn the_viewer_draws_the_walk_plan() {
     assert_eq!(run.code, Some(0), "{}", run.stderr);
     let page = out.join("view.html").canonicalize().unwrap();
     let text = std::fs::read_to_string(&page).unwrap();
-    // A frame with a step queued ends `…,grounded,[zmp x,zmp y],[[side,x,y,…]]],`.
-    let planned = text.lines().filter(|l| l.ends_with("]]],")).count();
+    // A frame with a step queued ends `…,grounded,[zmp x,zmp y],[[side,x,y,…]],[]],` (no hand
+    // supports).
+    let planned = text.lines().filter(|l| l.ends_with("]],[]],")).count();
     assert!(planned > 50, "{planned} frames with a footstep");
     let report = selftest(&browser, &page);
     assert_eq!(report["errors"], Value::Array(vec![]), "{report}");
-    // The same frames without the plan (every frame's last two entries emptied).
+    // The same frames without the plan (every frame's ZMP and footsteps emptied).
     let stripped: String = (text.lines())
         .map(|l| match (l.starts_with('['), l.rfind("],[[")) {
             (true, Some(cut)) => {
                 let zmp = l[..cut].rfind(",[").unwrap();
-                format!("{},null,[]],\n", &l[..zmp])
+                format!("{},null,[],[]],\n", &l[..zmp])
             }
             _ => format!("{l}\n"),
         })
@@ -124,6 +125,44 @@ fn the_viewer_draws_the_walk_plan() {
     assert_eq!(without["errors"], Value::Array(vec![]), "{without}");
     let first = |r: &Value| r["drawn"][0].as_f64().unwrap();
     assert!(first(&report) > first(&without), "{report} vs {without}");
+}
+
+/// A run with hands on a stool draws the surface each hand rests on and the contact points: the
+/// frames carry them, and the page's last frame (both hands held) draws more than with them
+/// taken out.
+#[test]
+fn the_viewer_draws_the_surfaces_the_hands_rest_on() {
+    let Some(browser) = browser() else {
+        assert!(std::env::var_os("TASKSTACK_REQUIRE_BROWSER").is_none());
+        eprintln!("viewer test skipped: no browser");
+        return;
+    };
+    let dir = temp_dir("viewer-stool");
+    let out = dir.join("stool");
+    let data = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/contact");
+    let clip = format!("{data}/cmu_23_19_lean_hands_on_stool.bvh");
+    let scene = format!("{data}/stool_23_19.toml");
+    let args = ["-q", "imitate", &clip, "--scene", &scene, "--out", s(&out)];
+    let run = taskstack(&args);
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    let page = out.join("view.html").canonicalize().unwrap();
+    let text = std::fs::read_to_string(&page).unwrap();
+    // A frame with a hand support ends `…,[footsteps],[[side,holding,x,y,z,height,corners…]]],`.
+    let held = text.lines().filter(|l| l.ends_with("]]],")).count();
+    assert!(held > 20, "{held} frames with a hand support");
+    let report = selftest(&browser, &page);
+    assert_eq!(report["errors"], Value::Array(vec![]), "{report}");
+    let stripped: String = (text.lines())
+        .map(|l| match (l.starts_with('['), l.rfind(",[[")) {
+            (true, Some(cut)) if l.ends_with("]]],") => format!("{},[]],\n", &l[..cut]),
+            _ => format!("{l}\n"),
+        })
+        .collect();
+    std::fs::write(&page, stripped).unwrap();
+    let without = selftest(&browser, &page);
+    assert_eq!(without["errors"], Value::Array(vec![]), "{without}");
+    let last = |r: &Value| r["drawn"][3].as_f64().unwrap();
+    assert!(last(&report) > last(&without), "{report} vs {without}");
 }
 
 /// Loads `page` with `#selftest` in the headless `browser` and returns the page's report; the
