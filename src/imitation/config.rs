@@ -6,7 +6,7 @@ use super::hand_support::HandSupportConfig;
 use super::koenemann::KoenemannConfig;
 use super::look_ahead::FootLookAhead;
 use super::phase::PhaseConfig;
-use super::shaping::MotionLimits;
+use super::shaping::{HandSpeed, MotionLimits};
 use super::support::SupportConfig;
 use super::tables::TaskTables;
 use crate::robots::{FootArea, MotionTuning};
@@ -80,12 +80,12 @@ pub struct ImitatorConfig {
     /// human more closely while the CoM, the torso and the feet keep their slow, shaped
     /// references (the joint velocity bounds still limit the arms). `Some`: this speed in every
     /// phase. `None` (default): the profile's
-    /// [`MotionTuning::tracking_speed`](crate::robots::MotionTuning::tracking_speed) in double
-    /// support and its
-    /// [`stance_tracking_speed`](crate::robots::MotionTuning::stance_tracking_speed) on one foot
-    /// and in the transition steps (NAO 0.45 and 0.15 m/s; faster hands turned loaded feet in
-    /// the physics judge, see [`crate::robots::nao::TUNING`]); Koenemann's method, and Poubel's
-    /// with the dynamic walk on ([`FootstepConfig::dynamic`]), use the latter throughout.
+    /// [`MotionTuning::tracking_speed`](crate::robots::MotionTuning::tracking_speed) once both
+    /// the human and the robot have stood on both feet for a second, and its
+    /// [`stance_tracking_speed`](crate::robots::MotionTuning::stance_tracking_speed) otherwise
+    /// ([`super::shaping::HandSpeed`]; NAO 0.45 and 0.15 m/s; faster hands turned loaded feet
+    /// in the physics judge, see [`crate::robots::nao::TUNING`]), in both methods; Poubel's
+    /// with the dynamic walk on ([`FootstepConfig::dynamic`]) uses the latter throughout.
     pub max_tracking_speed: Option<f64>,
     /// When and where the robot steps: the human's footprints, scaled, clipped to the step
     /// envelope, taken one step at a time (see [`super::footsteps`]).
@@ -140,6 +140,21 @@ impl ImitatorConfig {
     pub(super) fn motion_for(&self, tuning: &MotionTuning) -> MotionLimits {
         self.motion
             .unwrap_or_else(|| MotionLimits::with_com_of(tuning))
+    }
+
+    /// The hands' speeds: [`ImitatorConfig::max_tracking_speed`] in every phase, or `tuning`'s
+    /// double-support and stance speeds.
+    pub(super) fn hand_speed_for(&self, tuning: &MotionTuning) -> HandSpeed {
+        match self.max_tracking_speed {
+            Some(speed) => HandSpeed {
+                double: speed,
+                stance: speed,
+            },
+            None => HandSpeed {
+                double: tuning.tracking_speed,
+                stance: tuning.stance_tracking_speed,
+            },
+        }
     }
 
     /// Checks the imitator's own settings (the phase, table, support and solver settings are

@@ -34,7 +34,7 @@ use super::metrics::CONTACT_HEIGHT;
 use super::phase::{Measurements, PhaseMachine, Settling, SupportKind, SupportPhase, TakeOff};
 use super::phase_solver::{Criteria, FrameTargets, PhaseSolver};
 use super::scaler::{RobotSkeleton, ScaleConfig, Scaler};
-use super::shaping::{ComReference, MotionLimits, SwingHeight};
+use super::shaping::{ComReference, HandSpeed, MotionLimits, SwingHeight};
 use super::support::{HumanSupport, SupportDetector};
 use super::tables::{PointTarget, Task, TaskTable, TaskTables};
 use super::walking::follower::WalkFollower;
@@ -47,13 +47,6 @@ use crate::solver::{JointBounds, JointLimitAvoidance, JointTracking, Settings};
 use super::config::ImitatorConfig;
 use super::error::ImitationError;
 use super::output::{EFFECTORS, RobotFrame, effector_frames};
-
-/// How long the human must have stood on both feet (s) before the hands move at the
-/// double-support speed ([`MotionTuning::tracking_speed`](crate::robots::MotionTuning::tracking_speed)).
-/// Without it the faster hands between steps added a third to a half to the time the judge's
-/// weak NAO had its CoM outside the contact area on the stepping clips (automatic hold); with
-/// 1 s, CMU 05_12, 09_12 and 131_01 are back at their times at the stance speed.
-const SETTLED_DOUBLE_SUPPORT: f64 = 1.0;
 
 /// Poubel et al.'s imitator.
 pub(crate) struct PoubelImitator {
@@ -68,10 +61,8 @@ pub(crate) struct PoubelImitator {
     machine: PhaseMachine,
     iterations: usize,
     max_task_speed: f64,
-    /// Largest speed of the hand targets in double support (m/s).
-    max_tracking_speed: f64,
-    /// ... in single support and the transition steps (m/s).
-    stance_tracking_speed: f64,
+    /// Largest speed of the hand targets.
+    hand_speed: HandSpeed,
     limits: JointLimitAvoidance,
     tracking: JointTracking,
     human_q: Vec<f64>,
@@ -219,12 +210,13 @@ impl PoubelImitator {
             // A dynamic walk starts from double support and holds the arms where they are: at
             // the double-support speed they stopped within a frame and the judge's weak NAO
             // fell on CMU 05_02 (16 of 16 runs passed at the stance speed).
-            max_tracking_speed: (config.max_tracking_speed).unwrap_or(match walk {
-                Some(_) => tuning.stance_tracking_speed,
-                None => tuning.tracking_speed,
-            }),
-            stance_tracking_speed: (config.max_tracking_speed)
-                .unwrap_or(tuning.stance_tracking_speed),
+            hand_speed: match (walk.is_some(), config.hand_speed_for(&tuning)) {
+                (true, speed) => HandSpeed {
+                    double: speed.stance,
+                    ..speed
+                },
+                (false, speed) => speed,
+            },
             phases,
             effectors,
             phase: SupportPhase::Double,
@@ -398,7 +390,7 @@ impl PoubelImitator {
             com: planned.com,
             swing_lift: planned.swing_lift,
             footstep: Some(planned.footstep),
-            tracking_step: self.max_tracking_speed * walk.iteration_dt(dt),
+            tracking_step: self.hand_speed.double * walk.iteration_dt(dt),
             hand_contacts: [None; 2],
             up: planned.up,
             com_height: planned.com_height,
@@ -434,17 +426,10 @@ impl PoubelImitator {
         Ok(())
     }
 
-    /// The hands' largest speed in `phase` (m/s): the double-support speed once the human has
-    /// stood on both feet for [`SETTLED_DOUBLE_SUPPORT`], else the slower stance speed: on one
-    /// foot and while the weight shifts the arms' reaction costs more balance, and a human who
-    /// has just put a foot down may step again
-    /// ([`MotionTuning::stance_tracking_speed`](crate::robots::MotionTuning::stance_tracking_speed)).
+    /// The hands' largest speed in `phase` (m/s; [`HandSpeed`]).
     fn tracking_speed(&self, phase: SupportPhase) -> f64 {
-        let settled = self.footsteps.double_support_time() >= SETTLED_DOUBLE_SUPPORT;
-        match phase.kind() == SupportKind::Double && settled {
-            true => self.max_tracking_speed,
-            false => self.stance_tracking_speed,
-        }
+        let double = phase.kind() == SupportKind::Double;
+        (self.hand_speed).at(self.footsteps.double_support_time(), double)
     }
 
     /// Scales the human frame into the root frame (`output.reference`) and sets the
