@@ -53,8 +53,8 @@ pub(crate) struct ImitationOptions {
     #[arg(long, value_name = "M_PER_S", value_parser = positive, allow_negative_numbers = true)]
     pub(crate) task_speed: Option<f64>,
     /// Fastest speed of the hand targets toward the scaled human (m/s, > 0), in every phase.
-    /// Default: the profile's, in double support / on one foot and while the weight shifts
-    /// (NAO 0.45 / 0.15, G1 0.3 / 0.3; Koenemann's method and --dynamic-walk the second
+    /// Default: the profile's, once both feet have stood for a second / on one foot and while
+    /// the weight shifts (NAO 0.45 / 0.15, G1 0.3 / 0.3; both methods; --dynamic-walk the second
     /// throughout).
     #[arg(long, value_name = "M_PER_S", value_parser = positive, allow_negative_numbers = true)]
     pub(crate) tracking_speed: Option<f64>,

@@ -19,7 +19,7 @@ use crate::imitation::metrics::CONTACT_HEIGHT;
 use crate::imitation::output::RobotFrame;
 use crate::imitation::phase::{Landing, SupportPhase, TakeOff};
 use crate::imitation::scaler::reference_points;
-use crate::imitation::shaping::{MotionLimits, SwingHeight};
+use crate::imitation::shaping::{HandSpeed, MotionLimits, SwingHeight};
 use crate::imitation::support::{HumanSupport, SupportDetector};
 use crate::model::{FrameId, ModelData, ModelError};
 use crate::robots::{BipedProfile, FootArea, SolePlacement};
@@ -94,7 +94,9 @@ pub(crate) struct KoenemannImitator {
     position_bounds: JointBounds,
     /// The position limits narrowed to what the velocity limits reach in the frame.
     frame_bounds: JointBounds,
-    tracking_speed: f64,
+    hand_speed: HandSpeed,
+    /// How long the human has stood on both feet (s; 0 while a foot is up).
+    human_double_time: f64,
     foot_speed: f64,
     motion: MotionLimits,
     step_envelope: FootArea,
@@ -325,9 +327,8 @@ impl KoenemannImitator {
         let hold = shared.output.left_sole;
         Ok(KoenemannImitator {
             detector: SupportDetector::new(config.support)?,
-            // One speed in every support state: the one judged safe on one foot (the faster
-            // double-support speed of the profile was measured with Poubel's tables only).
-            tracking_speed: (config.max_tracking_speed).unwrap_or(tuning.stance_tracking_speed),
+            hand_speed: config.hand_speed_for(&tuning),
+            human_double_time: 0.0,
             foot_speed: config.max_task_speed.unwrap_or(tuning.task_speed),
             motion: config.motion_for(&tuning),
             step_envelope: config.step_envelope.unwrap_or(profile.step_envelope),
@@ -362,6 +363,10 @@ impl KoenemannImitator {
         let start = Instant::now();
         let dt = self.shared.begin_frame(frame.time)?;
         let human = self.detector.update(frame);
+        self.human_double_time = match human {
+            HumanSupport::Double => self.human_double_time + dt,
+            _ => 0.0,
+        };
         self.q_start.copy_from_slice(&self.shared.q);
         let posture = Posture::of_human(frame);
         if self.mapping.is_none() && posture.is_some() {
@@ -450,8 +455,8 @@ impl KoenemannImitator {
         (&self.shared.data[root], &self.frames[root])
     }
 
-    /// The hand targets: mapped, at most `tracking_speed` from the last ones, outside the torso;
-    /// then the arms' IK.
+    /// The hand targets: mapped, at most the hands' speed ([`HandSpeed`]) × `dt` from the last
+    /// ones, outside the torso; then the arms' IK.
     fn track_hands(&mut self, mapped: Option<&Posture>, dt: f64) -> Result<(), ImitationError> {
         let (data, f) = self.current();
         let current = f
@@ -462,7 +467,9 @@ impl KoenemannImitator {
             None => self.hands.unwrap_or(current),
         };
         let previous = self.hands.unwrap_or(current);
-        let reach = self.tracking_speed * dt;
+        // Both feet down and no foot landing: the robot stands on both.
+        let robot_double = self.mode == SupportMode::Double && self.landing.is_none();
+        let reach = (self.hand_speed).at(self.human_double_time, robot_double) * dt;
         let radius = 0.5 * (self.body.hips[0] - self.body.hips[1]).norm();
         let targets = [0, 1].map(|k| {
             let moved = step_toward(previous[k], wanted[k], reach);
