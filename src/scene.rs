@@ -170,6 +170,17 @@ impl SurfaceShape {
         self.half_size.is_none()
     }
 
+    /// The rectangle's corners (m, xy; counter-clockwise from `+x +y` in its own axes); `None`
+    /// when unbounded.
+    pub fn corners(&self) -> Option<[Vector2<f64>; 4]> {
+        let half = self.half_size?;
+        let turn = Rotation2::new(self.yaw);
+        Some(
+            [[1.0, 1.0], [-1.0, 1.0], [-1.0, -1.0], [1.0, -1.0]]
+                .map(|[sx, sy]| self.centre + turn * Vector2::new(sx * half.x, sy * half.y)),
+        )
+    }
+
     /// `xy` in the rectangle's own axes, relative to its centre (m).
     fn local(&self, xy: Vector2<f64>) -> Vector2<f64> {
         Rotation2::new(-self.yaw) * (xy - self.centre)

@@ -100,3 +100,22 @@ fn a_mapped_surface_is_turned_scaled_and_moved_about_the_anchor() {
     assert_eq!(mapped.outside_distance(&Vector3::new(0.0, 1.15, 0.0)), 0.0);
     assert!((mapped.outside_distance(&Vector3::new(0.0, 1.25, 0.0)) - 0.05).abs() < 1e-12);
 }
+
+/// A 0.4 × 0.2 m rectangle centred at (1, 2), turned 90°: its long side runs along y, so its
+/// corners (by hand) are (1 ∓ 0.1, 2 ± 0.2); the floor has none.
+#[test]
+fn a_turned_rectangle_lists_its_corners() {
+    let stool = Surface::rectangle("stool", [1.0, 2.0], [0.4, 0.2], 90.0, 0.45).unwrap();
+    let corners = stool.shape().corners().unwrap();
+    let expected = [[0.9, 2.2], [0.9, 1.8], [1.1, 1.8], [1.1, 2.2]];
+    for (c, e) in corners.iter().zip(expected) {
+        assert!((c - Vector2::from(e)).norm() < 1e-12, "{c} vs {e:?}");
+    }
+    assert!(
+        Surface::plane("floor", 0.0)
+            .unwrap()
+            .shape()
+            .corners()
+            .is_none()
+    );
+}

@@ -312,13 +312,8 @@ fn push_hand_supports(line: &mut String, hands: &[Option<HandPlacement>; 2]) {
             mm(p.z),
             mm(surface.height())
         ));
-        if let Some(half) = surface.half_size() {
-            let (sin, cos) = surface.yaw().sin_cos();
-            for [sx, sy] in [[1.0, 1.0], [-1.0, 1.0], [-1.0, -1.0], [1.0, -1.0]] {
-                let (x, y) = (sx * half.x, sy * half.y);
-                let c = surface.centre() + Vector2::new(cos * x - sin * y, sin * x + cos * y);
-                line.push_str(&format!(",{},{}", mm(c.x), mm(c.y)));
-            }
+        for c in surface.corners().into_iter().flatten() {
+            line.push_str(&format!(",{},{}", mm(c.x), mm(c.y)));
         }
         line.push(']');
     }
