@@ -148,3 +148,46 @@ proptest! {
         }
     }
 }
+
+/// A human who stops moving: after the Kinect gesture clip, its last frame held for 2 s (what
+/// the CLI's hold does). The hands reach their targets and their speed falls to zero; every
+/// frame must still give a finite posture (a zero step over a zero distance once gave the arms'
+/// IK a NaN target).
+#[test]
+fn a_human_who_stops_moving_leaves_the_robot_standing_still() {
+    let path = format!(
+        "{}/tests/data/mocap/kinect2_labanotation_ges02_balancinghands.csv",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let mut clip = Clip::open(path).unwrap();
+    let config = ImitatorConfig {
+        method: ImitationMethod::Koenemann(KoenemannConfig::default()),
+        support: SupportConfig::for_capture(clip.capture()),
+        ..ImitatorConfig::default()
+    };
+    let mut imitator = Imitator::new(nao::profile(), config).unwrap();
+    let mut frame = HumanFrame::new(0.0);
+    while clip.read_frame(&mut frame).unwrap() {
+        imitator.step(&frame).unwrap();
+    }
+    let end = frame.time;
+    let mut last = Vec::new();
+    for k in 1..=240 {
+        frame.time = end + k as f64 / 120.0;
+        let q = &imitator.step(&frame).unwrap().q;
+        assert!(q.iter().all(|x| x.is_finite()), "frame {k}");
+        if k == 120 {
+            last = q.clone();
+        }
+    }
+    let q = &imitator.step(&frame).unwrap().q;
+    let moved = q
+        .iter()
+        .zip(&last)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    assert!(
+        moved < 0.05,
+        "still moving {moved} rad in the second second"
+    );
+}

@@ -88,6 +88,7 @@ def imitate_clip(
     upper_body_fraction: Optional[float] = None,
     task_speed: Optional[float] = None,
     tracking_speed: Optional[float] = None,
+    tracking_acceleration: Optional[float] = None,
     iterations: int = 1,
     calibration: str = "auto",
     retargeting: str = "shift-both-feet",
@@ -108,6 +109,8 @@ def imitate_clip(
         upper_body_fraction: the same for arms, head and torso (default: the robot's).
         task_speed: fastest CoM and foot target speed (m/s; default: the robot's).
         tracking_speed: fastest hand target speed (m/s; default: the robot's).
+        tracking_acceleration: largest change of the hand targets' speed (m/s²; default: the
+            robot's).
         iterations: solver iterations per frame (1 to 100).
         calibration: ``method="koenemann"``: ``"auto"``, ``"first-frame"`` or ``"ideal"``.
         retargeting: ``method="koenemann"``: ``"shift-both-feet"`` or ``"move-one-foot"``.
@@ -128,6 +131,7 @@ def imitate_clip(
         upper_body_fraction=upper_body_fraction,
         task_speed=task_speed,
         tracking_speed=tracking_speed,
+        tracking_acceleration=tracking_acceleration,
         iterations=iterations,
         calibration=calibration,
         retargeting=retargeting,

@@ -33,7 +33,7 @@ class Imitator:
         120 Hz, mm noise) or "kinect" (depth camera, 30 Hz, cm noise), which sets the support
         detection's thresholds; ``options``: ``method``, ``walk``, ``dynamic_walk``,
         ``velocity_fraction``, ``upper_body_fraction``, ``task_speed``, ``tracking_speed``,
-        ``iterations``, ``calibration``, ``retargeting``, as ``taskstack.imitate_clip``'s (an
+        ``tracking_acceleration``, ``iterations``, ``calibration``, ``retargeting``, as ``taskstack.imitate_clip``'s (an
         unknown one is a TypeError)."""
         ...
     @property

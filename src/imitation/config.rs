@@ -83,10 +83,14 @@ pub struct ImitatorConfig {
     /// [`MotionTuning::tracking_speed`](crate::robots::MotionTuning::tracking_speed) once both
     /// the human and the robot have stood on both feet for a second, and its
     /// [`stance_tracking_speed`](crate::robots::MotionTuning::stance_tracking_speed) otherwise
-    /// ([`super::shaping::HandSpeed`]; NAO 0.45 and 0.15 m/s; faster hands turned loaded feet
+    /// ([`super::shaping::HandSpeed`]; NAO 0.8 and 0.3 m/s, shaped at 2 m/s²; faster hands turned loaded feet
     /// in the physics judge, see [`crate::robots::nao::TUNING`]), in both methods; Poubel's
     /// with the dynamic walk on ([`FootstepConfig::dynamic`]) uses the latter throughout.
     pub max_tracking_speed: Option<f64>,
+    /// Largest change of the hands' speed toward their targets (m/s², > 0) in every phase, both
+    /// methods ([`super::shaping::HandRates`]). `None` (default): the profile's
+    /// [`MotionTuning::tracking_acceleration`](crate::robots::MotionTuning::tracking_acceleration).
+    pub max_tracking_acceleration: Option<f64>,
     /// When and where the robot steps: the human's footprints, scaled, clipped to the step
     /// envelope, taken one step at a time (see [`super::footsteps`]).
     pub footsteps: FootstepConfig,
@@ -125,6 +129,7 @@ impl Default for ImitatorConfig {
             iterations_per_frame: 1,
             max_task_speed: None,
             max_tracking_speed: None,
+            max_tracking_acceleration: None,
             footsteps: FootstepConfig::default(),
             nominal_dt: 1.0 / 120.0,
             solver: Settings::default(),
@@ -143,17 +148,18 @@ impl ImitatorConfig {
     }
 
     /// The hands' speeds: [`ImitatorConfig::max_tracking_speed`] in every phase, or `tuning`'s
-    /// double-support and stance speeds.
+    /// double-support and stance speeds; the acceleration of
+    /// [`ImitatorConfig::max_tracking_acceleration`] or `tuning`'s.
     pub(super) fn hand_speed_for(&self, tuning: &MotionTuning) -> HandSpeed {
-        match self.max_tracking_speed {
-            Some(speed) => HandSpeed {
-                double: speed,
-                stance: speed,
-            },
-            None => HandSpeed {
-                double: tuning.tracking_speed,
-                stance: tuning.stance_tracking_speed,
-            },
+        let acceleration = (self.max_tracking_acceleration).unwrap_or(tuning.tracking_acceleration);
+        let (double, stance) = match self.max_tracking_speed {
+            Some(speed) => (speed, speed),
+            None => (tuning.tracking_speed, tuning.stance_tracking_speed),
+        };
+        HandSpeed {
+            double,
+            stance,
+            acceleration,
         }
     }
 
@@ -193,6 +199,11 @@ impl ImitatorConfig {
                 "max_tracking_speed",
                 self.max_tracking_speed,
                 "must be finite and > 0 m/s",
+            ),
+            (
+                "max_tracking_acceleration",
+                self.max_tracking_acceleration,
+                "must be finite and > 0 m/s²",
             ),
             (
                 "upper_body_velocity_fraction",

@@ -70,9 +70,12 @@ pub(super) struct FrameTargets<'a> {
     pub(super) swing_lift: f64,
     /// The swing foot's target footprint, while the robot steps.
     pub(super) footstep: Option<GroundPose>,
-    /// Largest error (m) a task following the scaled human, or placing a hand, asks for in one
-    /// iteration.
+    /// Largest error (m) a task following the scaled human asks for in one iteration, the
+    /// hands' excepted.
     pub(super) tracking_step: f64,
+    /// The same for each hand's task (`[left, right]`) following the human (m). A hand placed
+    /// on a surface moves at the task speed, as the feet do.
+    pub(super) hand_steps: [f64; 2],
     /// The hands' contact points (`[left, right]`) while they are placed or held as supports.
     pub(super) hand_contacts: [Option<Vector3<f64>>; 2],
     /// The walk's up direction of the torso (unit): the target of
@@ -491,14 +494,15 @@ impl TaskModel for PhaseTasks<'_> {
     type Error = ImitationError;
 
     fn max_task_error(&self, task: usize) -> Option<f64> {
-        let follows_human = matches!(
-            self.tasks.get(task)?.task,
-            Task::Point {
-                target: PointTarget::Scaled(_) | PointTarget::HandContact(_),
-                ..
-            }
-        );
-        follows_human.then_some(self.targets.tracking_step)
+        let Task::Point { target, .. } = self.tasks.get(task)?.task else {
+            return None;
+        };
+        match target {
+            PointTarget::Scaled(HumanJoint::LHand) => Some(self.targets.hand_steps[0]),
+            PointTarget::Scaled(HumanJoint::RHand) => Some(self.targets.hand_steps[1]),
+            PointTarget::Scaled(_) => Some(self.targets.tracking_step),
+            _ => None,
+        }
     }
 
     fn evaluate(&mut self, q: &[f64], stack: &mut TaskStack) -> Result<(), ImitationError> {

@@ -42,8 +42,9 @@
 //! [tuning]                           # optional, each field too (default: the NAO's values
 //!                                    # scaled to this robot's size, crate::robots::tuning)
 //! task_speed = 0.15                  # m/s
-//! tracking_speed = 0.45              # m/s, the hands while both feet stand (settled)
-//! stance_tracking_speed = 0.15       # m/s, the hands on one foot and while the weight shifts
+//! tracking_speed = 0.8               # m/s, the hands while both feet stand (settled)
+//! stance_tracking_speed = 0.3        # m/s, the hands on one foot and while the weight shifts
+//! tracking_acceleration = 2.0        # m/s², the hands' change of speed
 //! upper_body_velocity_fraction = 0.5
 //! torso_lowering = 0.02              # m, the torso below its standing height
 //! torso_lean = 0.25                  # rad, over the stance foot
@@ -97,6 +98,7 @@ struct Tuning {
     task_speed: Option<f64>,
     tracking_speed: Option<f64>,
     stance_tracking_speed: Option<f64>,
+    tracking_acceleration: Option<f64>,
     upper_body_velocity_fraction: Option<f64>,
     torso_lowering: Option<f64>,
     torso_lean: Option<f64>,
@@ -330,6 +332,7 @@ fn tuning(file: Option<Tuning>, scaled: MotionTuning) -> MotionTuning {
         task_speed: t.task_speed.unwrap_or(scaled.task_speed),
         tracking_speed: t.tracking_speed.unwrap_or(scaled.tracking_speed),
         stance_tracking_speed: (t.stance_tracking_speed).unwrap_or(scaled.stance_tracking_speed),
+        tracking_acceleration: (t.tracking_acceleration).unwrap_or(scaled.tracking_acceleration),
         upper_body_velocity_fraction: (t.upper_body_velocity_fraction)
             .unwrap_or(scaled.upper_body_velocity_fraction),
         torso_lowering: t.torso_lowering.unwrap_or(scaled.torso_lowering),

@@ -21,6 +21,7 @@
 //! | `support_margin` | `× s'/s` | the same fraction of the sole's width |
 //! | `torso_lowering` | `× l'/l` | the same fraction of the leg |
 //! | `tracking_speed`, `stance_tracking_speed` | `× a'/a` | the hands cover the same fraction of the arm per second |
+//! | `tracking_acceleration` | `× a'/a` | the hands' speed changes by the same fraction of the arm per second, per second |
 //! | `upper_body_velocity_fraction` | `× ω/ω'`, at most its value | the same joint speeds (rad/s) on faster motors |
 //!
 //! The rules keep geometric and dynamic similarity; what they cannot see (servo stiffness, the
@@ -42,6 +43,10 @@ pub struct MotionTuning {
     /// shifting the weight between the feet, the robot has less support to take the arms'
     /// reaction, so the hands may be held slower there.
     pub stance_tracking_speed: f64,
+    /// Largest change of the hands' speed toward their targets (m/s²), in every phase: a hand
+    /// starts, cruises and brakes instead of reaching its speed in one frame, so the arms'
+    /// reaction on the feet stays small at a higher top speed.
+    pub tracking_acceleration: f64,
     /// Fraction of the rated velocity of every joint off the sole-to-sole chain (arms, head);
     /// the legs keep the imitator's `velocity_fraction`.
     pub upper_body_velocity_fraction: f64,
@@ -81,6 +86,7 @@ impl MotionTuning {
             ("task_speed", self.task_speed),
             ("tracking_speed", self.tracking_speed),
             ("stance_tracking_speed", self.stance_tracking_speed),
+            ("tracking_acceleration", self.tracking_acceleration),
             (
                 "upper_body_velocity_fraction",
                 self.upper_body_velocity_fraction,
@@ -113,11 +119,13 @@ impl MotionTuning {
     /// rules of the module docs.
     pub fn scaled(&self, from: &BipedSize, to: &BipedSize) -> MotionTuning {
         let froude = (to.com_height / from.com_height).sqrt();
+        let arm = to.arm_length / from.arm_length;
         let stance_angle = |s: &BipedSize| s.half_stance.atan2(s.com_height);
         MotionTuning {
             task_speed: self.task_speed * froude,
-            tracking_speed: self.tracking_speed * to.arm_length / from.arm_length,
-            stance_tracking_speed: self.stance_tracking_speed * to.arm_length / from.arm_length,
+            tracking_speed: self.tracking_speed * arm,
+            stance_tracking_speed: self.stance_tracking_speed * arm,
+            tracking_acceleration: self.tracking_acceleration * arm,
             upper_body_velocity_fraction: (self.upper_body_velocity_fraction
                 * from.upper_body_speed
                 / to.upper_body_speed)

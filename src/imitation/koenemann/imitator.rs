@@ -19,7 +19,7 @@ use crate::imitation::metrics::CONTACT_HEIGHT;
 use crate::imitation::output::RobotFrame;
 use crate::imitation::phase::{Landing, SupportPhase, TakeOff};
 use crate::imitation::scaler::reference_points;
-use crate::imitation::shaping::{HandSpeed, MotionLimits, SwingHeight};
+use crate::imitation::shaping::{HandRates, HandSpeed, MotionLimits, SwingHeight};
 use crate::imitation::support::{HumanSupport, SupportDetector};
 use crate::model::{FrameId, ModelData, ModelError};
 use crate::robots::{BipedProfile, FootArea, SolePlacement};
@@ -95,6 +95,8 @@ pub(crate) struct KoenemannImitator {
     /// The position limits narrowed to what the velocity limits reach in the frame.
     frame_bounds: JointBounds,
     hand_speed: HandSpeed,
+    /// The hand targets' speeds, shaped frame by frame.
+    hand_rates: HandRates,
     /// How long the human has stood on both feet (s; 0 while a foot is up).
     human_double_time: f64,
     foot_speed: f64,
@@ -328,6 +330,7 @@ impl KoenemannImitator {
         Ok(KoenemannImitator {
             detector: SupportDetector::new(config.support)?,
             hand_speed: config.hand_speed_for(&tuning),
+            hand_rates: HandRates::default(),
             human_double_time: 0.0,
             foot_speed: config.max_task_speed.unwrap_or(tuning.task_speed),
             motion: config.motion_for(&tuning),
@@ -469,10 +472,13 @@ impl KoenemannImitator {
         let previous = self.hands.unwrap_or(current);
         // Both feet down and no foot landing: the robot stands on both.
         let robot_double = self.mode == SupportMode::Double && self.landing.is_none();
-        let reach = (self.hand_speed).at(self.human_double_time, robot_double) * dt;
+        let cap = (self.hand_speed).at(self.human_double_time, robot_double);
+        let distances = [0, 1].map(|k| (wanted[k] - previous[k]).norm());
+        let acceleration = self.hand_speed.acceleration;
+        let speeds = (self.hand_rates).advance([cap; 2], acceleration, distances, dt);
         let radius = 0.5 * (self.body.hips[0] - self.body.hips[1]).norm();
         let targets = [0, 1].map(|k| {
-            let moved = step_toward(previous[k], wanted[k], reach);
+            let moved = step_toward(previous[k], wanted[k], speeds[k] * dt);
             outside_torso(moved, radius, &self.body)
         });
         self.hands = Some(targets);
@@ -890,7 +896,11 @@ fn human_offset(frame: &HumanFrame) -> Option<f64> {
 /// `from` moved toward `to` by at most `reach` (m).
 fn step_toward(from: Vector3<f64>, to: Vector3<f64>, reach: f64) -> Vector3<f64> {
     let step = to - from;
-    from + step * (reach / step.norm().max(reach))
+    let distance = step.norm();
+    match distance <= reach {
+        true => to,
+        false => from + step * (reach / distance),
+    }
 }
 
 /// `p` pushed out of the torso's vertical cylinder of `radius` around the torso's z axis,

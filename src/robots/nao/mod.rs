@@ -305,6 +305,18 @@ pub fn self_collision() -> SelfCollision {
 ///   2.8–6.3 cm and the hands' lag from 0.40–0.47 s to 0.07–0.17 s. Koenemann's method with the
 ///   same rule: 16 of 16 pass (loaded feet turn at most 1.6°); hands 9.1 / 8.5 → 8.6 / 4.3 cm
 ///   on the Kinect clips and 5.1 → 2.8 cm on CMU 02_10, lag 0.40–0.50 → 0.10–0.13 s.
+/// * The hands' speed shaped at 2 m/s² (the imitation's `HandRates`: a hand starts and brakes
+///   instead of reaching its speed within a frame), and then 0.8 m/s on both feet and 0.3 m/s
+///   on one: 16 of 16 pass (hold 60), loaded feet slipping ≤ 1.5 mm and turning ≤ 1.0°, the
+///   weak model's CoM ≥ 99.3 % in the contact area (99.7 % before); the mean hand error over
+///   the clip drops on every clip (2.5–11.5 cm, was 2.8–12.8) and the lag to 0.07–0.22 s (CMU
+///   05_12 was 1.5 s late). Koenemann's method, `--offline` and the dynamic walk pass 16 of 16
+///   too. With 0.15 m/s on one foot Koenemann's method failed a run (CMU 05_02: a loaded foot
+///   turned 2.5°); at 4 m/s² and 0.8 m/s the hands came closer on the balancing clip (1.8 cm)
+///   but a loaded foot slipped 4.4 mm on the weak model (5 allowed); at 1.2 m/s no closer (the
+///   acceleration decides). The cost: with the automatic hold (shorter than 60 s) the weak
+///   model's CoM was outside the contact area 3.1 % of CMU 05_12 (1.4 % unshaped at 0.15 m/s;
+///   14 of 16 pass either way).
 /// * The torso 0.02 m low: with 0.1 m shanks both knees end up straight at the standing height.
 /// * A 0.25 rad lean over the stance foot: upright, the stance hip-roll servo holds the upper
 ///   body at 88 % of its rated torque (beyond a weak servo's limit); leaning 0.25 rad lowers the
@@ -317,8 +329,9 @@ pub fn self_collision() -> SelfCollision {
 ///   about 0.6 s, 0.15 m/s and 0.6 m/s² of the CoM on the 0.1 m stance.
 pub const TUNING: MotionTuning = MotionTuning {
     task_speed: 0.15,
-    tracking_speed: 0.45,
-    stance_tracking_speed: 0.15,
+    tracking_speed: 0.8,
+    stance_tracking_speed: 0.3,
+    tracking_acceleration: 2.0,
     upper_body_velocity_fraction: 0.5,
     torso_lowering: 0.02,
     torso_lean: 0.25,
