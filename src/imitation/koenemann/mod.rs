@@ -6,8 +6,8 @@
 //! 1. **Posture mapping** ([`mapping`], §III–IV.B, eq. 1–5): the hands relative to the
 //!    shoulders and the feet relative to the hips, scaled by the limb ratios from a T-pose
 //!    calibration, become targets in the robot's torso frame. The arms follow by weighted
-//!    damped least squares ([`Method::WeightedDls`](crate::solver::Method::WeightedDls), a fixed
-//!    30 iterations as in the paper).
+//!    damped least squares ([`Method::WeightedDls`](crate::solver::Method::WeightedDls), at most
+//!    4 iterations a frame from the last frame's posture, where the paper runs 30).
 //! 2. **CoM control** ([`offset`], §V.A, eq. 6): the robot's CoM offset between its feet moves
 //!    toward the human's (or toward the support foot when the human stands on one), its speed
 //!    a negative quadratic of the offset, its acceleration bounded.
@@ -71,10 +71,17 @@ pub struct KoenemannConfig {
     /// Damping `λ` of the arms' least-squares IK (m). Default 0.01 (the paper's 0.3 is for its
     /// own scaling of the Jacobian, which it does not give).
     pub damping: f64,
-    /// Iterations of the arms' IK per frame (paper: 30).
+    /// Largest number of iterations of the arms' IK per frame. Default 4 (the paper: 30); see
+    /// [`KoenemannConfig::max_leg_iterations`].
     pub arm_iterations: usize,
     /// Largest number of iterations of the legs' stabilizing IK per frame (the paper runs it
-    /// to tolerance: 1784 at worst). Default 200.
+    /// to tolerance: 1784 at worst). Default 4: each IK starts from the last frame's posture,
+    /// so a goal it does not meet in a frame it goes on approaching in the next, and every
+    /// frame costs about the same. With the arms' 30 and the legs' 200 one frame in a hundred
+    /// cost 3–12 times the median (the arms at their cap on half of CMU 02_10's frames, the
+    /// legs 30–96 iterations where single support leaves their lowest goals out of reach); at
+    /// 4 and 4 the step's p99 is within 2.5 times its median on the bundled clips, and the
+    /// physics judge passes the same runs (the closing note of issue 32).
     pub max_leg_iterations: usize,
     /// Tolerance of the legs' IK (m; a normal's error counts 0.033 rad as 1 mm). Default 1e-3.
     pub tolerance: f64,
@@ -88,8 +95,8 @@ impl Default for KoenemannConfig {
             offset_speed: None,
             offset_tolerance: 0.05,
             damping: 0.01,
-            arm_iterations: 30,
-            max_leg_iterations: 200,
+            arm_iterations: 4,
+            max_leg_iterations: 4,
             tolerance: 1e-3,
         }
     }
