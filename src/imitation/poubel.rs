@@ -212,7 +212,6 @@ impl PoubelImitator {
             // A dynamic walk starts from double support and holds the arms where they are: at
             // the double-support speed they stopped within a frame and the judge's weak NAO
             // fell on CMU 05_02 (16 of 16 runs passed at the stance speed).
-            hand_rates: HandRates::default(),
             hand_speed: match (walk.is_some(), config.hand_speed_for(&tuning)) {
                 (true, speed) => HandSpeed {
                     double: speed.stance,
@@ -220,6 +219,7 @@ impl PoubelImitator {
                 },
                 (false, speed) => speed,
             },
+            hand_rates: HandRates::default(),
             phases,
             effectors,
             phase: SupportPhase::Double,

@@ -80,8 +80,9 @@ pub struct KoenemannConfig {
     /// frame costs about the same. With the arms' 30 and the legs' 200 one frame in a hundred
     /// cost 3–12 times the median (the arms at their cap on half of CMU 02_10's frames, the
     /// legs 30–96 iterations where single support leaves their lowest goals out of reach); at
-    /// 4 and 4 the step's p99 is within 2.5 times its median on the bundled clips, and the
-    /// physics judge passes the same runs (the closing note of issue 32).
+    /// 4 and 4 the p99 fell 2–8 times on the slow clips (NAO ≤ 262 µs, G1 ≤ 425 µs) with
+    /// medians no higher, and the physics judge passes the same runs (the closing note of
+    /// issue 32).
     pub max_leg_iterations: usize,
     /// Tolerance of the legs' IK (m; a normal's error counts 0.033 rad as 1 mm). Default 1e-3.
     pub tolerance: f64,
