@@ -339,6 +339,63 @@ fn run(imitator: &mut Imitator, frames: &[HumanFrame]) -> Vec<RobotFrame> {
         .collect()
 }
 
+/// Koenemann et al.'s settings out of range are refused by name, before any frame.
+#[test]
+fn koenemann_config_out_of_range_is_refused_by_name() {
+    use taskstack::imitation::config::ImitationMethod;
+    use taskstack::imitation::koenemann::KoenemannConfig;
+    type Set = fn(&mut KoenemannConfig, f64);
+    let fields: [(&str, Set, &[f64]); 4] = [
+        (
+            "koenemann.damping",
+            |k, v| k.damping = v,
+            &[f64::NAN, 0.0, -1.0],
+        ),
+        (
+            "koenemann.tolerance",
+            |k, v| k.tolerance = v,
+            &[f64::INFINITY, 0.0],
+        ),
+        (
+            "koenemann.offset_tolerance",
+            |k, v| k.offset_tolerance = v,
+            &[f64::NAN, -0.1, 0.5],
+        ),
+        (
+            "koenemann.arm_posture_gain",
+            |k, v| k.arm_posture_gain = v,
+            &[f64::NAN, -0.01, 1.5],
+        ),
+    ];
+    for (name, set, values) in fields {
+        for &v in values {
+            let mut k = KoenemannConfig::default();
+            set(&mut k, v);
+            let c = ImitatorConfig {
+                method: ImitationMethod::Koenemann(k),
+                ..ImitatorConfig::default()
+            };
+            let err = Imitator::new(nao::profile(), c).err();
+            assert!(
+                matches!(err, Some(ImitationError::InvalidParameter { name: n, .. }) if n == name),
+                "{name} = {v}: {err:?}"
+            );
+        }
+    }
+    // The ends of the posture gain's range are settings, not errors.
+    for gain in [0.0, 1.0] {
+        let k = KoenemannConfig {
+            arm_posture_gain: gain,
+            ..KoenemannConfig::default()
+        };
+        let c = ImitatorConfig {
+            method: ImitationMethod::Koenemann(k),
+            ..ImitatorConfig::default()
+        };
+        assert!(Imitator::new(nao::profile(), c).is_ok(), "gain {gain}");
+    }
+}
+
 #[test]
 fn imitator_config_out_of_range_is_refused_by_name() {
     type Set = fn(&mut ImitatorConfig, f64);

@@ -117,6 +117,17 @@ impl JointBounds {
         }
     }
 
+    /// Copies the limits of the joints `columns` of `other` into `self` (joint `c` of `self` is
+    /// joint `columns[c]` of `other`; `self` has `columns.len()` joints): the bounds of a
+    /// problem over a subset of the joints. Allocation-free.
+    pub(crate) fn copy_columns(&mut self, other: &JointBounds, columns: &[usize]) {
+        for (c, &k) in columns.iter().enumerate() {
+            self.lower[c] = other.lower[k];
+            self.upper[c] = other.upper[k];
+            self.velocity[c] = other.velocity[k];
+        }
+    }
+
     /// Copies the position limits of `other` (same number of joints) into `self`, narrowed to
     /// what its velocity limits reach from `q` in `dt` seconds: `[max(q_min, q − v Δt),
     /// min(q_max, q + v Δt)]`, or the nearest position limit when `q` is outside its range by

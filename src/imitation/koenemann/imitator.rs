@@ -243,6 +243,14 @@ impl KoenemannImitator {
             dls,
             arm_settings,
         )?;
+        // The upper body drawn toward its standing posture where the hands leave it free.
+        let arms = match method.arm_posture_gain {
+            0.0 => arms,
+            gain => {
+                let gains = (shared.legs.iter()).map(|&leg| if leg { 0.0 } else { gain });
+                arms.with_posture(profile.stand.clone(), gains.collect())
+            }
+        };
         // The arms' self-collision pairs: weighted DLS has no inequalities, so a second IK
         // moves the upper body the least that keeps them apart, after the hands' IK.
         let upper_body: Vec<bool> = shared.legs.iter().map(|leg| !leg).collect();

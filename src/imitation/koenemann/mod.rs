@@ -86,6 +86,18 @@ pub struct KoenemannConfig {
     pub max_leg_iterations: usize,
     /// Tolerance of the legs' IK (m; a normal's error counts 0.033 rad as 1 mm). Default 1e-3.
     pub tolerance: f64,
+    /// Share of the way toward the profile's standing posture
+    /// ([`BipedProfile::stand`](crate::robots::BipedProfile::stand)) that each joint of the
+    /// upper body takes per iteration of the arms' IK where the hands leave it free (a gradient
+    /// term `g (q_stand − q)`, 1/iteration; 0: none). Three hand coordinates leave an arm's
+    /// joints free in two directions, and without a pull the IK let them drift into corners
+    /// of their limits where it stalls: on CMU 05_02 the NAO's left arm stuck with shoulder
+    /// pitch, shoulder roll and elbow roll at their limits for 1.5 s while the hand's target
+    /// moved 8–19 cm away. Default 0.01 (1.2 per second at four iterations a frame at
+    /// 120 Hz): the NAO's mean hand error over its bundled clips 1.7–7.4 cm (were 1.7–8.6;
+    /// Kinect ges01 6.4 → 2.9, CMU 02_10 3.3 → 2.0), and the physics judge passes every run it
+    /// passed. In [0, 1].
+    pub arm_posture_gain: f64,
 }
 
 impl Default for KoenemannConfig {
@@ -99,6 +111,7 @@ impl Default for KoenemannConfig {
             arm_iterations: 4,
             max_leg_iterations: 4,
             tolerance: 1e-3,
+            arm_posture_gain: 0.01,
         }
     }
 }
@@ -122,6 +135,13 @@ impl KoenemannConfig {
             .find(|(_, v)| !(v.is_finite() && *v > 0.0))
         {
             return Some((name, v, "must be finite and > 0"));
+        }
+        if !(0.0..=1.0).contains(&self.arm_posture_gain) {
+            return Some((
+                "koenemann.arm_posture_gain",
+                self.arm_posture_gain,
+                "must be in [0, 1]",
+            ));
         }
         if !(0.0..0.5).contains(&self.offset_tolerance) {
             return Some((
