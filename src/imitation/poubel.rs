@@ -456,7 +456,7 @@ impl PoubelImitator {
             }
         });
         let cap = self.tracking_speed(phase);
-        (self.hand_rates).advance([cap; 2], self.hand_speed.acceleration, distances, dt)
+        (self.hand_rates).advance(cap, self.hand_speed.acceleration, distances, dt)
     }
 
     /// The hands' largest speed in `phase` (m/s; [`HandSpeed`]).

@@ -201,21 +201,21 @@ impl HandSpeed {
 pub struct HandRates([f64; 2]);
 
 impl HandRates {
-    /// The speeds after `dt` seconds (s, > 0) toward targets `distances` away (m), each hand's
-    /// speed at most its `caps` entry (m/s), changing by at most `acceleration` (m/s²); a
-    /// non-finite cap, acceleration or `dt` keeps the speeds.
+    /// The speeds after `dt` seconds (s, > 0) toward targets `distances` away (m), each at most
+    /// `cap` (m/s), changing by at most `acceleration` (m/s²); a non-finite cap, acceleration
+    /// or `dt` keeps the speeds.
     pub fn advance(
         &mut self,
-        caps: [f64; 2],
+        cap: f64,
         acceleration: f64,
         distances: [f64; 2],
         dt: f64,
     ) -> [f64; 2] {
         let a = acceleration;
-        if !(caps.iter().all(|c| c.is_finite()) && a.is_finite() && dt.is_finite() && dt > 0.0) {
+        if !(cap.is_finite() && a.is_finite() && dt.is_finite() && dt > 0.0) {
             return self.0;
         }
-        for ((rate, d), cap) in self.0.iter_mut().zip(distances).zip(caps) {
+        for (rate, d) in self.0.iter_mut().zip(distances) {
             let d = if d.is_finite() { d.max(0.0) } else { 0.0 };
             let wanted = cap.min((2.0 * a * d).sqrt());
             *rate = (*rate + (wanted - *rate).clamp(-a * dt, a * dt)).max(0.0);
@@ -330,7 +330,7 @@ mod tests {
         let (mut d, mut t, mut vmax, mut amax, mut previous) =
             (distance, 0.0, 0.0_f64, 0.0_f64, 0.0);
         loop {
-            let [v, _] = rates.advance([speed.double; 2], speed.acceleration, [d, 0.0], dt);
+            let [v, _] = rates.advance(speed.double, speed.acceleration, [d, 0.0], dt);
             t += dt;
             vmax = vmax.max(v);
             if v * dt >= d {
@@ -371,26 +371,25 @@ mod tests {
     fn hand_rates_ignore_non_finite_input_and_stop() {
         let mut rates = HandRates::default();
         let dt = 0.01;
-        let caps = [0.8; 2];
-        assert_eq!(rates.advance(caps, 2.0, [1.0, 1.0], dt), [0.02, 0.02]);
+        let cap = 0.8;
+        assert_eq!(rates.advance(cap, 2.0, [1.0, 1.0], dt), [0.02, 0.02]);
+        assert_eq!(rates.advance(f64::NAN, 2.0, [1.0, 1.0], dt), [0.02, 0.02]);
         assert_eq!(
-            rates.advance([f64::NAN, 0.8], 2.0, [1.0, 1.0], dt),
+            rates.advance(cap, f64::INFINITY, [1.0, 1.0], dt),
             [0.02, 0.02]
         );
         assert_eq!(
-            rates.advance(caps, f64::INFINITY, [1.0, 1.0], dt),
+            rates.advance(cap, 2.0, [1.0, 1.0], f64::INFINITY),
             [0.02, 0.02]
         );
-        assert_eq!(
-            rates.advance(caps, 2.0, [1.0, 1.0], f64::INFINITY),
-            [0.02, 0.02]
-        );
-        // A distance that is not a number counts as arrived: the hand brakes. Each hand has
-        // its own cap.
-        let [left, right] = rates.advance([0.8, 0.03], 2.0, [f64::NAN, 1.0], dt);
-        assert_eq!((left, right), (0.0, 0.03));
+        // A distance that is not a number counts as arrived: that hand brakes, the other
+        // speeds up; a cap below a hand's speed brings it down to the cap within a·dt = 0.02
+        // (0.04 → 0.03) while the hand at rest speeds up (0 → 0.02).
+        let [left, right] = rates.advance(cap, 2.0, [f64::NAN, 1.0], dt);
+        assert_eq!((left, right), (0.0, 0.04));
+        assert_eq!(rates.advance(0.03, 2.0, [1.0, 1.0], dt), [0.02, 0.03]);
         rates.stop();
-        assert_eq!(rates.advance(caps, 2.0, [0.0, 0.0], dt), [0.0, 0.0]);
+        assert_eq!(rates.advance(cap, 2.0, [0.0, 0.0], dt), [0.0, 0.0]);
     }
 
     #[test]

@@ -483,7 +483,7 @@ impl KoenemannImitator {
         let cap = (self.hand_speed).at(self.human_double_time, robot_double);
         let distances = [0, 1].map(|k| (wanted[k] - previous[k]).norm());
         let acceleration = self.hand_speed.acceleration;
-        let speeds = (self.hand_rates).advance([cap; 2], acceleration, distances, dt);
+        let speeds = (self.hand_rates).advance(cap, acceleration, distances, dt);
         let radius = 0.5 * (self.body.hips[0] - self.body.hips[1]).norm();
         let targets = [0, 1].map(|k| {
             let moved = step_toward(previous[k], wanted[k], speeds[k] * dt);
