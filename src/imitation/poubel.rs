@@ -390,13 +390,14 @@ impl PoubelImitator {
         // The walk holds the arms; after it they start again from rest.
         self.hand_rates.stop();
         let planned = walk.targets(&self.shared.world_t_root, now);
+        let tracking_step = self.hand_speed.double * walk.iteration_dt(dt);
         let targets = FrameTargets {
             reference: &self.shared.output.reference,
             com: planned.com,
             swing_lift: planned.swing_lift,
             footstep: Some(planned.footstep),
-            tracking_step: self.hand_speed.double * walk.iteration_dt(dt),
-            hand_steps: [self.hand_speed.double * walk.iteration_dt(dt); 2],
+            tracking_step,
+            hand_steps: [tracking_step; 2],
             hand_contacts: [None; 2],
             up: planned.up,
             com_height: planned.com_height,

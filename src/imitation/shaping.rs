@@ -139,9 +139,7 @@ impl ComReference {
         let to_goal = goal - self.position;
         let distance = to_goal.norm();
         let wanted = if distance > 0.0 {
-            let speed = limits
-                .com_speed
-                .min((2.0 * limits.com_acceleration * distance).sqrt());
+            let speed = stopping_speed(limits.com_speed, limits.com_acceleration, distance);
             to_goal * (speed / distance)
         } else {
             Vector2::zeros()
@@ -193,6 +191,13 @@ impl HandSpeed {
     }
 }
 
+/// The speed toward a target `distance` away (m) that is at most `cap` (m/s) and from which
+/// braking at `acceleration` (m/s²) stops at the target: `min(cap, √(2 a d))`. The shaped
+/// references ([`ComReference`], [`HandRates`]) move toward it.
+fn stopping_speed(cap: f64, acceleration: f64, distance: f64) -> f64 {
+    cap.min((2.0 * acceleration * distance).sqrt())
+}
+
 /// How fast each hand (`[left, right]`) may move toward its target this frame (m/s): a speed
 /// per hand that changes by at most the acceleration times the time step, toward
 /// `min(cap, √(2 a d))` with `d` the hand's distance to its target, from which it can still
@@ -217,7 +222,7 @@ impl HandRates {
         }
         for (rate, d) in self.0.iter_mut().zip(distances) {
             let d = if d.is_finite() { d.max(0.0) } else { 0.0 };
-            let wanted = cap.min((2.0 * a * d).sqrt());
+            let wanted = stopping_speed(cap, a, d);
             *rate = (*rate + (wanted - *rate).clamp(-a * dt, a * dt)).max(0.0);
         }
         self.0

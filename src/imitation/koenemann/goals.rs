@@ -430,7 +430,7 @@ impl GoalRows<'_> {
         }
         let mut level = stack.level_mut(self.distance_level);
         let (mut jac, lower, upper) = level.inequalities_mut();
-        let full = &mut self.scratch[4];
+        let [.., full] = &mut *self.scratch;
         for (r, d) in self.distances.iter().enumerate() {
             d.write(
                 self.model,
