@@ -83,6 +83,9 @@ pub(super) struct FrameTargets<'a> {
     pub(super) up: Vector3<f64>,
     /// The CoM's height above the root sole (m): the target of [`Task::ComHeight`].
     pub(super) com_height: f64,
+    /// The share of [`PointTarget::Standing`]'s lowering asked for, in [0, 1]: below 1 at the
+    /// start ([`super::shaping::StartRamp`]).
+    pub(super) lowering_share: f64,
 }
 
 /// The gradient criteria of the imitator, shared by every phase.
@@ -640,7 +643,9 @@ impl PhaseTasks<'_> {
                 task.held.y,
                 task.rest_height + targets.swing_lift,
             ),
-            PointTarget::Standing { lower } => task.standing - Vector3::z() * lower,
+            PointTarget::Standing { lower } => {
+                task.standing - Vector3::z() * (lower * targets.lowering_share)
+            }
             PointTarget::Footstep { lift } => {
                 let xy = targets.footstep.map_or(task.held.xy(), |f| f.xy);
                 Vector3::new(xy.x, xy.y, task.rest_height + lift)

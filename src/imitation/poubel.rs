@@ -34,7 +34,7 @@ use super::metrics::CONTACT_HEIGHT;
 use super::phase::{Measurements, PhaseMachine, Settling, SupportKind, SupportPhase, TakeOff};
 use super::phase_solver::{Criteria, FrameTargets, PhaseSolver};
 use super::scaler::{RobotSkeleton, ScaleConfig, Scaler};
-use super::shaping::{ComReference, HandRates, HandSpeed, MotionLimits, SwingHeight};
+use super::shaping::{ComReference, HandRates, HandSpeed, MotionLimits, StartRamp, SwingHeight};
 use super::support::{HumanSupport, SupportDetector};
 use super::tables::{PointTarget, Task, TaskTable, TaskTables};
 use super::walking::follower::WalkFollower;
@@ -81,6 +81,8 @@ pub(crate) struct PoubelImitator {
     com_reference: Option<ComReference>,
     /// The shaped height of the swing foot above the ground.
     swing: SwingHeight,
+    /// The torso lowering brought in at the start.
+    start: StartRamp,
     /// Hands as supports, when configured.
     hands: Option<HandSupports>,
     /// The walk, when the feet follow the human's ([`super::walking`]).
@@ -162,6 +164,7 @@ impl PoubelImitator {
         let angles = profile.joint_angles.map(|build| build(model)).transpose()?;
         let effectors = effector_ids(profile)?;
         let tuning = profile.tuning;
+        let motion = config.motion_for(&tuning);
         let area = config.step_envelope.unwrap_or(profile.step_envelope);
         let scale = ScaleConfig {
             min_segment: config.min_segment,
@@ -232,9 +235,10 @@ impl PoubelImitator {
             },
             posture_settling: Settling::new(),
             footsteps,
-            motion: config.motion_for(&tuning),
+            motion,
             com_reference: None,
             swing: SwingHeight::at(0.0),
+            start: StartRamp::new(tuning.torso_lowering, motion.com_acceleration),
             hands,
             walk,
             rehold: false,
@@ -401,6 +405,7 @@ impl PoubelImitator {
             hand_contacts: [None; 2],
             up: planned.up,
             com_height: planned.com_height,
+            lowering_share: self.start.advance(dt),
         };
         let criteria = Criteria {
             limits: &self.limits,
@@ -541,6 +546,7 @@ impl PoubelImitator {
             hand_contacts,
             up: Vector3::z(),
             com_height: 0.0,
+            lowering_share: self.start.advance(dt),
         };
         let criteria = Criteria {
             limits: &self.limits,

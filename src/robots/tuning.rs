@@ -53,7 +53,9 @@ pub struct MotionTuning {
     /// How far below its standing height the executable task tables keep the torso (m, ≥ 0).
     /// Shifting the hips over one foot with the torso upright lengthens the far leg: at the
     /// standing height the free leg ends up straight, a singular posture it cannot lift from
-    /// quickly, and a straight leg cannot reach down the last micrometres of a landing.
+    /// quickly, and a straight leg cannot reach down the last micrometres of a landing. A robot
+    /// starting in its standing posture is lowered along a ramp of `√(6 d / com_acceleration)`
+    /// seconds (`imitation::shaping::StartRamp`).
     pub torso_lowering: f64,
     /// Sideways lean of the torso over the foot the robot stands or is about to stand on in the
     /// executable tables (rad, ≥ 0). With an upright pelvis the stance hip ends up outside the
