@@ -1,33 +1,14 @@
 //! The pattern generator's tick and the walker's tick allocate nothing after the first ticks:
-//! a counting global allocator in its own test binary counts allocations over a whole walk.
-
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
+//! a counting global allocator (per thread, `alloc_counter`) counts allocations over a whole walk.
 
 use taskstack::locomotion::{GroundPose, WalkParams, WholeBodyWalker, goal_feet, plan_steps};
 use taskstack::robots::nao;
 
-struct Counting;
-
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
-
-// SAFETY: forwards to the system allocator; only counts.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
+mod alloc_counter;
+use alloc_counter::allocations;
 
 #[global_allocator]
-static GLOBAL: Counting = Counting;
+static GLOBAL: alloc_counter::Counting = alloc_counter::Counting;
 
 #[test]
 fn a_walk_allocates_nothing_after_warm_up() {
@@ -47,7 +28,7 @@ fn a_walk_allocates_nothing_after_warm_up() {
         walker.tick().unwrap();
     }
     // Every later tick (both roots, single and double support), and steps queued on the way.
-    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    let before = allocations();
     let mut queued = rest.iter();
     let mut ticks = 0;
     while !walker.generator().is_stopped() || queued.len() > 0 {
@@ -59,7 +40,7 @@ fn a_walk_allocates_nothing_after_warm_up() {
         walker.tick().unwrap();
         ticks += 1;
     }
-    let allocations = ALLOCATIONS.load(Ordering::SeqCst) - before;
+    let allocations = allocations() - before;
     assert!(ticks > 500);
     assert_eq!(allocations, 0, "{allocations} allocations in {ticks} ticks");
 }

@@ -1,38 +1,16 @@
 //! No heap allocation in forward kinematics, Jacobians and CoM once the workspace exists: a
 //! counting global allocator around the RS-stack kinematics of the NAO.
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
-
 use faer::Mat;
 use nalgebra::Vector3;
 use taskstack::model::Axis;
 use taskstack::robots::nao;
 
-struct Counting;
-
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
-
-// SAFETY: forwards every call unchanged to the system allocator; only counts.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
-        // SAFETY: same contract as the caller's.
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: same contract as the caller's.
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
-        // SAFETY: same contract as the caller's.
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
+mod alloc_counter;
+use alloc_counter::allocations;
 
 #[global_allocator]
-static GLOBAL: Counting = Counting;
+static GLOBAL: alloc_counter::Counting = alloc_counter::Counting;
 
 #[test]
 fn kinematics_do_not_allocate_after_new_data() {
@@ -42,7 +20,7 @@ fn kinematics_do_not_allocate_after_new_data() {
     let mut j = Mat::<f64>::zeros(16, model.nv());
     let mut q = vec![0.1; model.nv()];
     let zero = Vector3::zeros();
-    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    let before = allocations();
     let mut checksum = 0.0;
     for step in 0..100 {
         q[step % 23] += 0.01;
@@ -74,7 +52,7 @@ fn kinematics_do_not_allocate_after_new_data() {
             .unwrap();
         checksum += model.com(&data).unwrap().x + j[(5, 3)];
     }
-    let after = ALLOCATIONS.load(Ordering::SeqCst);
+    let after = allocations();
     assert!(checksum.is_finite());
     assert_eq!(after - before, 0, "heap allocations in the kinematics loop");
 }

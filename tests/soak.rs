@@ -26,8 +26,6 @@
 //! cargo test --release --test soak -- --ignored --nocapture
 //! ```
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
 use std::hash::{DefaultHasher, Hasher};
 use std::path::Path;
 
@@ -47,54 +45,11 @@ use taskstack::io::clip::Clip;
 use taskstack::robots::{BipedProfile, g1, nao};
 use taskstack::scene::Scene;
 
-struct Counting;
-
-thread_local! {
-    // Const-initialised, no destructor: using them from the allocator never allocates.
-    static LIVE_BYTES: Cell<isize> = const { Cell::new(0) };
-    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
-}
-
-fn count(bytes: isize, allocations: usize) {
-    // `try_with`: the allocator may be called while a thread's locals are being torn down.
-    let _ = LIVE_BYTES.try_with(|b| b.set(b.get() + bytes));
-    let _ = ALLOCATIONS.try_with(|a| a.set(a.get() + allocations));
-}
-
-// SAFETY: forwards every call unchanged to the system allocator; only counts.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        count(layout.size() as isize, 1);
-        // SAFETY: same contract as the caller's.
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
-        count(layout.size() as isize, 1);
-        // SAFETY: same contract as the caller's.
-        unsafe { System.alloc_zeroed(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        count(-(layout.size() as isize), 0);
-        // SAFETY: same contract as the caller's.
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        count(new_size as isize - layout.size() as isize, 1);
-        // SAFETY: same contract as the caller's.
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
+mod alloc_counter;
+use alloc_counter::{allocations, live_bytes};
 
 #[global_allocator]
-static GLOBAL: Counting = Counting;
-
-fn live_bytes() -> isize {
-    LIVE_BYTES.with(Cell::get)
-}
-
-fn allocations() -> usize {
-    ALLOCATIONS.with(Cell::get)
-}
+static GLOBAL: alloc_counter::Counting = alloc_counter::Counting;
 
 const ALL: [&str; 8] = [
     "cmu_02_10_wash_self_standing_arm_gestures.bvh",

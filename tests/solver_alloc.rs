@@ -1,36 +1,17 @@
 //! A warmed-up solve allocates nothing on the heap: a counting global allocator in its own test
 //! binary (so no other test's allocations interfere) counts allocations during the solves.
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
-
 use taskstack::solver::driver::{DriverSettings, PositionDriver, TaskModel};
 use taskstack::solver::{
     JointBounds, JointLimitAvoidance, JointTracking, Method, Settings, Solver, SolverError,
     StackShape, TaskStack,
 };
 
-struct Counting;
-
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
-
-// SAFETY: forwards to the system allocator; only counts.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
+mod alloc_counter;
+use alloc_counter::allocations;
 
 #[global_allocator]
-static GLOBAL: Counting = Counting;
+static GLOBAL: alloc_counter::Counting = alloc_counter::Counting;
 
 const N: usize = 23;
 
@@ -127,7 +108,7 @@ fn warmed_up_solves_do_not_allocate_with(shape: &StackShape, method: Method) {
     fill(&mut solver, 0);
     solver.solve(&q, &bounds, 0.01).unwrap();
 
-    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    let before = allocations();
     let (mut clamped, mut active) = (0, 0);
     for salt in 0..50 {
         fill(&mut solver, salt);
@@ -144,7 +125,7 @@ fn warmed_up_solves_do_not_allocate_with(shape: &StackShape, method: Method) {
     driver
         .run(&mut solver, &mut model, &mut q_driver, &bounds)
         .unwrap();
-    let after = ALLOCATIONS.load(Ordering::SeqCst);
+    let after = allocations();
     assert!(clamped > 0, "the clamping loop was exercised");
     let inequalities = solver.stack().total_inequality_rows();
     assert!(
