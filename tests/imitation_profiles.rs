@@ -201,8 +201,8 @@ fn profile_errors_name_the_field() {
 
 /// The G1 starts standing in its profile's posture and the tables keep its pelvis 5 cm lower:
 /// the lowering comes in along a ramp whose vertical acceleration stays near the CoM's bound
-/// (0.3 m/s²) instead of a 0.15 m/s step in the first frame (≈ 18 m/s² at 120 Hz), which set the
-/// judge's G1 rocking on its soles. The pelvis height is read off every frame's joint angles
+/// (0.3 m/s²) instead of a 0.15 m/s step in the first frame (4.6 m/s² on this 30 Hz clip before
+/// the ramp), which set the judge's G1 rocking on its soles. The pelvis height is read off every frame's joint angles
 /// through the model's forward kinematics.
 #[test]
 fn g1_lowers_its_torso_smoothly_at_the_start() {

@@ -257,10 +257,8 @@ impl StartRamp {
     /// The ramp of a lowering of `lowering` m whose acceleration stays within `acceleration`
     /// m/s² (no ramp for a lowering ≤ 0).
     pub fn new(lowering: f64, acceleration: f64) -> Self {
-        let duration = match lowering > 0.0 && acceleration > 0.0 {
-            true => (6.0 * lowering / acceleration).sqrt(),
-            false => 0.0,
-        };
+        // NaN, 0 or ∞ for a lowering ≤ 0 or an acceleration ≤ 0: no ramp.
+        let duration = (6.0 * lowering / acceleration).sqrt();
         Self {
             duration: if duration.is_finite() { duration } else { 0.0 },
             elapsed: 0.0,
