@@ -174,6 +174,29 @@ impl Model {
         Ok(())
     }
 
+    /// Adds `directionᵀ J` to the 1×n view `out`, with `J` the [`Model::point_jacobian`] of the
+    /// point at `offset` from `frame` (`direction` in the base frame's axes; the rate of the
+    /// point's displacement along it, m per unit q̇ for a unit direction). It adds, so that
+    /// `nᵀ (J₁ − J₂)`, the rate of a distance between two points, takes two calls (the second
+    /// with `−n`) and no 3×n scratch.
+    pub fn add_point_jacobian_along(
+        &self,
+        data: &ModelData,
+        frame: FrameId,
+        offset: &Vector3<f64>,
+        direction: &Vector3<f64>,
+        mut out: MatMut<'_, f64>,
+    ) -> Result<(), ModelError> {
+        let x = self.point_position(data, frame, offset)?;
+        self.check_shape(&out, 1)?;
+        let link = self.frames[frame.0].link;
+        for &i in &self.chain[self.chain_start[link]..self.chain_start[link + 1]] {
+            let (k, column) = self.point_column(data, i, &x);
+            out[(0, k)] += direction.dot(&column);
+        }
+        Ok(())
+    }
+
     /// 3×n orientation Jacobian of `frame`: maps `q̇` to the frame's angular velocity in the base
     /// frame (rad/s per unit q̇), written into `out`.
     pub fn orientation_jacobian(
@@ -302,7 +325,7 @@ impl Model {
         Ok(())
     }
 
-    fn check_frame(&self, frame: FrameId) -> Result<(), ModelError> {
+    pub(crate) fn check_frame(&self, frame: FrameId) -> Result<(), ModelError> {
         if frame.0 >= self.frames.len() {
             return Err(ModelError::FrameOutOfRange(frame.0));
         }

@@ -11,13 +11,12 @@
 //! near), Jacobian `νᵀ J_p`. Each task is one row `margin − d ≤ C δq ≤ +∞`.
 
 use std::any::Any;
-use std::cell::RefCell;
 
-use faer::{Mat, MatMut};
+use faer::MatMut;
 use nalgebra::Vector3;
 
 use super::inequality::InequalityTask;
-use super::{TaskError, combine_rows, finite_target};
+use super::{TaskError, finite_target};
 use crate::model::{FrameId, Model, ModelData, ModelError};
 
 /// A segment `[a, b]` fixed in a frame (m, in the frame's axes), swept by a sphere of `radius`
@@ -198,15 +197,15 @@ pub struct CapsuleDistanceTask {
     first: Capsule,
     second: Capsule,
     margin: f64,
-    /// Point-Jacobian scratch (3 × nv each), so that writing does not allocate.
-    scratch: RefCell<(Mat<f64>, Mat<f64>)>,
 }
 
 impl CapsuleDistanceTask {
-    /// Keeps `first` and `second` at least `margin` (m, ≥ 0) apart; named `name`.
+    /// Keeps `first` and `second` (capsules on frames of `model`) at least `margin` (m, ≥ 0)
+    /// apart; named `name`.
     ///
     /// # Errors
-    /// [`TaskError::NonFiniteTarget`], [`TaskError::InvalidGeometry`] for a bad margin.
+    /// [`TaskError::NonFiniteTarget`], [`TaskError::InvalidGeometry`] for a bad margin;
+    /// [`TaskError::Model`] for a capsule on a frame `model` does not have.
     pub fn new(
         model: &Model,
         name: &str,
@@ -215,13 +214,13 @@ impl CapsuleDistanceTask {
         margin: f64,
     ) -> Result<Self, TaskError> {
         check_margin(name, margin)?;
-        let nv = model.nv();
+        model.check_frame(first.frame)?;
+        model.check_frame(second.frame)?;
         Ok(Self {
             name: name.to_owned(),
             first,
             second,
             margin,
-            scratch: RefCell::new((Mat::zeros(3, nv), Mat::zeros(3, nv))),
         })
     }
 
@@ -254,13 +253,11 @@ impl InequalityTask for CapsuleDistanceTask {
         upper: &mut [f64],
     ) -> Result<(), ModelError> {
         let closest = self.closest(model, data)?;
-        let mut scratch = self.scratch.borrow_mut();
-        let (j1, j2) = &mut *scratch;
         let (first, second) = (self.first.local(closest.s), self.second.local(closest.t));
-        model.point_jacobian(data, self.first.frame, &first, j1.as_mut())?;
-        model.point_jacobian(data, self.second.frame, &second, j2.as_mut())?;
-        *j1 -= &*j2;
-        combine_rows(&closest.normal, j1.as_ref(), jacobian.as_mut());
+        jacobian.fill(0.0);
+        let n = closest.normal;
+        model.add_point_jacobian_along(data, self.first.frame, &first, &n, jacobian.as_mut())?;
+        model.add_point_jacobian_along(data, self.second.frame, &second, &-n, jacobian.as_mut())?;
         write_room(self.margin, closest.distance, lower, upper);
         Ok(())
     }
@@ -279,16 +276,15 @@ pub struct PlaneDistanceTask {
     point: Vector3<f64>,
     normal: Vector3<f64>,
     margin: f64,
-    scratch: RefCell<Mat<f64>>,
 }
 
 impl PlaneDistanceTask {
-    /// Keeps `capsule` at least `margin` (m) on the `normal` side of the plane through `point`;
-    /// named `name`. `normal` is normalized.
+    /// Keeps `capsule` (on a frame of `model`) at least `margin` (m) on the `normal` side of the
+    /// plane through `point`; named `name`. `normal` is normalized.
     ///
     /// # Errors
     /// [`TaskError::NonFiniteTarget`]; [`TaskError::InvalidGeometry`] for a zero normal or a
-    /// negative margin.
+    /// negative margin; [`TaskError::Model`] for a capsule on a frame `model` does not have.
     pub fn new(
         model: &Model,
         name: &str,
@@ -298,6 +294,7 @@ impl PlaneDistanceTask {
         margin: f64,
     ) -> Result<Self, TaskError> {
         check_margin(name, margin)?;
+        model.check_frame(capsule.frame)?;
         finite_target(name, point.as_slice())?;
         finite_target(name, normal.as_slice())?;
         if normal.norm() < 1e-12 {
@@ -312,7 +309,6 @@ impl PlaneDistanceTask {
             point,
             normal: normal.normalize(),
             margin,
-            scratch: RefCell::new(Mat::zeros(3, model.nv())),
         })
     }
 
@@ -358,10 +354,10 @@ impl InequalityTask for PlaneDistanceTask {
         upper: &mut [f64],
     ) -> Result<(), ModelError> {
         let (d, s) = self.nearest(model, data)?;
-        let mut j = self.scratch.borrow_mut();
         let offset = self.capsule.local(s);
-        model.point_jacobian(data, self.capsule.frame, &offset, j.as_mut())?;
-        combine_rows(&self.normal, j.as_ref(), jacobian.as_mut());
+        jacobian.fill(0.0);
+        let (frame, normal) = (self.capsule.frame, &self.normal);
+        model.add_point_jacobian_along(data, frame, &offset, normal, jacobian.as_mut())?;
         write_room(self.margin, d, lower, upper);
         Ok(())
     }

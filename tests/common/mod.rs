@@ -90,6 +90,12 @@ pub fn frame_jacobian_error(
             zrow.as_mut().submatrix_mut(2, 0, 1, n),
         )
         .unwrap();
+    // Along an oblique direction, added onto a row of ones (it must add, not overwrite).
+    let direction = Vector3::new(0.48, -0.6, 0.64);
+    let mut along = Mat::<f64>::from_fn(1, n, |_, _| 1.0);
+    model
+        .add_point_jacobian_along(&data, frame, offset, &direction, along.as_mut())
+        .unwrap();
     let mut worst: f64 = 0.0;
     for k in 0..n {
         let dp = diff(
@@ -113,6 +119,7 @@ pub fn frame_jacobian_error(
             worst = worst.max((jr[(r, k)] - dr[r]).abs());
         }
         worst = worst.max((zrow[(2, k)] - dp[2]).abs());
+        worst = worst.max((along[(0, k)] - 1.0 - direction.dot(&dp)).abs());
         // Rows of the buffer outside the view must stay untouched.
         worst = worst
             .max(zrow[(0, k)].abs())
