@@ -419,8 +419,23 @@ impl TaskStack {
         &self.target
     }
 
-    /// Finds the first non-finite number, naming its place.
+    /// Checks that every number of the stack is finite and every inequality row's bounds are
+    /// valid; an error names the first offending place. A solve calls this every time, so the
+    /// common case (all finite) is one quick pass, and only a failure is searched row by row.
     pub(crate) fn check_finite(&self) -> Result<(), SolverError> {
+        let columns_finite = |m: &Mat<f64>| (0..m.ncols()).all(|c| all_finite(m.col_as_slice(c)));
+        if columns_finite(&self.jacobian_t)
+            && all_finite(&self.target)
+            && columns_finite(&self.inequality_jacobian_t)
+            && all_finite(&self.gradient)
+        {
+            return self.check_inequality_bounds();
+        }
+        self.find_non_finite()
+    }
+
+    /// Finds the first non-finite number, naming its place.
+    fn find_non_finite(&self) -> Result<(), SolverError> {
         for (j, level) in self.shape.levels.iter().enumerate() {
             for row in self.level_start[j]..self.level_start[j + 1] {
                 let local = row - self.level_start[j];
@@ -454,7 +469,7 @@ impl TaskStack {
         check_finite_slice("gradient term", &self.gradient)
     }
 
-    /// Finite inequality Jacobians; bounds not NaN, `l ≤ u`, `l < +∞` and `u > −∞`.
+    /// Finite inequality Jacobians, then [`TaskStack::check_inequality_bounds`].
     fn check_inequalities(&self) -> Result<(), SolverError> {
         for (j, level) in self.shape.levels.iter().enumerate() {
             for row in self.inequality_start[j]..self.inequality_start[j + 1] {
@@ -473,6 +488,16 @@ impl TaskStack {
                         value: v,
                     });
                 }
+            }
+        }
+        self.check_inequality_bounds()
+    }
+
+    /// Inequality bounds not NaN, `l ≤ u`, `l < +∞` and `u > −∞`.
+    fn check_inequality_bounds(&self) -> Result<(), SolverError> {
+        for (j, level) in self.shape.levels.iter().enumerate() {
+            for row in self.inequality_start[j]..self.inequality_start[j + 1] {
+                let local = row - self.inequality_start[j];
                 let (lower, upper) = (self.lower[row], self.upper[row]);
                 if lower.is_nan() || upper.is_nan() {
                     return Err(SolverError::NonFinite {
@@ -643,6 +668,20 @@ pub(crate) fn check_len(what: &str, expected: usize, got: usize) -> Result<(), S
     }
 }
 
+/// Whether every value is finite: `0 · v` is ±0 for a finite `v` and NaN otherwise, summed in
+/// four independent lanes so that the loop vectorizes.
+fn all_finite(values: &[f64]) -> bool {
+    let mut lanes = [0.0; 4];
+    let chunks = values.chunks_exact(4);
+    let rest: f64 = chunks.remainder().iter().map(|v| 0.0 * v).sum();
+    for chunk in chunks {
+        for (lane, v) in lanes.iter_mut().zip(chunk) {
+            *lane += 0.0 * v;
+        }
+    }
+    lanes.iter().sum::<f64>() + rest == 0.0
+}
+
 pub(crate) fn check_finite_slice(what: &str, values: &[f64]) -> Result<(), SolverError> {
     match values.iter().enumerate().find(|(_, v)| !v.is_finite()) {
         None => Ok(()),
@@ -650,5 +689,26 @@ pub(crate) fn check_finite_slice(what: &str, values: &[f64]) -> Result<(), Solve
             what: format!("{what} at index {i}"),
             value,
         }),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::all_finite;
+
+    /// Every length up to three chunks and a remainder, a bad value at every place: found.
+    #[test]
+    fn all_finite_finds_a_bad_value_in_every_lane_and_the_remainder() {
+        for len in 0..11 {
+            let values: Vec<f64> = (0..len).map(|i| f64::MAX / (i + 1) as f64).collect();
+            assert!(all_finite(&values), "{len}");
+            for at in 0..len {
+                for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+                    let mut v = values.clone();
+                    v[at] = bad;
+                    assert!(!all_finite(&v), "{len} {at} {bad}");
+                }
+            }
+        }
     }
 }
