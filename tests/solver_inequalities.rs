@@ -141,6 +141,12 @@ fn solve(problem: &Problem, levels: usize) -> (Vec<f64>, Solver) {
         ..Settings::default()
     };
     let mut solver = Solver::with_settings(&shape(problem, levels), settings).unwrap();
+    let velocity = solve_with(&mut solver, problem, levels);
+    (velocity, solver)
+}
+
+/// Loads the first `levels` levels of `problem` into `solver` (of their shape) and solves.
+fn solve_with(solver: &mut Solver, problem: &Problem, levels: usize) -> Vec<f64> {
     for (j, level) in problem.levels[..levels].iter().enumerate() {
         let mut l = solver.stack_mut().level_mut(j);
         for (t, (row, target)) in level.equalities.iter().enumerate() {
@@ -155,12 +161,38 @@ fn solve(problem: &Problem, levels: usize) -> (Vec<f64>, Solver) {
         .gradient_mut()
         .copy_from_slice(&problem.gradient);
     let bounds = JointBounds::new(&problem.lo, &problem.hi).unwrap();
-    let velocity = solver
+    solver
         .solve(&vec![0.0; problem.n], &bounds, 1.0)
         .unwrap()
         .velocity
-        .to_vec();
-    (velocity, solver)
+        .to_vec()
+}
+
+/// A problem of `problem`'s shape with other rows, targets, bounds and joint intervals (from
+/// `seed`), so that its active set differs.
+fn same_shape(problem: &Problem, seed: u64) -> Problem {
+    let other = random_problem(seed, true);
+    let mut rng = Rng(seed ^ 0x5555);
+    let n = problem.n;
+    let mut row = || (0..n).map(|_| rng.uniform(-1.0, 1.0)).collect::<Vec<_>>();
+    let levels = (problem.levels.iter())
+        .map(|level| Level {
+            equalities: (level.equalities.iter())
+                .map(|(_, target)| (row(), -target))
+                .collect(),
+            inequalities: (level.inequalities.iter())
+                .map(|(_, lower, upper)| (row(), -upper, -lower))
+                .collect(),
+        })
+        .collect();
+    let pick = |v: &[f64], i: usize| v.get(i).copied().unwrap_or(1.0);
+    Problem {
+        n,
+        levels,
+        lo: (0..n).map(|i| -pick(&other.hi, i).abs().min(0.5)).collect(),
+        hi: (0..n).map(|i| pick(&other.lo, i).abs().min(0.5)).collect(),
+        gradient: vec![0.0; n],
+    }
 }
 
 /// Level `j`'s cost `½‖J q̇ − ẋ‖² + ½‖v(q̇)‖²`.
@@ -391,6 +423,41 @@ proptest! {
         );
     }
 
+    /// A warm start from another problem's active set (same shape, other rows and bounds)
+    /// reaches the reference optimum all the same, and a warm start from the problem's own
+    /// optimum takes one pass.
+    #[test]
+    fn a_warm_start_from_any_active_set_equals_the_reference_qp(
+        seed in any::<u64>(),
+        other in any::<u64>(),
+    ) {
+        let problem = random_problem(seed, true);
+        let expected = reference(&problem);
+        prop_assume!(expected.is_some(), "the reference QP found no solution");
+        let expected = expected.unwrap();
+        let levels = problem.levels.len();
+        let settings = Settings {
+            damping_threshold: 0.0,
+            limits_by_active_set: true,
+            warm_start: true,
+            ..Settings::default()
+        };
+        let mut solver = Solver::with_settings(&shape(&problem, levels), settings).unwrap();
+        solve_with(&mut solver, &same_shape(&problem, other), levels);
+        let ours = solve_with(&mut solver, &problem, levels);
+        prop_assert!(solver.report().converged());
+        let error = norm(&ours.iter().zip(&expected).map(|(a, b)| a - b).collect::<Vec<_>>());
+        prop_assert!(
+            error <= 1e-5 * (1.0 + norm(&expected))
+                || lexicographically_better(&problem, &ours, &expected, 1e-12),
+            "ours {ours:?}\nreference {expected:?}\n{problem:?}\n{:?}", solver.report()
+        );
+        let again = solve_with(&mut solver, &problem, levels);
+        prop_assert_eq!(solver.report().active_set_iterations(), 1);
+        let change = norm(&again.iter().zip(&ours).map(|(a, b)| a - b).collect::<Vec<_>>());
+        prop_assert!(change <= 1e-9 * (1.0 + norm(&ours)), "{again:?} vs {ours:?}");
+    }
+
     /// Adding lower levels costs no higher level anything, equality or inequality; every joint
     /// stays in its interval.
     #[test]
@@ -517,4 +584,41 @@ fn a_damped_level_cycle_ends_the_solve_at_once() {
     assert!((solution.velocity[0] - 0.5).abs() < 1e-12);
     assert!((solution.velocity[1] - 1.5).abs() < 1e-12);
     assert_eq!(report.clamped_joints(), &[0]);
+}
+
+/// The damped cycle above with a warm start: a warm start that does not converge is solved again
+/// cold, so every solve ends where the cold one does (`(0.5, 1.5)`), the second one too, whose
+/// warm set holds the bound the cycle ended on.
+#[test]
+fn a_warm_start_that_cycles_ends_where_the_cold_solve_does() {
+    let shape = StackShape::new(2)
+        .with_level("sum", &[("sum", 1)])
+        .with_level("difference", &[("difference", 1)]);
+    let settings = Settings {
+        limits_by_active_set: true,
+        warm_start: true,
+        ..Settings::default()
+    };
+    let mut solver = Solver::with_settings(&shape, settings).unwrap();
+    let s = 0.01 / 2.0_f64.sqrt();
+    let stack = solver.stack_mut();
+    stack.level_mut(0).set_row(0, &[1.0, 1.0], 2.0).unwrap();
+    stack.level_mut(1).set_row(0, &[s, -s], -2.0 * s).unwrap();
+    let bounds = JointBounds::new(&[-10.0, -10.0], &[0.5, 10.0]).unwrap();
+    for _ in 0..2 {
+        let solution = solver.solve(&[0.0, 0.0], &bounds, 1.0).unwrap();
+        assert!(!solution.report.converged());
+        // The warm steps, then the cold solve's 4.
+        assert!(solution.report.active_set_iterations() > 4);
+        assert!(
+            (solution.velocity[0] - 0.5).abs() < 1e-12,
+            "{:?}",
+            solution.velocity
+        );
+        assert!(
+            (solution.velocity[1] - 1.5).abs() < 1e-12,
+            "{:?}",
+            solution.velocity
+        );
+    }
 }

@@ -98,9 +98,11 @@ pub struct ImitatorConfig {
     /// Time step assumed for the first frame, and for a frame with the same time as the previous
     /// one (s). Default 1/120 s.
     pub nominal_dt: f64,
-    /// Numerical settings of the solver. The imitator always turns
-    /// [`Settings::scale_to_fit`] on: when the velocity limits bind, the whole step slows down
-    /// uniformly instead of the clamping loop pinning joints the balance level needs.
+    /// Numerical settings of the solver. Poubel et al.'s method turns
+    /// [`Settings::scale_to_fit`] on for tables without inequality rows (when the velocity
+    /// limits bind, the whole step slows down uniformly instead of the clamping loop pinning
+    /// joints the balance level needs) and [`Settings::warm_start`] on (each frame's
+    /// active-set solve starts from the last frame's active bounds).
     pub solver: Settings,
     /// Initial posture (model variable order, rad); `None` (default): the profile's
     /// [`BipedProfile::stand`](crate::robots::BipedProfile::stand).

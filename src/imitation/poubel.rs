@@ -117,9 +117,12 @@ fn phase_solvers(
             // instead of the clamping loop pinning joints the balance level needs. A table with
             // inequalities has the joint intervals as the top inequalities of the active set
             // instead, which never pins a joint a level needs either.
+            // A phase's active bounds change little from one frame to the next: its
+            // active-set solves start from the last frame's (most frames take one pass).
             let inequalities = table.levels.iter().any(|l| !l.constraints.is_empty());
             let settings = Settings {
                 scale_to_fit: !inequalities,
+                warm_start: true,
                 ..solver
             };
             PhaseSolver::new(table, profile, q, settings)

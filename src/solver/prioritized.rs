@@ -117,6 +117,17 @@ pub struct Settings {
     /// inequality rows; this switch asks for it on equality-only stacks too. Default off.
     /// Not available with [`Settings::scale_to_fit`] or [`Method::WeightedDls`].
     pub limits_by_active_set: bool,
+    /// Start the active-set method from the bounds held at the end of the previous solve
+    /// instead of from none (a warm start): the method activates what that guess lacks and
+    /// releases what it holds wrongly, so the result is the same lexicographic optimum up to
+    /// rounding whenever the method converges (it is unique: the last level is `‖q̇ − g‖²`).
+    /// In a control loop, where one tick's active bounds are mostly the last tick's, most of
+    /// the passes that add them one at a time are saved. A damped level's or a capped solve's
+    /// end may depend on the path, so the result may then differ a little from a cold start.
+    /// Default off: each solve starts from no active bound. Only the active-set method starts
+    /// warm (a stack with inequality rows, or [`Settings::limits_by_active_set`]); the
+    /// clamping loop's result depends on the order it pins joints in, so it always starts cold.
+    pub warm_start: bool,
 }
 
 impl Default for Settings {
@@ -129,6 +140,7 @@ impl Default for Settings {
             scale_to_fit: false,
             method: Method::Prioritized,
             limits_by_active_set: false,
+            warm_start: false,
         }
     }
 }

@@ -23,7 +23,10 @@
 //! bound, each active joint clamped — solved exactly by the null-space recursion of
 //! [`prioritized`](super). The iterate `x` starts at `0` with the joints outside their interval
 //! clamped to it and the rows it violates active; from then on every inactive row and free joint
-//! holds at `x`. Each step:
+//! holds at `x`. A **warm start** ([`Settings::warm_start`](crate::solver::Settings::warm_start))
+//! starts from the bounds the previous solve ended with instead, and when the first `x*` meets
+//! every bound, `x = x*` (a feasible iterate) and the method goes on at step 3, which releases
+//! the bounds not wanted; in a control loop most solves end there. Each step:
 //!
 //! 1. `x* =` the hierarchy's solution for the active set.
 //! 2. If moving from `x` to `x*` would take an inactive row or a free joint past a bound, move to
@@ -84,6 +87,10 @@ pub(crate) struct ActiveSetWorkspace {
     seen: Vec<u8>,
     /// Slots of `seen` in use.
     seen_count: usize,
+    /// The bound each joint and inequality row was held at when the last solve ended: the
+    /// start of the next one with [`Settings::warm_start`](crate::solver::Settings::warm_start).
+    warm_joints: Vec<Option<Bound>>,
+    warm_rows: Vec<Option<Bound>>,
 }
 
 impl ActiveSetWorkspace {
@@ -98,6 +105,8 @@ impl ActiveSetWorkspace {
             decided_joints: vec![false; dof],
             seen: vec![0; (iteration_cap(dof, inequalities) + 1) * (dof + inequalities)],
             seen_count: 0,
+            warm_joints: vec![None; dof],
+            warm_rows: vec![None; inequalities],
         }
     }
 
@@ -156,22 +165,47 @@ fn judge(pull: f64, tolerance: f64, bound: Constraint, decided: &mut bool, worst
 impl Solver {
     /// Solves with the joint intervals in `step_lo`/`step_hi` (±∞ for none) and the inequality
     /// rows by the active-set method; writes `velocity` and the report's joint and iteration
-    /// entries.
+    /// entries. A warm start that does not converge (a damped level's cycle, or the cap) is
+    /// solved again cold: a bound the warm set carried in can keep such a cycle going frame
+    /// after frame (on the NAO's hand levels it left the hands 15 cm off), where a cold
+    /// start's path would not have met it.
     pub(super) fn solve_active_set(&mut self) {
         let n = self.stack.dof();
-        let rows = self.stack.total_inequality_rows();
         self.scales.fill(1.0);
-        self.start_active_set();
-        let cap = iteration_cap(n, rows);
-        let (mut iterations, mut converged) = (0, false);
-        while iterations < cap {
-            iterations += 1;
+        let warm = self.settings.warm_start;
+        let (mut iterations, mut converged) = self.run_active_set(warm);
+        if warm && !converged {
+            let (cold, cold_converged) = self.run_active_set(false);
+            (iterations, converged) = (iterations + cold, cold_converged);
+        }
+        self.velocity.copy_from_slice(&self.active_set.point);
+        self.keep_active_set();
+        self.report.clamped.clear();
+        self.report
+            .clamped
+            .extend((0..n).filter(|&i| self.clamped[i]));
+        self.report.clamping_iterations = 0;
+        self.report.active_set_iterations = iterations;
+        self.report.converged = converged;
+    }
+
+    /// The method's steps from a cold or `warm` start until it converges, meets an active set
+    /// again or reaches its cap; the iterate is left in the workspace's `point`. Returns the
+    /// steps taken and whether it converged.
+    fn run_active_set(&mut self, warm: bool) -> (usize, bool) {
+        let n = self.stack.dof();
+        self.start_active_set(warm);
+        let cap = iteration_cap(n, self.stack.total_inequality_rows());
+        for iterations in 1..=cap {
             self.prioritized_pass();
+            // A warm set's first solution that meets every bound is a feasible iterate
+            // itself: the method goes on from there.
+            let warm_start_met = warm && iterations == 1 && self.meets_bounds();
             let ws = &mut self.active_set;
             for i in 0..n {
                 ws.direction[i] = self.velocity[i] - ws.point[i];
             }
-            if let Some((tau, blocking)) = self.first_blocking() {
+            if let Some((tau, blocking)) = self.first_blocking().filter(|_| !warm_start_met) {
                 let ws = &mut self.active_set;
                 for i in 0..n {
                     ws.point[i] += tau * ws.direction[i];
@@ -182,52 +216,69 @@ impl Solver {
             self.active_set.point.copy_from_slice(&self.velocity);
             if self.met_before() {
                 // The same steps would follow again, and end here again.
-                break;
+                return (iterations, false);
             }
             match self.release_candidate() {
                 Some(bound) => self.release(bound),
-                None => {
-                    converged = true;
-                    break;
-                }
+                None => return (iterations, true),
             }
         }
-        self.velocity.copy_from_slice(&self.active_set.point);
-        self.report.clamped.clear();
-        self.report
-            .clamped
-            .extend((0..n).filter(|&i| self.clamped[i]));
-        self.report.clamping_iterations = 0;
-        self.report.active_set_iterations = iterations;
-        self.report.converged = converged;
+        (cap, false)
+    }
+
+    /// Records the bounds held at the end of this solve for the next one's warm start.
+    fn keep_active_set(&mut self) {
+        let ws = &mut self.active_set;
+        for (i, warm) in ws.warm_joints.iter_mut().enumerate() {
+            *warm = self.clamped[i].then(|| {
+                if self.fixed_velocity[i] == self.step_hi[i] {
+                    Bound::Upper
+                } else {
+                    Bound::Lower
+                }
+            });
+        }
+        ws.warm_rows.copy_from_slice(&self.inequality_state);
     }
 
     /// `x = 0`, with the joints whose interval excludes 0 clamped to it and the rows `x` violates
-    /// active.
-    fn start_active_set(&mut self) {
+    /// active. With a `warm` start the bounds
+    /// the last solve ended with are active instead, where finite (a joint whose interval
+    /// excludes 0 is clamped all the same): the first `x*` then starts the method where it
+    /// meets every bound, and otherwise a row `x` violates blocks the first step at once.
+    fn start_active_set(&mut self, warm: bool) {
         self.clamped.fill(false);
         self.fixed_velocity.fill(0.0);
-        self.inequality_state.fill(None);
         let ws = &mut self.active_set;
         ws.seen_count = 0;
-        ws.point.fill(0.0);
         for i in 0..self.stack.dof() {
             let (lo, hi) = (self.step_lo[i], self.step_hi[i]);
-            let v = if lo > 0.0 {
+            let x = if lo > 0.0 {
                 lo
             } else if hi < 0.0 {
                 hi
             } else {
-                continue;
+                0.0
+            };
+            ws.point[i] = x;
+            let held = match ws.warm_joints[i].filter(|_| warm) {
+                Some(Bound::Upper) if hi.is_finite() => hi,
+                Some(Bound::Lower) if lo.is_finite() => lo,
+                _ if x != 0.0 => x,
+                _ => continue,
             };
             self.clamped[i] = true;
-            self.fixed_velocity[i] = v;
-            ws.point[i] = v;
+            self.fixed_velocity[i] = held;
         }
         for r in 0..self.stack.total_inequality_rows() {
-            let value = dot(self.stack.inequality_row(r), &ws.point);
             let (lower, upper) = self.stack.inequality_bounds(r);
-            self.inequality_state[r] = if value > upper {
+            let value = dot(self.stack.inequality_row(r), &ws.point);
+            self.inequality_state[r] = if warm {
+                ws.warm_rows[r].filter(|&b| match b {
+                    Bound::Upper => upper.is_finite(),
+                    Bound::Lower => lower.is_finite(),
+                })
+            } else if value > upper {
                 Some(Bound::Upper)
             } else if value < lower {
                 Some(Bound::Lower)
@@ -235,6 +286,26 @@ impl Solver {
                 None
             };
         }
+    }
+
+    /// Whether `velocity` keeps every free joint in its interval and every inactive row within
+    /// its bounds (up to the feasibility tolerance).
+    fn meets_bounds(&self) -> bool {
+        let joints_in = (self.free.iter())
+            .all(|&i| self.step_lo[i] <= self.velocity[i] && self.velocity[i] <= self.step_hi[i]);
+        joints_in
+            && (0..self.stack.total_inequality_rows())
+                .filter(|&r| self.inequality_state[r].is_none())
+                .all(|r| {
+                    let value = dot(self.stack.inequality_row(r), &self.velocity);
+                    let (lower, upper) = self.stack.inequality_bounds(r);
+                    lower - self.slack(lower) <= value && value <= upper + self.slack(upper)
+                })
+    }
+
+    /// How far past `bound` a row may be and still count as within it.
+    fn slack(&self, bound: f64) -> f64 {
+        self.settings.feasibility_tolerance * (1.0 + bound.abs())
     }
 
     /// The first bound the step `x → x + direction` crosses, with the step fraction `τ < 1` that
@@ -265,7 +336,7 @@ impl Solver {
                 );
             }
         }
-        let slack = |bound: f64| self.settings.feasibility_tolerance * (1.0 + bound.abs());
+        let slack = |bound: f64| self.slack(bound);
         for r in 0..self.stack.total_inequality_rows() {
             if self.inequality_state[r].is_some() {
                 continue;
