@@ -122,8 +122,10 @@ pub struct Settings {
     /// releases what it holds wrongly, so the result is the same lexicographic optimum up to
     /// rounding whenever the method converges (it is unique: the last level is `‖q̇ − g‖²`).
     /// In a control loop, where one tick's active bounds are mostly the last tick's, most of
-    /// the passes that add them one at a time are saved. A damped level's or a capped solve's
-    /// end may depend on the path, so the result may then differ a little from a cold start.
+    /// the passes that add them one at a time are saved. A warm solve that does not converge
+    /// (a damped level's cycle, or the cap) is solved again cold and returns the cold
+    /// solve's result; a damped level's optimum may still depend on the path, so a converged
+    /// warm result can differ a little from the cold one there.
     /// Default off: each solve starts from no active bound. Only the active-set method starts
     /// warm (a stack with inequality rows, or [`Settings::limits_by_active_set`]); the
     /// clamping loop's result depends on the order it pins joints in, so it always starts cold.

@@ -242,10 +242,10 @@ impl Solver {
     }
 
     /// `x = 0`, with the joints whose interval excludes 0 clamped to it and the rows `x` violates
-    /// active. With a `warm` start the bounds
-    /// the last solve ended with are active instead, where finite (a joint whose interval
-    /// excludes 0 is clamped all the same): the first `x*` then starts the method where it
-    /// meets every bound, and otherwise a row `x` violates blocks the first step at once.
+    /// active. With a `warm` start the bounds the last solve ended with are active instead,
+    /// where finite (a joint whose interval excludes 0 is clamped all the same): the first `x*`
+    /// then starts the method where it meets every bound, and otherwise a row `x` violates
+    /// blocks the first step at once.
     fn start_active_set(&mut self, warm: bool) {
         self.clamped.fill(false);
         self.fixed_velocity.fill(0.0);
