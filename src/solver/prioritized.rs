@@ -124,7 +124,8 @@ pub struct Settings {
     /// In a control loop, where one tick's active bounds are mostly the last tick's, most of
     /// the passes that add them one at a time are saved. A warm solve that does not converge
     /// (a damped level's cycle, or the cap) is solved again cold and returns the cold
-    /// solve's result; a damped level's optimum may still depend on the path, so a converged
+    /// solve's result, and the solve after one that did not converge starts cold; a damped
+    /// level's optimum may still depend on the path, so a converged
     /// warm result can differ a little from the cold one there.
     /// Default off: each solve starts from no active bound. Only the active-set method starts
     /// warm (a stack with inequality rows, or [`Settings::limits_by_active_set`]); the

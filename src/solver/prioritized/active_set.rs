@@ -91,6 +91,8 @@ pub(crate) struct ActiveSetWorkspace {
     /// start of the next one with [`Settings::warm_start`](crate::solver::Settings::warm_start).
     warm_joints: Vec<Option<Bound>>,
     warm_rows: Vec<Option<Bound>>,
+    /// Whether the last solve converged: only then is its active set worth starting from.
+    warm_valid: bool,
 }
 
 impl ActiveSetWorkspace {
@@ -107,6 +109,7 @@ impl ActiveSetWorkspace {
             seen_count: 0,
             warm_joints: vec![None; dof],
             warm_rows: vec![None; inequalities],
+            warm_valid: false,
         }
     }
 
@@ -168,11 +171,13 @@ impl Solver {
     /// entries. A warm start that does not converge (a damped level's cycle, or the cap) is
     /// solved again cold: a bound the warm set carried in can keep such a cycle going frame
     /// after frame (on the NAO's hand levels it left the hands 15 cm off), where a cold
-    /// start's path would not have met it.
+    /// start's path would not have met it. After a solve that did not converge the next one
+    /// starts cold: where the cold method itself cycles (the NAO's lift and landing phases,
+    /// frame after frame), a warm try first only doubled the cost.
     pub(super) fn solve_active_set(&mut self) {
         let n = self.stack.dof();
         self.scales.fill(1.0);
-        let warm = self.settings.warm_start;
+        let warm = self.settings.warm_start && self.active_set.warm_valid;
         let (mut iterations, mut converged) = self.run_active_set(warm);
         if warm && !converged {
             let (cold, cold_converged) = self.run_active_set(false);
@@ -180,6 +185,7 @@ impl Solver {
         }
         self.velocity.copy_from_slice(&self.active_set.point);
         self.keep_active_set();
+        self.active_set.warm_valid = converged;
         self.report.clamped.clear();
         self.report
             .clamped
