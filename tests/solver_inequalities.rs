@@ -537,6 +537,25 @@ fn a_bound_above_a_conflicting_level_by_hand() {
     assert_eq!(report.first_infeasible_level(), Some(1));
 }
 
+/// The two-joint problem of the damped-cycle tests below: level 0 `q̇₀ + q̇₁ = 2`, level 1
+/// `s (q̇₀ − q̇₁) = −2 s` with `s = 0.01/√2`, limits by the active set.
+fn damped_cycle_solver(warm_start: bool) -> Solver {
+    let shape = StackShape::new(2)
+        .with_level("sum", &[("sum", 1)])
+        .with_level("difference", &[("difference", 1)]);
+    let settings = Settings {
+        limits_by_active_set: true,
+        warm_start,
+        ..Settings::default()
+    };
+    let mut solver = Solver::with_settings(&shape, settings).unwrap();
+    let s = 0.01 / 2.0_f64.sqrt();
+    let stack = solver.stack_mut();
+    stack.level_mut(0).set_row(0, &[1.0, 1.0], 2.0).unwrap();
+    stack.level_mut(1).set_row(0, &[s, -s], -2.0 * s).unwrap();
+    solver
+}
+
 /// A damped level's cycle ends the active-set solve at once. Two joints; level 0 `q̇₀ + q̇₁ = 2`;
 /// level 1 `s (q̇₀ − q̇₁) = −2 s` with `s = 0.01/√2`, whose row left in level 0's null space
 /// (direction `u = (1, −1)/√2`) has norm `σ = s √2 = 0.01`, under the damping threshold `0.02`:
@@ -550,25 +569,7 @@ fn a_bound_above_a_conflicting_level_by_hand() {
 /// until its cap of 16 steps, ending at the same velocity.
 #[test]
 fn a_damped_level_cycle_ends_the_solve_at_once() {
-    let shape = StackShape::new(2)
-        .with_level("sum", &[("sum", 1)])
-        .with_level("difference", &[("difference", 1)]);
-    let settings = Settings {
-        limits_by_active_set: true,
-        ..Settings::default()
-    };
-    let mut solver = Solver::with_settings(&shape, settings).unwrap();
-    let s = 0.01 / 2.0_f64.sqrt();
-    solver
-        .stack_mut()
-        .level_mut(0)
-        .set_row(0, &[1.0, 1.0], 2.0)
-        .unwrap();
-    solver
-        .stack_mut()
-        .level_mut(1)
-        .set_row(0, &[s, -s], -2.0 * s)
-        .unwrap();
+    let mut solver = damped_cycle_solver(false);
     // The premise: without the bound, the damped step of the hand calculation.
     let wide = JointBounds::new(&[-10.0, -10.0], &[10.0, 10.0]).unwrap();
     let free = solver.solve(&[0.0, 0.0], &wide, 1.0).unwrap().velocity;
@@ -592,19 +593,7 @@ fn a_damped_level_cycle_ends_the_solve_at_once() {
 /// not converge, starts cold: exactly the cold solve's 4 steps.
 #[test]
 fn a_warm_start_that_cycles_ends_where_the_cold_solve_does() {
-    let shape = StackShape::new(2)
-        .with_level("sum", &[("sum", 1)])
-        .with_level("difference", &[("difference", 1)]);
-    let settings = Settings {
-        limits_by_active_set: true,
-        warm_start: true,
-        ..Settings::default()
-    };
-    let mut solver = Solver::with_settings(&shape, settings).unwrap();
-    let s = 0.01 / 2.0_f64.sqrt();
-    let stack = solver.stack_mut();
-    stack.level_mut(0).set_row(0, &[1.0, 1.0], 2.0).unwrap();
-    stack.level_mut(1).set_row(0, &[s, -s], -2.0 * s).unwrap();
+    let mut solver = damped_cycle_solver(true);
     let wide = JointBounds::new(&[-10.0, -10.0], &[10.0, 10.0]).unwrap();
     assert!(
         solver

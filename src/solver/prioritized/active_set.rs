@@ -133,6 +133,16 @@ fn bound_code(bound: Option<Bound>) -> u8 {
     }
 }
 
+/// The bound a joint is held at: `None` while free, else the side its fixed velocity `fixed`
+/// sits on (`hi`, the interval's upper end, or the lower one).
+fn held_bound(clamped: bool, fixed: f64, hi: f64) -> Option<Bound> {
+    clamped.then_some(if fixed == hi {
+        Bound::Upper
+    } else {
+        Bound::Lower
+    })
+}
+
 /// A bound that enters or leaves the active set: a joint's interval, or an inequality row.
 #[derive(Debug, Clone, Copy)]
 enum Constraint {
@@ -211,7 +221,11 @@ impl Solver {
             for i in 0..n {
                 ws.direction[i] = self.velocity[i] - ws.point[i];
             }
-            if let Some((tau, blocking)) = self.first_blocking().filter(|_| !warm_start_met) {
+            let blocking = match warm_start_met {
+                true => None,
+                false => self.first_blocking(),
+            };
+            if let Some((tau, blocking)) = blocking {
                 let ws = &mut self.active_set;
                 for i in 0..n {
                     ws.point[i] += tau * ws.direction[i];
@@ -236,13 +250,7 @@ impl Solver {
     fn keep_active_set(&mut self) {
         let ws = &mut self.active_set;
         for (i, warm) in ws.warm_joints.iter_mut().enumerate() {
-            *warm = self.clamped[i].then(|| {
-                if self.fixed_velocity[i] == self.step_hi[i] {
-                    Bound::Upper
-                } else {
-                    Bound::Lower
-                }
-            });
+            *warm = held_bound(self.clamped[i], self.fixed_velocity[i], self.step_hi[i]);
         }
         ws.warm_rows.copy_from_slice(&self.inequality_state);
     }
@@ -278,18 +286,20 @@ impl Solver {
         }
         for r in 0..self.stack.total_inequality_rows() {
             let (lower, upper) = self.stack.inequality_bounds(r);
-            let value = dot(self.stack.inequality_row(r), &ws.point);
             self.inequality_state[r] = if warm {
                 ws.warm_rows[r].filter(|&b| match b {
                     Bound::Upper => upper.is_finite(),
                     Bound::Lower => lower.is_finite(),
                 })
-            } else if value > upper {
-                Some(Bound::Upper)
-            } else if value < lower {
-                Some(Bound::Lower)
             } else {
-                None
+                let value = dot(self.stack.inequality_row(r), &ws.point);
+                if value > upper {
+                    Some(Bound::Upper)
+                } else if value < lower {
+                    Some(Bound::Lower)
+                } else {
+                    None
+                }
             };
         }
     }
@@ -342,7 +352,6 @@ impl Solver {
                 );
             }
         }
-        let slack = |bound: f64| self.slack(bound);
         for r in 0..self.stack.total_inequality_rows() {
             if self.inequality_state[r].is_some() {
                 continue;
@@ -350,7 +359,7 @@ impl Solver {
             let row = self.stack.inequality_row(r);
             let (value, change) = (dot(row, &ws.point), dot(row, &ws.direction));
             let (lower, upper) = self.stack.inequality_bounds(r);
-            let (above, below) = (upper + slack(upper), lower - slack(lower));
+            let (above, below) = (upper + self.slack(upper), lower - self.slack(lower));
             if value > above {
                 consider(0.0, Constraint::Row(r, Bound::Upper));
             } else if value < below {
@@ -396,11 +405,11 @@ impl Solver {
         let slot = &mut slot[..len];
         let (joints, rows) = slot.split_at_mut(self.clamped.len());
         for (code, i) in joints.iter_mut().zip(0..) {
-            *code = match self.clamped[i] {
-                false => bound_code(None),
-                true if self.fixed_velocity[i] == self.step_hi[i] => bound_code(Some(Bound::Upper)),
-                true => bound_code(Some(Bound::Lower)),
-            };
+            *code = bound_code(held_bound(
+                self.clamped[i],
+                self.fixed_velocity[i],
+                self.step_hi[i],
+            ));
         }
         for (code, state) in rows.iter_mut().zip(&self.inequality_state) {
             *code = bound_code(*state);
@@ -540,14 +549,11 @@ impl Solver {
         }
         for i in 0..self.stack.dof() {
             // A zero-width interval pins the joint whatever the levels want.
-            if !self.clamped[i] || ws.decided_joints[i] || self.step_lo[i] >= self.step_hi[i] {
+            let held = held_bound(self.clamped[i], self.fixed_velocity[i], self.step_hi[i]);
+            let Some(bound) = held else { continue };
+            if ws.decided_joints[i] || self.step_lo[i] >= self.step_hi[i] {
                 continue;
             }
-            let bound = if self.fixed_velocity[i] == self.step_hi[i] {
-                Bound::Upper
-            } else {
-                Bound::Lower
-            };
             let wanted = pull(bound, ws.residual[i]);
             let c = Constraint::Joint(i, bound);
             judge(wanted, tolerance, c, &mut ws.decided_joints[i], worst);
