@@ -689,6 +689,7 @@ pub fn metrics_value(m: &ImitationMetrics, clip: &Path) -> Value {
         "hand_reach": m.hand_reach.map(|arms| {
             let arm = |r: &crate::imitation::reach::HandReach| json!({
                 "reach_m": r.reach_m,
+                "min_reach_m": r.min_reach_m,
                 "frames": r.frames,
                 "unreachable_frames": r.unreachable_frames,
                 "shortfall_m": { "mean": r.mean_shortfall_m, "max": r.max_shortfall_m },

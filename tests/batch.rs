@@ -4,8 +4,9 @@
 use std::path::{Path, PathBuf};
 
 use taskstack::batch::{BatchError, BatchOptions, clips_in, retarget_all};
+use taskstack::human::Side;
 use taskstack::model::Model;
-use taskstack::robots::BipedProfile;
+use taskstack::robots::{BipedProfile, nao};
 
 // Compile-time: the batch shares one model set between worker threads (`Sync`) and moves clones
 // into them (`Send`).
@@ -345,20 +346,27 @@ fn the_hands_follow_the_kinect_gestures_on_time() {
     }
 }
 
-/// The report tells hand references beyond the arm's reach from lateness (issue 31 item 3). The
-/// NAO's arm, shoulder → elbow → wrist → hand, from Aldebaran's documented link offsets (mm):
-/// √(105² + 15²) + 55.95 + √(57.75² + 12.31²) = 106.07 + 55.95 + 59.05 = 221.07. A hand the
-/// arm cannot bring within its reach of the reference is off by at least the shortfall on that
+/// The report tells hand references out of the arm's reach from lateness (issue 31 item 3).
+/// The arm's span is checked against the NAO built from its URDF (an independent model of the
+/// same robot), in the standing posture: the hand's distance from the shoulder frame with the
+/// elbow roll at its straight limit (the reach) and at its bent limit (the nearest). A hand the
+/// arm cannot bring within its span of the reference is off by at least the shortfall on that
 /// frame, so over the clip the hand's errors add up to at least the shortfalls.
 #[test]
 fn the_report_counts_hand_references_beyond_the_arms_reach() {
     let (m, json) = nao_clip_metrics(SHORT[0]);
     let reach = m.hand_reach.expect("the NAO maps shoulders and hands");
-    for arm in &reach {
+    for (arm, side) in reach.iter().zip(Side::BOTH) {
+        let [near, far] = urdf_arm_span(side);
         assert!(
-            (arm.reach_m - 0.22107).abs() < 1e-4,
-            "arm {} m",
+            (arm.reach_m - far).abs() < 1e-4,
+            "{side:?}: reach {} m, URDF {far} m",
             arm.reach_m
+        );
+        let nearest = arm.min_reach_m;
+        assert!(
+            (nearest - near).abs() < 1e-4,
+            "{side:?}: nearest {nearest} m, URDF {near} m"
         );
         assert_eq!(arm.frames, m.clip_frames);
     }
@@ -384,6 +392,35 @@ fn the_report_counts_hand_references_beyond_the_arms_reach() {
     let cell = &json["hand_reach"]["r_hand"];
     assert_eq!(cell["unreachable_frames"], waving.unreachable_frames);
     assert!(cell["shortfall_m"]["max"].as_f64().unwrap() >= waving.mean_shortfall_m.unwrap());
+}
+
+/// The URDF NAO's hand distance from its shoulder frame, standing, with the `side` elbow roll
+/// at its bent and at its straight limit (m).
+fn urdf_arm_span(side: Side) -> [f64; 2] {
+    let urdf = format!("{}/tests/data/nao.urdf", env!("CARGO_MANIFEST_DIR"));
+    let model = nao::from_urdf_file(&urdf, Some(nao::sole(Side::Right))).unwrap();
+    let profile = nao::profile();
+    let (elbow, shoulder) = match side {
+        Side::Left => ("LElbowRoll", "l_shoulder"),
+        Side::Right => ("RElbowRoll", "r_shoulder"),
+    };
+    let k = model.variable_index(elbow).unwrap();
+    let v = &model.variables()[k];
+    let shoulder = model.frame_id(shoulder).unwrap();
+    let hand = model.frame_id(&profile.hands[side.index()]).unwrap();
+    let mut data = model.new_data();
+    // The NAO's elbow rolls bend toward the larger |angle|: the left's range is negative.
+    let (bent, straight) = match side {
+        Side::Left => (v.lower, v.upper),
+        Side::Right => (v.upper, v.lower),
+    };
+    [bent, straight].map(|angle| {
+        let mut q = profile.stand.clone();
+        q[k] = angle;
+        model.forward_kinematics(&mut data, &q).unwrap();
+        let p = |f| data.frame_placement(f).translation.vector;
+        (p(hand) - p(shoulder)).norm()
+    })
 }
 
 /// The NAO's metrics over the bundled clip `name` at default settings (no hold), and their

@@ -356,8 +356,9 @@ fn print_tracking(text: &mut String, m: &ImitationMetrics) {
     print_reach(text, m);
 }
 
-/// Per hand, the clip frames whose reference lay beyond the arm's reach from the robot's
-/// shoulder: error no speed can remove.
+/// Per hand, the clip frames whose reference lay out of the arm's reach from the robot's
+/// shoulder (beyond it, or nearer than the bent elbow brings the hand): error no speed can
+/// remove.
 fn print_reach(text: &mut String, m: &ImitationMetrics) {
     let Some(arms) = &m.hand_reach else {
         return;
@@ -374,7 +375,8 @@ fn print_reach(text: &mut String, m: &ImitationMetrics) {
     };
     let _ = writeln!(
         text,
-        "beyond the arm's reach ({:.1} cm) from the robot's shoulder: {}; {}",
+        "out of the arm's reach ({:.1}–{:.1} cm) from the robot's shoulder: {}; {}",
+        arms[0].min_reach_m * 100.0,
         arms[0].reach_m * 100.0,
         hand("l_hand", &arms[0]),
         hand("r_hand", &arms[1])

@@ -70,6 +70,9 @@ pub(super) struct FrameTargets<'a> {
     pub(super) swing_lift: f64,
     /// The swing foot's target footprint, while the robot steps.
     pub(super) footstep: Option<GroundPose>,
+    /// The hands' targets (`[left, right]`, m): the scaled human's hands within the arms'
+    /// reach ([`super::reach::Arm::within_reach`]); the targets of the `Scaled` hand points.
+    pub(super) hands: [Option<Vector3<f64>>; 2],
     /// Largest error (m) a task following the scaled human asks for in one iteration, the
     /// hands' excepted.
     pub(super) tracking_step: f64,
@@ -635,6 +638,8 @@ impl PhaseTasks<'_> {
         };
         Ok(match target {
             // Missing references (never after the scaler) hold the current position.
+            PointTarget::Scaled(HumanJoint::LHand) => or_current(targets.hands[0])?,
+            PointTarget::Scaled(HumanJoint::RHand) => or_current(targets.hands[1])?,
             PointTarget::Scaled(joint) => or_current(targets.reference[joint.index()])?,
             // A lifted or lowered foot follows the shaped swing height; a foot on the ground
             // (lift 0 outside a landing) has swing height 0.

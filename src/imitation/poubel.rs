@@ -33,6 +33,7 @@ use super::imitator::{Shared, effector_ids, ground_pose, human_stance, velocity_
 use super::metrics::CONTACT_HEIGHT;
 use super::phase::{Measurements, PhaseMachine, Settling, SupportKind, SupportPhase, TakeOff};
 use super::phase_solver::{Criteria, FrameTargets, PhaseSolver};
+use super::reach::Arm;
 use super::scaler::{RobotSkeleton, ScaleConfig, Scaler};
 use super::shaping::{ComReference, HandRates, HandSpeed, MotionLimits, StartRamp, SwingHeight};
 use super::support::{HumanSupport, SupportDetector};
@@ -42,7 +43,7 @@ use crate::human::{HumanFrame, Side};
 use crate::model::FrameId;
 use crate::robots::{BipedProfile, HumanJointAngles};
 use crate::solver::driver::DriverSettings;
-use crate::solver::{JointBounds, JointLimitAvoidance, JointTracking, Settings};
+use crate::solver::{JointBounds, JointLimitAvoidance, JointTracking, Settings, SolverError};
 
 use super::config::ImitatorConfig;
 use super::error::ImitationError;
@@ -65,6 +66,9 @@ pub(crate) struct PoubelImitator {
     hand_speed: HandSpeed,
     /// The hands' speeds toward their targets, shaped frame by frame.
     hand_rates: HandRates,
+    /// Each model's arms (`arms[root][side]`), which keep the hand targets within reach;
+    /// `None` for an arm the profile does not map.
+    arms: [[Option<Arm>; 2]; 2],
     limits: JointLimitAvoidance,
     tracking: JointTracking,
     human_q: Vec<f64>,
@@ -130,6 +134,22 @@ fn phase_solvers(
         .collect()
 }
 
+/// `bounds` with each arm's elbow kept in its interval ([`super::reach::Elbow::interval`]),
+/// widened to include the posture `q`: the hands' IK never straightens an elbow.
+fn elbows_kept_bent(
+    bounds: &JointBounds,
+    arms: &[Option<Arm>; 2],
+    q: &[f64],
+) -> Result<JointBounds, SolverError> {
+    let (mut lower, mut upper) = (bounds.lower().to_vec(), bounds.upper().to_vec());
+    for elbow in arms.iter().flatten().filter_map(Arm::elbow) {
+        let (k, [lo, hi]) = (elbow.variable, elbow.interval);
+        lower[k] = lower[k].max(lo).min(q[k]);
+        upper[k] = upper[k].min(hi).max(q[k]);
+    }
+    JointBounds::with_velocity(&lower, &upper, bounds.velocity())
+}
+
 impl PoubelImitator {
     /// An imitator for `profile` (validated by the caller with `config`).
     pub(crate) fn new(
@@ -174,6 +194,11 @@ impl PoubelImitator {
             ..ScaleConfig::new(area)
         };
         let scaler = Scaler::new(RobotSkeleton::of(profile)?, scale)?;
+        let arms = Side::BOTH.map(|root| {
+            let model = profile.model(root);
+            Side::BOTH.map(|side| Arm::of(profile, model, side))
+        });
+        shared.bounds = elbows_kept_bent(&shared.bounds, &arms[Side::Right.index()], &shared.q)?;
         let mut footsteps = FootstepPlanner::new(config.footsteps, area);
         if let Some(ahead) = config.look_ahead.take() {
             footsteps = footsteps.with_look_ahead(ahead);
@@ -226,6 +251,7 @@ impl PoubelImitator {
                 (false, speed) => speed,
             },
             hand_rates: HandRates::default(),
+            arms,
             phases,
             effectors,
             phase: SupportPhase::Double,
@@ -391,6 +417,7 @@ impl PoubelImitator {
             // `walking_table`), and the arms swinging with the human cost the judge's NAO.
             self.tracking.set_reference(walk.start_posture())?;
         }
+        let hands = self.hand_goals();
         let Some(walk) = &mut self.walk else {
             return Ok(());
         };
@@ -404,6 +431,7 @@ impl PoubelImitator {
             swing_lift: planned.swing_lift,
             footstep: Some(planned.footstep),
             tracking_step,
+            hands,
             hand_steps: [tracking_step; 2],
             hand_contacts: [None; 2],
             up: planned.up,
@@ -449,6 +477,7 @@ impl PoubelImitator {
     fn hand_rates(
         &mut self,
         phase: SupportPhase,
+        goals: &[Option<Vector3<f64>>; 2],
         contacts: &[Option<Vector3<f64>>; 2],
         dt: f64,
     ) -> [f64; 2] {
@@ -456,16 +485,29 @@ impl PoubelImitator {
         let data = &self.shared.data[root];
         let distances = Side::BOTH.map(|side| {
             let k = side.index();
-            let (_, joint) = EFFECTORS[k];
-            let target = self.shared.output.reference[joint.index()];
             let hand = data.frame_placement(self.effectors[root][k]);
             match contacts[k] {
                 Some(_) => 0.0,
-                None => target.map_or(0.0, |t| (t - hand.translation.vector).norm()),
+                None => goals[k].map_or(0.0, |t| (t - hand.translation.vector).norm()),
             }
         });
         let cap = self.tracking_speed(phase);
         (self.hand_rates).advance(cap, self.hand_speed.acceleration, distances, dt)
+    }
+
+    /// Each hand's target this frame (`[left, right]`, root frame, m): the scaled human's hand,
+    /// moved within the arm's reach from the robot's shoulder ([`Arm::within_reach`]).
+    fn hand_goals(&self) -> [Option<Vector3<f64>>; 2] {
+        let root = self.shared.root.index();
+        let data = &self.shared.data[root];
+        Side::BOTH.map(|side| {
+            let k = side.index();
+            let target = self.shared.output.reference[EFFECTORS[k].1.index()]?;
+            Some(match &self.arms[root][k] {
+                Some(arm) => arm.within_reach(data, target),
+                None => target,
+            })
+        })
     }
 
     /// The hands' largest speed in `phase` (m/s; [`HandSpeed`]).
@@ -528,7 +570,8 @@ impl PoubelImitator {
         // The velocity budget of the frame, split over its iterations.
         let step_dt = dt / self.iterations as f64;
         let hand_contacts = self.hand_contacts();
-        let hand_steps = (self.hand_rates(phase, &hand_contacts, dt)).map(|v| v * step_dt);
+        let hands = self.hand_goals();
+        let hand_steps = (self.hand_rates(phase, &hands, &hand_contacts, dt)).map(|v| v * step_dt);
         let settings = DriverSettings {
             gain: 1.0 / step_dt,
             dt: step_dt,
@@ -545,6 +588,7 @@ impl PoubelImitator {
             swing_lift: self.swing.height(),
             footstep: self.footstep_in_root(),
             tracking_step: self.tracking_speed(phase) * step_dt,
+            hands,
             hand_steps,
             hand_contacts,
             up: Vector3::z(),

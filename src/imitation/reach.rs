@@ -1,29 +1,35 @@
-//! Hand references beyond the robot arm's reach: a hand error that is not lateness.
+//! Hand references out of the robot arm's reach: a hand error that is not lateness, and the
+//! hand targets the imitation keeps within reach.
 //!
 //! A hand's scaled reference is placed from the *scaled* shoulder with the robot's segment
 //! lengths ([`super::scaler`], eq. 1), so it is always within the arm's length of that point.
 //! The robot's own shoulder is elsewhere whenever its trunk does not follow the scaled one: the
 //! tables hold the torso upright over the stance foot, a robot standing on bent knees carries
 //! its hips lower than the scaled hips, and a robot whose waist is not tracked (the G1) keeps
-//! its shoulders where its posture puts them. Per frame of the clip the meter measures how far
-//! each hand's reference lies beyond the arm's reach from the robot's current shoulder:
+//! its shoulders where its posture puts them. And a human elbow folds further than most robot
+//! elbows, so a reference can also lie nearer the shoulder than the robot's hand gets.
+//!
+//! [`Arm`] measures each arm in the model, by forward kinematics from the standing posture:
+//! its elbow is the variable that changes the shoulder–hand distance `d(θ)` most over its
+//! range, and the arm spans `[d_min, d_max]`, the extremes of `d` over that range. Per frame of
+//! the clip the meter measures how far each hand's reference lies outside that span around
+//! the robot's current shoulder:
 //!
 //! ```text
-//! shortfall = max(0, |p_hand^ref − p_shoulder^robot(q)| − L_arm)
+//! shortfall = max(0, |p_hand^ref − p_shoulder^robot(q)| − d_max, d_min − |…|)
 //! ```
 //!
-//! with `L_arm` the sum of the robot segment lengths shoulder → elbow → wrist → hand of the
-//! [`RobotSkeleton`] (metres, reference posture). The sum is an upper bound of the reach (joint
-//! limits may keep the arm from stretching straight), so the unreachable frames counted are a
-//! lower bound, and a hand's error on such a frame is at least its shortfall whatever the arm
-//! does. Positions in the left-rooted model's base frame; the references are moved there from
-//! the frame's root.
+//! A hand's error on such a frame is at least its shortfall whatever the arm does. Positions
+//! in the left-rooted model's base frame; the references are moved there from the frame's root.
+//!
+//! Poubel's method aims each hand at its reference moved along the line from the shoulder into
+//! the span the arm has with its elbow kept [`MIN_ELBOW_BEND`] away from straight
+//! ([`Arm::within_reach`]), and keeps the elbow there ([`Elbow::interval`]).
 
 use nalgebra::{IsometryMatrix3, Vector3};
 
 use super::imitator::RobotFrame;
 use super::output::EFFECTORS;
-use super::scaler::RobotSkeleton;
 use crate::human::{HumanJoint, Side};
 use crate::model::{FrameId, Model, ModelData};
 use crate::robots::{BipedProfile, RobotPoint};
@@ -31,11 +37,14 @@ use crate::robots::{BipedProfile, RobotPoint};
 /// How far one hand's references lay beyond the arm's reach over the frames measured.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HandReach {
-    /// The arm's length: the robot segments from the shoulder to the hand (m).
+    /// The farthest the hand gets from the shoulder point: the elbow at its straightest (m).
     pub reach_m: f64,
+    /// The nearest the hand gets to the shoulder point: the elbow at its most bent (m).
+    pub min_reach_m: f64,
     /// Frames measured (the clip's frames with a reference for this hand).
     pub frames: usize,
-    /// Frames whose reference lay beyond `reach_m` from the robot's shoulder.
+    /// Frames whose reference lay beyond `reach_m` from the robot's shoulder, or nearer than
+    /// `min_reach_m`.
     pub unreachable_frames: usize,
     /// Mean shortfall over the unreachable frames (m); `None` without any.
     pub mean_shortfall_m: Option<f64>,
@@ -43,55 +52,173 @@ pub struct HandReach {
     pub max_shortfall_m: Option<f64>,
 }
 
-/// One robot arm in the meter's model: the frames of its shoulder point and its length.
+/// One robot arm in a model: the frames of its shoulder point and hand, and how near to and
+/// far from the shoulder its elbow can bring the hand.
 #[derive(Debug, Clone, Copy)]
-struct Arm {
+pub(super) struct Arm {
     hand: HumanJoint,
+    hand_frame: FrameId,
     /// The shoulder point is the mean of these frames' origins (the same frame twice for a
     /// [`RobotPoint::Frame`]).
     shoulder: [FrameId; 2],
-    reach: f64,
+    /// The shoulder–hand distances the elbow spans over its joint range, `[nearest, farthest]`
+    /// (m): the arm's reach.
+    span: [f64; 2],
+    /// The same over the interval the imitation keeps the elbow in ([`Elbow::interval`]).
+    kept_span: [f64; 2],
+    elbow: Option<Elbow>,
 }
 
+/// The elbow of an arm: the variable that changes the shoulder–hand distance most over its
+/// range, found in the model by forward kinematics (no joint names).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct Elbow {
+    /// Its variable index.
+    pub(super) variable: usize,
+    /// The interval the imitation keeps it in (rad): its range less [`MIN_ELBOW_BEND`] on the
+    /// side of its straightest angle, widened to include the standing posture.
+    pub(super) interval: [f64; 2],
+}
+
+/// The least bend of the elbow (rad), from its straightest angle, that the imitation leaves
+/// an arm ([`Elbow::interval`], [`Arm::within_reach`]). A straight elbow is singular: bending
+/// it moves the hand across the arm, not along it, so a one-step (Gauss–Newton) IK cannot
+/// shorten a straight arm, and an elbow held at its straight limit by the clamping stays
+/// there. On the NAO a hand stayed straight-armed 20–30 cm from its reference for seconds
+/// (CMU 02_10's right hand, 05_02's left) after the reference had passed out of reach. At
+/// 0.3 rad the hand still moves 30 % as fast along the arm as across it, and a two-segment
+/// arm of equal segments reaches `1 − cos 0.15 ≈ 1 %` less far.
+pub(super) const MIN_ELBOW_BEND: f64 = 0.3;
+
+/// Samples of a variable's range when looking for the elbow.
+const ELBOW_SAMPLES: usize = 64;
+
 impl Arm {
-    /// The `side` arm of `profile` in `model`; `None` when its hand or shoulder is not mapped or
-    /// a frame is unknown.
-    fn of(
-        profile: &BipedProfile,
-        skeleton: &RobotSkeleton,
-        model: &Model,
-        side: Side,
-    ) -> Option<Self> {
+    /// The `side` arm of `profile` in `model`, measured in `profile`'s standing posture; `None`
+    /// when its hand or shoulder is not mapped or a frame is unknown.
+    pub(super) fn of(profile: &BipedProfile, model: &Model, side: Side) -> Option<Self> {
         let (hand, shoulder) = match side {
             Side::Left => (EFFECTORS[0].1, HumanJoint::LShoulder),
             Side::Right => (EFFECTORS[1].1, HumanJoint::RShoulder),
         };
-        let mut reach = 0.0;
-        let mut joint = hand;
-        while joint != shoulder {
-            reach += skeleton.length(joint)?;
-            joint = skeleton.antecedent(joint)?;
-        }
         let frame = |name: &str| model.frame_id(name).ok();
         let shoulder = match &profile.points.iter().find(|(j, _)| *j == shoulder)?.1 {
             RobotPoint::Frame(a) => [frame(a)?; 2],
             RobotPoint::Midpoint(a, b) => [frame(a)?, frame(b)?],
         };
-        Some(Self {
+        let mut arm = Self {
             hand,
+            hand_frame: frame(&profile.hands[side.index()])?,
             shoulder,
-            reach,
-        })
+            span: [0.0; 2],
+            kept_span: [0.0; 2],
+            elbow: None,
+        };
+        arm.measure(model, &profile.stand)?;
+        Some(arm)
     }
 
-    /// How far `target` (model base frame, m) lies beyond the arm's reach from the shoulder
-    /// point of the kinematics in `data` (m; negative within it).
-    fn shortfall(&self, data: &ModelData, target: &Vector3<f64>) -> f64 {
+    /// Finds the elbow and the spans from `stand` (see [`Elbow`]); `None` when the forward
+    /// kinematics fails (a posture of the wrong length).
+    fn measure(&mut self, model: &Model, stand: &[f64]) -> Option<()> {
+        let mut data = model.new_data();
+        let mut q = stand.to_vec();
+        let mut distance = |q: &[f64]| {
+            model.forward_kinematics(&mut data, q).ok()?;
+            Some(self.hand_distance(&data))
+        };
+        let standing = distance(&q)?;
+        let (mut elbow, mut widest) = (None, 0.0);
+        for (k, v) in model.variables().iter().enumerate() {
+            if !(v.lower.is_finite() && v.upper.is_finite() && v.upper > v.lower) {
+                continue;
+            }
+            let mut samples = [(0.0, 0.0); ELBOW_SAMPLES];
+            for (i, sample) in samples.iter_mut().enumerate() {
+                let t = i as f64 / (ELBOW_SAMPLES - 1) as f64;
+                q[k] = v.lower + t * (v.upper - v.lower);
+                *sample = (q[k], distance(&q)?);
+            }
+            q[k] = stand[k];
+            let [near, far] = span(&samples, [v.lower, v.upper]);
+            if far - near > widest {
+                widest = far - near;
+                elbow = Some((k, samples));
+            }
+        }
+        let Some((variable, samples)) = elbow else {
+            (self.span, self.kept_span) = ([standing; 2], [standing; 2]);
+            return Some(());
+        };
+        let v = &model.variables()[variable];
+        let straight = samples.iter().max_by(|a, b| a.1.total_cmp(&b.1))?.0;
+        let mut interval = match v.upper - straight >= straight - v.lower {
+            true => [straight + MIN_ELBOW_BEND, v.upper],
+            false => [v.lower, straight - MIN_ELBOW_BEND],
+        };
+        interval = [
+            interval[0].min(stand[variable]),
+            interval[1].max(stand[variable]),
+        ];
+        if interval[0] >= interval[1] {
+            interval = [v.lower, v.upper];
+        }
+        self.span = span(&samples, [v.lower, v.upper]);
+        self.kept_span = span(&samples, interval);
+        self.elbow = Some(Elbow { variable, interval });
+        Some(())
+    }
+
+    /// The elbow, when the arm has one.
+    pub(super) fn elbow(&self) -> Option<Elbow> {
+        self.elbow
+    }
+
+    /// The shoulder point of the kinematics in `data` (model base frame, m).
+    fn shoulder_point(&self, data: &ModelData) -> Vector3<f64> {
         let [a, b] = self
             .shoulder
             .map(|f| data.frame_placement(f).translation.vector);
-        (target - (a + b) * 0.5).norm() - self.reach
+        (a + b) * 0.5
     }
+
+    /// The distance from the shoulder point to the hand in `data` (m).
+    fn hand_distance(&self, data: &ModelData) -> f64 {
+        (data.frame_placement(self.hand_frame).translation.vector - self.shoulder_point(data))
+            .norm()
+    }
+
+    /// How far `target` (model base frame, m) lies outside the arm's reach from the shoulder
+    /// point of the kinematics in `data`, beyond it or nearer than the bent elbow brings the
+    /// hand (m; negative within it).
+    fn shortfall(&self, data: &ModelData, target: &Vector3<f64>) -> f64 {
+        let d = (target - self.shoulder_point(data)).norm();
+        (d - self.span[1]).max(self.span[0] - d)
+    }
+
+    /// `target` (model base frame, m) moved along the line from the shoulder point of `data`
+    /// into the distances the arm spans with its elbow in [`Elbow::interval`]; unchanged when
+    /// it lies within them.
+    pub(super) fn within_reach(&self, data: &ModelData, target: Vector3<f64>) -> Vector3<f64> {
+        let shoulder = self.shoulder_point(data);
+        let arm = target - shoulder;
+        let distance = arm.norm();
+        let [near, far] = self.kept_span;
+        match distance {
+            d if d > far => shoulder + arm * (far / d),
+            d if d < near && d > 0.0 => shoulder + arm * (near / d),
+            _ => target,
+        }
+    }
+}
+
+/// The nearest and farthest distance among `samples` (`(angle, distance)`) whose angle lies in
+/// `interval`.
+fn span(samples: &[(f64, f64)], [lo, hi]: [f64; 2]) -> [f64; 2] {
+    let kept = samples.iter().filter(|(a, _)| (lo..=hi).contains(a));
+    kept.fold([f64::INFINITY, f64::NEG_INFINITY], |[n, f], &(_, d)| {
+        [n.min(d), f.max(d)]
+    })
 }
 
 /// Measures [`HandReach`] frame by frame (see the module docs).
@@ -109,9 +236,8 @@ impl ReachMeter {
     /// A meter for `profile`'s arms; `None` when a hand or shoulder is not mapped or the profile
     /// cannot be measured (the imitator validated its profile, so that is the unmapped case).
     pub fn new(profile: &BipedProfile) -> Option<Self> {
-        let skeleton = RobotSkeleton::of(profile).ok()?;
         let model = profile.models[Side::Left.index()].clone();
-        let arm = |side| Arm::of(profile, &skeleton, &model, side);
+        let arm = |side| Arm::of(profile, &model, side);
         let arms = [arm(Side::Left)?, arm(Side::Right)?];
         let sole = |side: Side| model.frame_id(&profile.foot(side).sole).ok();
         Some(Self {
@@ -155,7 +281,8 @@ impl ReachMeter {
             let (frames, unreachable, sum, max) = self.counts[k];
             let any = unreachable > 0;
             HandReach {
-                reach_m: self.arms[k].reach,
+                reach_m: self.arms[k].span[1],
+                min_reach_m: self.arms[k].span[0],
                 frames,
                 unreachable_frames: unreachable,
                 mean_shortfall_m: any.then(|| sum / unreachable as f64),
