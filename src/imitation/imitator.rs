@@ -163,6 +163,9 @@ pub(crate) struct Shared {
     /// frame's time plus this.
     pub(crate) paused: f64,
     pub(crate) output: RobotFrame,
+    /// Whether the root's forward kinematics are known to be at `q` and untouched since
+    /// ([`Shared::note_kinematics_current`]): the next [`Shared::refresh`] then skips them.
+    kinematics_current: bool,
 }
 
 impl Shared {
@@ -204,6 +207,7 @@ impl Shared {
             previous_time: None,
             paused: 0.0,
             output,
+            kinematics_current: false,
         };
         Ok((shared, position_bounds))
     }
@@ -232,13 +236,25 @@ impl Shared {
         }
     }
 
-    /// Forward kinematics of the root's model at `q`.
+    /// Forward kinematics of the root's model at `q`; none when the last call of
+    /// [`Shared::note_kinematics_current`] came after the last refresh.
     pub(crate) fn refresh(&mut self) -> Result<(), ImitationError> {
+        if std::mem::take(&mut self.kinematics_current) {
+            return Ok(());
+        }
         let root = self.root.index();
         self.profile
             .model(self.root)
             .forward_kinematics(&mut self.data[root], &self.q)?;
         Ok(())
+    }
+
+    /// Tells the next [`Shared::refresh`] that the root's forward kinematics are at `q`: the
+    /// caller has just computed them there, and nothing changes `q`, the root or the
+    /// kinematics before that refresh (a frame's solve ends with the kinematics at its final
+    /// posture, and the next frame begins by refreshing them).
+    pub(crate) fn note_kinematics_current(&mut self) {
+        self.kinematics_current = true;
     }
 
     /// Re-roots the model at `foot` if it is not already, keeping the world placement

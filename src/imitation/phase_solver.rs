@@ -305,7 +305,8 @@ impl PhaseSolver {
     }
 
     /// Runs the driver from `q` (updated in place) with `settings`, the model's forward
-    /// kinematics kept in `data`: after the call `data` holds the final `q`'s.
+    /// kinematics kept in `data`, which must hold `q`'s on entry (the frame's first evaluation
+    /// does not compute them again): after the call `data` holds the final `q`'s.
     #[allow(clippy::too_many_arguments)] // the frame's inputs, each from a different owner
     pub(super) fn run(
         &mut self,
@@ -329,6 +330,7 @@ impl PhaseSolver {
             targets,
             gradients: &self.table.gradients,
             criteria,
+            fresh: true,
         };
         self.driver.run(&mut self.solver, &mut tasks, q, bounds)?;
         let frame_dt = settings.dt * settings.max_iterations as f64;
@@ -459,6 +461,10 @@ struct PhaseTasks<'a> {
     targets: FrameTargets<'a>,
     gradients: &'a [Gradient],
     criteria: Criteria<'a>,
+    /// Whether `data` holds the kinematics at the `q` of the next evaluation: the first
+    /// evaluation of a run is at the run's starting posture, whose kinematics the caller
+    /// provides.
+    fresh: bool,
 }
 
 /// `goal` in the root frame (m), from the current forward kinematics in `data`.
@@ -512,7 +518,9 @@ impl TaskModel for PhaseTasks<'_> {
     }
 
     fn evaluate(&mut self, q: &[f64], stack: &mut TaskStack) -> Result<(), ImitationError> {
-        self.model.forward_kinematics(self.data, q)?;
+        if !std::mem::take(&mut self.fresh) {
+            self.model.forward_kinematics(self.data, q)?;
+        }
         for task in self.tasks {
             let mut level = stack.level_mut(task.level);
             let (jacobian, target) = level.rows_mut(task.row, task.rows);

@@ -448,6 +448,7 @@ impl PoubelImitator {
             &mut self.shared.data[root.index()],
         );
         walk.solve(model, data, targets, criteria, &mut self.shared.q, dt)?;
+        self.shared.note_kinematics_current();
         let solver = walk.solver();
         (self.shared.output).record(solver.driver_report(), solver.solve_report());
         let phase = if over {
@@ -611,6 +612,7 @@ impl PoubelImitator {
             &self.shared.bounds,
             settings,
         )?;
+        self.shared.note_kinematics_current();
         (self.shared.output).record(ps.driver_report(), ps.solve_report());
         Ok(())
     }
