@@ -308,8 +308,6 @@ fn print_summary(
     );
 }
 
-/// The tracking table: per effector, mean and maximum distance to the scaled human (cm) in
-/// single and double support, over the clip's frames whose phase tracks it.
 /// What the robot was still doing at the end of a run.
 fn unfinished(m: &ImitationMetrics) -> String {
     match m.queued_steps_at_end {
@@ -318,6 +316,9 @@ fn unfinished(m: &ImitationMetrics) -> String {
     }
 }
 
+/// The tracking table: per effector, mean and maximum distance to the scaled human (cm) in
+/// single support, double support and the transitions, over the clip's frames whose phase
+/// tracks it.
 fn print_tracking(text: &mut String, m: &ImitationMetrics) {
     let frames = m.clip_support_frames;
     let _ = writeln!(
