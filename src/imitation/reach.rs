@@ -26,7 +26,7 @@
 //! the span the arm has with its elbow kept [`MIN_ELBOW_BEND`] away from straight
 //! ([`Arm::within_reach`]), and keeps the elbow there ([`Elbow::interval`]).
 
-use nalgebra::{IsometryMatrix3, Vector3};
+use nalgebra::{IsometryMatrix3, Matrix3, Vector3};
 
 use super::imitator::RobotFrame;
 use super::output::EFFECTORS;
@@ -75,12 +75,13 @@ pub(super) struct Arm {
 pub(super) struct Elbow {
     /// Its variable index.
     pub(super) variable: usize,
-    /// The interval the imitation keeps it in (rad): its range less [`MIN_ELBOW_BEND`] on the
-    /// side of its straightest angle, widened to include the standing posture.
+    /// The interval the imitation keeps it in (rad): its range less the angles within
+    /// [`MIN_ELBOW_BEND`] of the straight arm ([`straight_angle`]; the longer side of what
+    /// remains), widened to include the standing posture.
     pub(super) interval: [f64; 2],
 }
 
-/// The least bend of the elbow (rad), from its straightest angle, that the imitation leaves
+/// The least bend of the elbow (rad), from the straight arm, that the imitation leaves
 /// an arm ([`Elbow::interval`], [`Arm::within_reach`]). A straight elbow is singular: bending
 /// it moves the hand across the arm, not along it, so a one-step (Gauss–Newton) IK cannot
 /// shorten a straight arm, and an elbow held at its straight limit by the clamping stays
@@ -151,10 +152,14 @@ impl Arm {
             return Some(());
         };
         let v = &model.variables()[variable];
-        let straight = samples.iter().max_by(|a, b| a.1.total_cmp(&b.1))?.0;
-        let mut interval = match v.upper - straight >= straight - v.lower {
-            true => [straight + MIN_ELBOW_BEND, v.upper],
-            false => [v.lower, straight - MIN_ELBOW_BEND],
+        let straight = straight_angle(&samples)?;
+        // The range less the angles within MIN_ELBOW_BEND of straight: the longer side.
+        let (near, far) = (straight - MIN_ELBOW_BEND, straight + MIN_ELBOW_BEND);
+        let above = [v.lower.max(far), v.upper];
+        let below = [v.lower, v.upper.min(near)];
+        let mut interval = match above[1] - above[0] >= below[1] - below[0] {
+            true => above,
+            false => below,
         };
         interval = [
             interval[0].min(stand[variable]),
@@ -210,6 +215,26 @@ impl Arm {
             _ => target,
         }
     }
+}
+
+/// The angle at which the arm is straight (rad): a revolute joint between two rigid segments
+/// puts their far ends `d(θ)` apart with `d² = A + B cos θ + C sin θ` (the law of cosines), so
+/// a least-squares fit of `d²` over `samples` (`(θ, d)`) gives it as `atan2(C, B)`, the angle of
+/// the largest `d`, whether or not the joint's range reaches it. Wrapped to the turn nearest
+/// the samples' middle; `None` when the fit is singular (fewer than three distinct angles).
+fn straight_angle(samples: &[(f64, f64)]) -> Option<f64> {
+    let mut normal = Matrix3::zeros();
+    let mut rhs = Vector3::zeros();
+    for &(angle, d) in samples {
+        let row = Vector3::new(1.0, angle.cos(), angle.sin());
+        normal += row * row.transpose();
+        rhs += row * (d * d);
+    }
+    let [_, b, c] = normal.cholesky()?.solve(&rhs).into();
+    let middle = 0.5 * (samples.first()?.0 + samples.last()?.0);
+    let straight = c.atan2(b);
+    let turns = ((middle - straight) / std::f64::consts::TAU).round();
+    Some(straight + turns * std::f64::consts::TAU)
 }
 
 /// The nearest and farthest distance among `samples` (`(angle, distance)`) whose angle lies in
@@ -289,5 +314,28 @@ impl ReachMeter {
                 max_shortfall_m: any.then_some(max),
             }
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An arm of 0.10 m and 0.12 m segments, straight at 1.44 rad, sampled over [−1, 1] rad
+    /// only: the distances from the law of cosines, `d² = a² + b² + 2ab cos(θ − θ₀)`.
+    #[test]
+    fn the_straight_angle_is_found_outside_the_sampled_range() {
+        let (a, b, straight) = (0.10, 0.12, 1.44);
+        let samples: Vec<(f64, f64)> = (0..ELBOW_SAMPLES)
+            .map(|i| {
+                let angle = -1.0 + 2.0 * i as f64 / (ELBOW_SAMPLES - 1) as f64;
+                let d2 = a * a + b * b + 2.0 * a * b * (angle - straight).cos();
+                (angle, d2.sqrt())
+            })
+            .collect();
+        let found = straight_angle(&samples).unwrap();
+        assert!((found - straight).abs() < 1e-9, "{found}");
+        // Fewer than three distinct angles cannot fix the fit.
+        assert!(straight_angle(&samples[..1]).is_none());
     }
 }
