@@ -22,9 +22,11 @@
 //! A hand's error on such a frame is at least its shortfall whatever the arm does. Positions
 //! in the left-rooted model's base frame; the references are moved there from the frame's root.
 //!
-//! Poubel's method aims each hand at its reference moved along the line from the shoulder into
-//! the span the arm has with its elbow kept [`MIN_ELBOW_BEND`] away from straight
-//! ([`Arm::within_reach`]), and keeps the elbow there ([`Elbow::interval`]).
+//! Poubel's method aims each hand at its reference pulled along the line to the shoulder until
+//! the arm reaches it with its elbow [`MIN_ELBOW_BEND`] from straight ([`Arm::within_reach`]),
+//! and keeps the elbow at least that bent ([`Elbow::interval`]). A reference nearer than the
+//! fully bent elbow brings the hand stays where it is: the bent limit is no singularity, and
+//! moving such targets out cost the G1 2 cm of mean hand error on CMU 131_01.
 
 use nalgebra::{IsometryMatrix3, Matrix3, Vector3};
 
@@ -64,8 +66,8 @@ pub(super) struct Arm {
     /// The shoulder–hand distances the elbow spans over its joint range, `[nearest, farthest]`
     /// (m): the arm's reach.
     span: [f64; 2],
-    /// The same over the interval the imitation keeps the elbow in ([`Elbow::interval`]).
-    kept_span: [f64; 2],
+    /// The farthest over the interval the imitation keeps the elbow in ([`Elbow::interval`]).
+    kept_reach: f64,
     elbow: Option<Elbow>,
 }
 
@@ -112,7 +114,7 @@ impl Arm {
             hand_frame: frame(&profile.hands[side.index()])?,
             shoulder,
             span: [0.0; 2],
-            kept_span: [0.0; 2],
+            kept_reach: 0.0,
             elbow: None,
         };
         arm.measure(model, &profile.stand)?;
@@ -148,7 +150,7 @@ impl Arm {
             }
         }
         let Some((variable, samples)) = elbow else {
-            (self.span, self.kept_span) = ([standing; 2], [standing; 2]);
+            (self.span, self.kept_reach) = ([standing; 2], standing);
             return Some(());
         };
         let v = &model.variables()[variable];
@@ -169,7 +171,7 @@ impl Arm {
             interval = [v.lower, v.upper];
         }
         self.span = span(&samples, [v.lower, v.upper]);
-        self.kept_span = span(&samples, interval);
+        self.kept_reach = span(&samples, interval)[1];
         self.elbow = Some(Elbow { variable, interval });
         Some(())
     }
@@ -201,18 +203,16 @@ impl Arm {
         (d - self.span[1]).max(self.span[0] - d)
     }
 
-    /// `target` (model base frame, m) moved along the line from the shoulder point of `data`
-    /// into the distances the arm spans with its elbow in [`Elbow::interval`]; unchanged when
-    /// it lies within them.
+    /// `target` (model base frame, m) pulled along the line to the shoulder point of `data`
+    /// until the arm reaches it with its elbow in [`Elbow::interval`]; unchanged when it is
+    /// that near.
     pub(super) fn within_reach(&self, data: &ModelData, target: Vector3<f64>) -> Vector3<f64> {
         let shoulder = self.shoulder_point(data);
         let arm = target - shoulder;
         let distance = arm.norm();
-        let [near, far] = self.kept_span;
-        match distance {
-            d if d > far => shoulder + arm * (far / d),
-            d if d < near && d > 0.0 => shoulder + arm * (near / d),
-            _ => target,
+        match distance > self.kept_reach {
+            true => shoulder + arm * (self.kept_reach / distance),
+            false => target,
         }
     }
 }
