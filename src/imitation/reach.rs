@@ -9,7 +9,7 @@
 //! its shoulders where its posture puts them. And a human elbow folds further than most robot
 //! elbows, so a reference can also lie nearer the shoulder than the robot's hand gets.
 //!
-//! [`Arm`] measures each arm in the model, by forward kinematics from the standing posture:
+//! `Arm` measures each arm in the model, by forward kinematics from the standing posture:
 //! its elbow is the variable that changes the shoulder–hand distance `d(θ)` most over its
 //! range, and the arm spans `[d_min, d_max]`, the extremes of `d` over that range. Per frame of
 //! the clip the meter measures how far each hand's reference lies outside that span around
@@ -23,10 +23,11 @@
 //! in the left-rooted model's base frame; the references are moved there from the frame's root.
 //!
 //! Poubel's method aims each hand at its reference pulled along the line to the shoulder until
-//! the arm reaches it with its elbow [`MIN_ELBOW_BEND`] from straight ([`Arm::within_reach`]),
-//! and keeps the elbow at least that bent ([`Elbow::interval`]). A reference nearer than the
-//! fully bent elbow brings the hand stays where it is: the bent limit is no singularity, and
-//! moving such targets out cost the G1 2 cm of mean hand error on CMU 131_01.
+//! the arm reaches it with its elbow `MIN_ELBOW_BEND` (0.3 rad) from straight
+//! (`Arm::within_reach`), and keeps the elbow at least that bent (`Elbow::interval`). A
+//! reference nearer than the fully bent elbow brings the hand stays where it is: the bent limit
+//! is no singularity, and moving such targets out cost the G1 2 cm of mean hand error on CMU
+//! 131_01.
 
 use nalgebra::{IsometryMatrix3, Matrix3, Vector3};
 
