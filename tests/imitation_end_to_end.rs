@@ -9,7 +9,7 @@
 //! a robot moving at 10 % of its rated speed can finish the step it is taking.
 //! `cargo test --release --test imitation_end_to_end -- --nocapture` prints the per-clip metrics.
 
-use taskstack::human::HumanFrame;
+use taskstack::human::{HumanFrame, Side};
 use taskstack::imitation::config::ImitationMethod;
 use taskstack::imitation::footsteps::FootstepConfig;
 use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
@@ -507,4 +507,55 @@ fn the_hands_keep_the_elbows_bent() {
     }
     assert!(least >= 0.27, "an elbow at {least} rad");
     assert!(least < 0.33, "the elbows never near straight: {least} rad");
+}
+
+/// What a frame reports of the robot (its hands and ankles in the root's frame, the world CoM)
+/// is the forward kinematics of the posture it reports, computed here afresh in the model of
+/// the frame's root. Poubel's method reuses the kinematics its last solve left instead of
+/// computing them again at the next frame's start; CMU 131_01 steps onto each leg, so the
+/// root switches soles and the reused kinematics place the new root in the world.
+#[test]
+fn each_frame_reports_the_kinematics_of_its_posture() {
+    let mut clip = Clip::open(clip_path("cmu_131_01_start_walk_stop_maxskel.bvh")).unwrap();
+    let config = ImitatorConfig {
+        support: SupportConfig::for_capture(clip.capture()),
+        ..ImitatorConfig::default()
+    };
+    let profile = nao::profile();
+    let mut imitator = Imitator::new(profile.clone(), config).unwrap();
+    let mut data = profile.models.each_ref().map(|m| m.new_data());
+    let mut frame = HumanFrame::new(0.0);
+    let (mut frames, mut roots) = (0, [false; 2]);
+    while clip.read_frame(&mut frame).unwrap() {
+        let out = imitator.step(&frame).unwrap();
+        let (model, data) = (profile.model(out.root), &mut data[out.root.index()]);
+        model.forward_kinematics(data, &out.q).unwrap();
+        let names = [
+            &profile.hands[0],
+            &profile.hands[1],
+            &profile.foot(Side::Left).ankle,
+            &profile.foot(Side::Right).ankle,
+        ];
+        for (name, reported) in names.iter().zip(&out.effectors) {
+            let fresh = data
+                .frame_placement(model.frame_id(name).unwrap())
+                .translation
+                .vector;
+            assert!(
+                (fresh - reported).norm() < 1e-12,
+                "frame {frames}: {name} {fresh} vs {reported}"
+            );
+        }
+        let com = out
+            .world_t_root
+            .transform_point(&model.com(data).unwrap().into())
+            .coords;
+        assert!((com - out.com).norm() < 1e-12, "frame {frames}: CoM");
+        roots[out.root.index()] = true;
+        frames += 1;
+    }
+    assert!(
+        roots == [true, true],
+        "the clip roots the model at both soles"
+    );
 }
