@@ -97,6 +97,10 @@ pub(super) const MIN_ELBOW_BEND: f64 = 0.3;
 /// Samples of a variable's range when looking for the elbow.
 const ELBOW_SAMPLES: usize = 64;
 
+/// A change of the shoulder–hand distance (m) below this is rounding: the variable does not
+/// lie between the shoulder and the hand.
+const OFF_CHAIN: f64 = 1e-9;
+
 impl Arm {
     /// The `side` arm of `profile` in `model`, measured in `profile`'s standing posture; `None`
     /// when its hand or shoulder is not mapped or a frame is unknown.
@@ -137,20 +141,33 @@ impl Arm {
             if !(v.lower.is_finite() && v.upper.is_finite() && v.upper > v.lower) {
                 continue;
             }
+            // `(angle, distance)` with the variable at the fraction `t` of its range.
+            let mut at = |t: f64| {
+                q[k] = v.lower + t * (v.upper - v.lower);
+                Some((q[k], distance(&q)?))
+            };
+            // A variable off the shoulder–hand chain moves both rigidly: the ends and the
+            // middle of its range leave the distance as it stands, and it is not swept.
+            let mut moves = false;
+            for t in [0.0, 0.5, 1.0] {
+                moves |= (at(t)?.1 - standing).abs() > OFF_CHAIN;
+            }
+            if !moves {
+                q[k] = stand[k];
+                continue;
+            }
             let mut samples = [(0.0, 0.0); ELBOW_SAMPLES];
             for (i, sample) in samples.iter_mut().enumerate() {
-                let t = i as f64 / (ELBOW_SAMPLES - 1) as f64;
-                q[k] = v.lower + t * (v.upper - v.lower);
-                *sample = (q[k], distance(&q)?);
+                *sample = at(i as f64 / (ELBOW_SAMPLES - 1) as f64)?;
             }
             q[k] = stand[k];
             let [near, far] = span(&samples, [v.lower, v.upper]);
             if far - near > widest {
                 widest = far - near;
-                elbow = Some((k, samples));
+                elbow = Some((k, samples, [near, far]));
             }
         }
-        let Some((variable, samples)) = elbow else {
+        let Some((variable, samples, full_span)) = elbow else {
             (self.span, self.kept_reach) = ([standing; 2], standing);
             return Some(());
         };
@@ -171,7 +188,7 @@ impl Arm {
         if interval[0] >= interval[1] {
             interval = [v.lower, v.upper];
         }
-        self.span = span(&samples, [v.lower, v.upper]);
+        self.span = full_span;
         self.kept_reach = span(&samples, interval)[1];
         self.elbow = Some(Elbow { variable, interval });
         Some(())
