@@ -482,6 +482,16 @@ fn koenemann_keeps_the_invariants_on_every_clip() {
     }
 }
 
+/// The clip `name` opened, and the NAO's imitator for it at default settings.
+fn nao_on(name: &str) -> (Clip, Imitator) {
+    let clip = Clip::open(clip_path(name)).unwrap();
+    let config = ImitatorConfig {
+        support: SupportConfig::for_capture(clip.capture()),
+        ..ImitatorConfig::default()
+    };
+    (clip, Imitator::new(nao::profile(), config).unwrap())
+}
+
 /// The hands' IK keeps each elbow 0.3 rad (`MIN_ELBOW_BEND`) from the straight arm: a
 /// straight elbow is singular, and CMU 02_10's right hand, reaching over its head and back
 /// down, stayed straight-armed 20 cm off its reference for 6 s before. The NAO's documented
@@ -490,12 +500,7 @@ fn koenemann_keeps_the_invariants_on_every_clip() {
 /// this clip they reach that bound.
 #[test]
 fn the_hands_keep_the_elbows_bent() {
-    let mut clip = Clip::open(clip_path("cmu_02_10_wash_self_standing_arm_gestures.bvh")).unwrap();
-    let config = ImitatorConfig {
-        support: SupportConfig::for_capture(clip.capture()),
-        ..ImitatorConfig::default()
-    };
-    let mut imitator = Imitator::new(nao::profile(), config).unwrap();
+    let (mut clip, mut imitator) = nao_on("cmu_02_10_wash_self_standing_arm_gestures.bvh");
     let names: Vec<String> = imitator.variable_names().map(str::to_owned).collect();
     let index = |name: &str| names.iter().position(|n| n == name).unwrap();
     let (left, right) = (index("LElbowRoll"), index("RElbowRoll"));
@@ -516,13 +521,8 @@ fn the_hands_keep_the_elbows_bent() {
 /// root switches soles and the reused kinematics place the new root in the world.
 #[test]
 fn each_frame_reports_the_kinematics_of_its_posture() {
-    let mut clip = Clip::open(clip_path("cmu_131_01_start_walk_stop_maxskel.bvh")).unwrap();
-    let config = ImitatorConfig {
-        support: SupportConfig::for_capture(clip.capture()),
-        ..ImitatorConfig::default()
-    };
-    let profile = nao::profile();
-    let mut imitator = Imitator::new(profile.clone(), config).unwrap();
+    let (mut clip, mut imitator) = nao_on("cmu_131_01_start_walk_stop_maxskel.bvh");
+    let profile = imitator.profile().clone();
     let mut data = profile.models.each_ref().map(|m| m.new_data());
     let mut frame = HumanFrame::new(0.0);
     let (mut frames, mut roots) = (0, [false; 2]);
