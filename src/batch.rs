@@ -10,7 +10,8 @@
 //! For a clip `name.bvh` (or `name.csv`) the job writes into `OUT/name/`:
 //!
 //! * `joints.csv`: a header `time,<the robot's joint names>`, then per frame the time (s) and the
-//!   joint angles (rad), six decimals;
+//!   joint angles (rad) to command, six decimals
+//!   ([`RobotFrame::servo_targets`](crate::imitation::output::RobotFrame::servo_targets));
 //! * `metrics.json`: the [`ImitationMetrics`] of the run (lengths in m, angles in rad, times in
 //!   s, solve time in µs; a non-finite value is written as `null`).
 //!
@@ -480,9 +481,10 @@ impl<W: std::io::Write> JointsWriter<W> {
         self.out.write_all(self.line.as_bytes())
     }
 
-    /// Writes `frame`'s line.
+    /// Writes `frame`'s line: its servo targets ([`RobotFrame::servo_targets`]), what a robot
+    /// with position servos plays.
     pub fn frame(&mut self, frame: &RobotFrame) -> std::io::Result<()> {
-        self.row(frame.time, &frame.q)
+        self.row(frame.time, &frame.servo_targets)
     }
 
     /// Writes one line: `time` (s) and the joint angles `q` (rad).

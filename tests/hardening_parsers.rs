@@ -762,7 +762,7 @@ fn dh_with_a_huge_com_is_refused_instead_of_giving_an_infinite_com() {
 }
 
 #[test]
-fn urdf_huge_numbers_negative_velocity_and_nan_inertia_are_refused() {
+fn urdf_huge_numbers_negative_velocity_or_effort_and_nan_inertia_are_refused() {
     use taskstack::model::UrdfError;
     let urdf = &inputs().urdf;
     let load = |text: String| Model::from_urdf_str(&text, &UrdfOptions::default());
@@ -783,6 +783,20 @@ fn urdf_huge_numbers_negative_velocity_and_nan_inertia_are_refused() {
     assert!(
         matches!(negative, Err(UrdfError::NegativeVelocity { velocity: -8.26797, ref joint }) if joint == "HeadYaw"),
         "{negative:?}"
+    );
+    let effort = |from: &str, to: &str| load(replaced(urdf, from, to));
+    let negative = effort("effort=\"1.547\"", "effort=\"-1.547\"");
+    assert!(
+        matches!(negative, Err(UrdfError::NegativeEffort { effort: -1.547, ref joint }) if joint == "HeadYaw"),
+        "{negative:?}"
+    );
+    // A missing (urdf-rs: 0) effort is "not stated", read as no limit.
+    let head = |model: Model| model.variables()[model.variable_index("HeadYaw").unwrap()].clone();
+    let unstated = effort("effort=\"1.547\"", "effort=\"0\"");
+    assert_eq!(head(unstated.unwrap()).effort, f64::INFINITY);
+    assert_eq!(
+        head(effort("effort=\"1.547\"", "effort=\"1.547\"").unwrap()).effort,
+        1.547
     );
     let nan = load(replaced(urdf, "ixx=\"1.60324e-05\"", "ixx=\"nan\""));
     assert!(

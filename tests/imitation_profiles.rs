@@ -195,6 +195,13 @@ fn profile_errors_name_the_field() {
     let err = load(&tuned(-0.01));
     assert!(err.to_string().contains("tuning.torso_lowering"), "{err}");
 
+    // The servos' stiffness, a key before the first table.
+    let servos = |saturation: f64| format!("servo_saturation = {saturation}\n{toml}");
+    let profile = BipedProfile::from_toml_str(&servos(0.02), &urdf).unwrap();
+    assert_eq!(profile.servo_saturation, Some(0.02));
+    let err = load(&servos(-0.02));
+    assert!(err.to_string().contains("servo_saturation"), "{err}");
+
     let missing = BipedProfile::from_toml_file(format!("{TINY}nowhere.toml")).unwrap_err();
     assert!(matches!(missing, ProfileError::Io { .. }), "{missing}");
 }

@@ -40,7 +40,9 @@ const CHECK_HOLD: f64 = 1.0;
 /// the human does, and with --walk steps where the human steps), then holds the last pose for
 /// --hold seconds. Writes into the output folder, as the frames come:
 ///
-///   joints.csv     time (s) and the robot's joint angles (rad), one line per frame
+///   joints.csv     time (s) and the robot's joint angles (rad), one line per frame: what
+///                  its position servos are told, the planned posture plus the servos'
+///                  static sag when the profile states their stiffness (the G1)
 ///   motion.npz     for learning pipelines (numpy): fps, time (s), joint_names, dof_pos (rad),
 ///                  root_pos (m) and root_quat (x y z w) of the floating base (NAO torso, G1
 ///                  pelvis; world: z up, the first right sole at the origin), contacts (left,

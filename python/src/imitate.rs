@@ -437,6 +437,10 @@ fn robot_frame_dict<'py>(
     let out = PyDict::new(py);
     out.set_item("time", frame.time)?;
     out.set_item("q", PyArray1::from_slice(py, &frame.q))?;
+    out.set_item(
+        "servo_targets",
+        PyArray1::from_slice(py, &frame.servo_targets),
+    )?;
     out.set_item("phase", frame.phase.to_string())?;
     out.set_item("root_pos", PyArray1::from_slice(py, &root_pos))?;
     out.set_item("root_quat", PyArray1::from_slice(py, &root_quat))?;

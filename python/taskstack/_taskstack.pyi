@@ -54,7 +54,10 @@ class Imitator:
         joint name -> (x, y, z) in metres (world: z up), or a (J, 3) array with its ``names``.
         Missing joints are left out of the dict, or NaN rows of the array.
 
-        Returns a dict: ``time`` (s), ``q`` (J, rad), ``phase`` (str), ``root_pos`` (3, m) and
+        Returns a dict: ``time`` (s), ``q`` (J, rad), ``servo_targets`` (J, rad: ``q`` plus the
+        static sag of the robot's position servos, what ``joints.csv`` holds; equal to ``q``
+        for a robot whose profile states no servo stiffness), ``phase`` (str), ``root_pos``
+        (3, m) and
         ``root_quat`` (4, x y z w) of the floating base, ``left_sole`` and ``right_sole``
         (4 x 4 world placements), ``com`` (3, m), ``contacts`` ([left, right] on the floor),
         ``awaiting_contact`` (feed the same frame again: a hand is being placed),

@@ -164,6 +164,8 @@ def test_a_live_imitator_fed_a_clip_frame_by_frame_gives_the_clips_run():
     for t, frame in zip(times, positions):
         out = imitator.step(t, frame, names=names)
         assert out["q"].shape == (len(imitator.joint_names),)
+        # The NAO's profile states no servo stiffness: its servo targets are its postures.
+        assert np.array_equal(out["servo_targets"], out["q"])
         assert out["root_quat"].shape == (4,) and out["left_sole"].shape == (4, 4)
         assert set(out["effectors"]) == {"l_hand", "r_hand", "l_ankle", "r_ankle"}
         qs.append(out["q"])

@@ -13,6 +13,7 @@ use super::footsteps::GroundPose;
 use super::koenemann::imitator::KoenemannImitator;
 use super::phase::SupportPhase;
 use super::poubel::PoubelImitator;
+use super::servo::ServoSag;
 use super::tables::TaskTable;
 use crate::human::{HumanFrame, HumanJoint, Side};
 use crate::model::{FrameId, Model, ModelData, ModelError};
@@ -163,6 +164,8 @@ pub(crate) struct Shared {
     /// frame's time plus this.
     pub(crate) paused: f64,
     pub(crate) output: RobotFrame,
+    /// The servos' static deflection, when the profile states their stiffness.
+    servo: Option<ServoSag>,
     /// Whether the root's forward kinematics are known to be at `q` and untouched since
     /// ([`Shared::note_kinematics_current`]): the next [`Shared::refresh`] then skips them.
     kinematics_current: bool,
@@ -193,6 +196,7 @@ impl Shared {
         model.forward_kinematics(&mut data[right], &q)?;
         let left_sole = *data[right].frame_placement(soles[right][Side::Left.index()]);
         let output = RobotFrame::at_start(&q, left_sole, &[0, 0]);
+        let servo = ServoSag::new(&profile);
         let shared = Shared {
             profile,
             data,
@@ -207,6 +211,7 @@ impl Shared {
             previous_time: None,
             paused: 0.0,
             output,
+            servo,
             kinematics_current: false,
         };
         Ok((shared, position_bounds))
@@ -297,6 +302,19 @@ impl Shared {
         out.time = time + self.paused;
         out.human_time = time;
         out.q.copy_from_slice(&self.q);
+        let soles = &self.soles[root];
+        match &mut self.servo {
+            Some(servo) => servo.targets(
+                model,
+                data,
+                self.root,
+                soles,
+                phase,
+                &self.q,
+                &mut out.servo_targets,
+            )?,
+            None => out.servo_targets.copy_from_slice(&self.q),
+        }
         for (position, &id) in out.effectors.iter_mut().zip(effectors) {
             *position = data.frame_placement(id).translation.vector;
         }

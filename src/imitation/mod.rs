@@ -27,6 +27,7 @@ mod phase_solver;
 mod poubel;
 pub mod reach;
 pub mod scaler;
+mod servo;
 pub mod shaping;
 pub mod support;
 pub mod tables;

@@ -46,6 +46,12 @@ pub struct RobotFrame {
     pub hand_supports: [Option<HandPlacement>; 2],
     /// Joint angles in the model's variable order (rad); names in [`Imitator::variable_names`](super::imitator::Imitator::variable_names).
     pub q: Vec<f64>,
+    /// What to command the robot's position servos (model variable order, rad): `q` plus the
+    /// deflection under which servos of the profile's stiffness hold this posture's static load
+    /// ([`BipedProfile::servo_saturation`]; the module `servo` of the imitation states the
+    /// maths), inside the joint limits; equal to `q` when the profile states no stiffness.
+    /// `joints.csv` holds these.
+    pub servo_targets: Vec<f64>,
     /// The human's support at this frame.
     pub human_support: HumanSupport,
     /// The robot's phase or transition step.
@@ -131,6 +137,7 @@ impl RobotFrame {
             awaiting_contact: false,
             hand_supports: [None; 2],
             q: q.to_vec(),
+            servo_targets: q.to_vec(),
             human_support: HumanSupport::Double,
             phase: SupportPhase::Double,
             root: Side::Right,

@@ -206,6 +206,21 @@ impl SupportPhase {
         }
     }
 
+    /// The foot the plan holds off the ground: the free foot in RS and LS, the swing foot while
+    /// it is lifted or lowered; `None` while both soles are planned on the floor (DS, and the
+    /// CoM shifts of the transitions).
+    pub const fn airborne_foot(self) -> Option<Side> {
+        match self {
+            SupportPhase::Right
+            | SupportPhase::DoubleToRight(TakeOff::LiftFoot)
+            | SupportPhase::RightToDouble(Landing::LowerFoot) => Some(Side::Left),
+            SupportPhase::Left
+            | SupportPhase::DoubleToLeft(TakeOff::LiftFoot)
+            | SupportPhase::LeftToDouble(Landing::LowerFoot) => Some(Side::Right),
+            _ => None,
+        }
+    }
+
     /// The take-off step, in a transition from DS to a single support.
     pub const fn take_off(self) -> Option<TakeOff> {
         match self {

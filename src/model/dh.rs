@@ -201,6 +201,7 @@ fn variable(row: &Row<'_>) -> Result<Variable, DhError> {
         lower,
         upper,
         velocity: row.mass("velocity")?,
+        effort: f64::INFINITY,
     })
 }
 

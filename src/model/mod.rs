@@ -49,6 +49,7 @@
 
 pub mod dh;
 mod kinematics;
+mod statics;
 mod tree;
 pub mod urdf;
 
@@ -56,6 +57,7 @@ use nalgebra::{IsometryMatrix3, Matrix3, Unit, Vector3};
 use thiserror::Error;
 
 pub use dh::DhError;
+pub use statics::PointLoad;
 pub use urdf::{UrdfError, UrdfFrame, UrdfOptions};
 
 /// Largest magnitude the loaders ([`dh`], [`urdf`]) accept for a number of a robot description
@@ -125,6 +127,9 @@ pub struct Variable {
     pub upper: f64,
     /// Maximum speed |q̇| (rad/s or m/s).
     pub velocity: f64,
+    /// Largest torque (N·m) or force (N) the variable's actuator gives, > 0; `f64::INFINITY`
+    /// when the description states none (DH tables; a URDF `effort` of 0 or left out).
+    pub effort: f64,
 }
 
 /// A named frame: a link plus a constant placement in that link's frame.
@@ -217,6 +222,9 @@ pub enum ModelError {
     /// The model has zero total mass, so its centre of mass is undefined.
     #[error("the model has zero total mass: its centre of mass is undefined")]
     NoMass,
+    /// A gravity or load of [`Model::static_torques`] is NaN or infinite.
+    #[error("a gravity or load is not finite: {0}")]
+    NonFiniteLoad(f64),
 }
 
 /// An immutable kinematic tree (see the [module docs](self) for the maths). Two models are equal

@@ -156,6 +156,14 @@ pub enum UrdfError {
         /// The velocity limit (rad/s or m/s).
         velocity: f64,
     },
+    /// A joint with a negative (or NaN) effort limit.
+    #[error("joint `{joint}`: effort limit {effort} is not >= 0")]
+    NegativeEffort {
+        /// Joint name.
+        joint: String,
+        /// The effort limit (N·m or N).
+        effort: f64,
+    },
     /// A link with negative mass.
     #[error("link `{link}`: negative mass {mass}")]
     NegativeMass {
@@ -852,11 +860,23 @@ fn number_variables(
                 velocity: limit.velocity,
             });
         }
+        if limit.effort.is_nan() || limit.effort < 0.0 {
+            return Err(UrdfError::NegativeEffort {
+                joint: joint.name.clone(),
+                effort: limit.effort,
+            });
+        }
         variables.push(Variable {
             name: joint.name.clone(),
             lower,
             upper,
             velocity: limit.velocity,
+            // urdf-rs reads a missing effort as 0: no actuator has none, so 0 means "not stated".
+            effort: if limit.effort > 0.0 {
+                limit.effort
+            } else {
+                f64::INFINITY
+            },
         });
     }
     let drives = drives

@@ -162,6 +162,15 @@ pub const TUNING: MotionTuning = MotionTuning {
     offset_acceleration: 1.0,
 };
 
+/// The joint error (rad) at which the G1's position servos reach their torque limit: 35 mrad,
+/// so stiffness = URDF effort / 0.035 (hip roll and knee 3971, hip pitch and yaw 2514, ankles
+/// 1000, arms 714 N·m/rad). These are the gains of a stiff whole-body position hold, the recipe
+/// of the physics models that check this crate's G1 outputs (`taskstack check`), not
+/// Unitree's deployment gains (40–300 N·m/rad, made for a balancing policy that closes the
+/// loop on the IMU; played open loop, the G1 does not stand on them). A robot run at other
+/// gains should set its own ([`BipedProfile::servo_saturation`]).
+pub const SERVO_SATURATION: f64 = 0.035;
+
 /// Where the G1 may put a foot down relative to the other sole: x ∈ [−0.10, 0.15] m, lateral
 /// ∈ [0.20, 0.30] m, |yaw| ≤ 0.3 rad. The NAO's envelope scaled by the legs' length ratio
 /// (about 3), with the lateral bounds around the G1's 0.237 m stance width so that the feet
@@ -250,6 +259,7 @@ pub fn profile_with(models: [Model; 2]) -> BipedProfile {
         joint_angles: None,
         // Not modelled yet: the G1's bodies need sizing from its collision geometry.
         self_collision: SelfCollision::default(),
+        servo_saturation: Some(SERVO_SATURATION),
     }
 }
 

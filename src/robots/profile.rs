@@ -237,6 +237,13 @@ pub struct BipedProfile {
     pub tuning: MotionTuning,
     /// The bodies kept apart and the distance they keep; empty: no self-collision avoidance.
     pub self_collision: SelfCollision,
+    /// How stiff the robot's position servos are, as the joint error (rad, or m for a
+    /// prismatic variable) at which a servo gives its variable's whole
+    /// [`Variable::effort`](crate::model::Variable::effort): stiffness `k = effort /
+    /// servo_saturation` (N·m/rad). With it the imitation commands each posture plus the
+    /// deflection `τ / k` under which a servo holds the posture's static load `τ`
+    /// ([`Model::static_torques`]); `None`: it commands the postures.
+    pub servo_saturation: Option<f64>,
 }
 
 impl BipedProfile {
@@ -253,9 +260,9 @@ impl BipedProfile {
     /// Checks the profile against its models: both models have the same variables, every frame
     /// the profile names exists in both, each model's base is its sole, the outlines have three
     /// or more finite corners, the standing posture is finite and inside the limits, the step
-    /// envelope is valid, the self-collision bodies resolve on both models
-    /// ([`SelfCollision::resolve`]) and every pair keeps its margin in the standing posture.
-    /// The error names the field.
+    /// envelope is valid, the servo saturation (if any) is a finite angle > 0, the
+    /// self-collision bodies resolve on both models ([`SelfCollision::resolve`]) and every pair
+    /// keeps its margin in the standing posture. The error names the field.
     pub fn validate(&self) -> Result<(), ProfileError> {
         let invalid = |field: &str, reason: String| ProfileError::Invalid {
             field: field.to_owned(),
@@ -317,6 +324,14 @@ impl BipedProfile {
             return Err(invalid(
                 &format!("step_envelope.{field}"),
                 format!("{value} breaks min ≤ max, finite, yaw_max ≥ 0"),
+            ));
+        }
+        if let Some(saturation) = self.servo_saturation
+            && !(saturation.is_finite() && saturation > 0.0)
+        {
+            return Err(invalid(
+                "servo_saturation",
+                format!("{saturation} is not a finite angle > 0 (rad)"),
             ));
         }
         self.validate_self_collision()

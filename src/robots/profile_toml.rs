@@ -1,7 +1,8 @@
 //! A [`BipedProfile`] from a small TOML file next to the robot's URDF.
 //!
 //! Lengths in metres, angles in radians, frames as in the URDF (x forward, y left, z up). Every
-//! field but `variables`, `locked`, `stand` and `frames` is required; an unknown field is an
+//! field but `variables`, `locked`, `stand`, `servo_saturation`, `frames` and `tuning` is
+//! required; an unknown field is an
 //! error (it is a typo more often than not).
 //!
 //! ```toml
@@ -12,6 +13,8 @@
 //! hands = ["l_hand", "r_hand"]       # frames (links or `frames` below) tracking the hands
 //! torso = "base"                     # the frame held upright at its standing height
 //! stand = { l_knee = 0.3, r_knee = 0.3 }  # standing posture; joints not named are 0
+//! servo_saturation = 0.035           # optional: rad of error at which a position servo gives
+//!                                    # its URDF effort (BipedProfile::servo_saturation)
 //!
 //! [feet.left]
 //! link = "l_foot"                    # the URDF link the sole hangs from
@@ -84,6 +87,7 @@ struct File {
     torso: String,
     #[serde(default)]
     stand: BTreeMap<String, f64>,
+    servo_saturation: Option<f64>,
     feet: Feet,
     step_envelope: Envelope,
     points: BTreeMap<String, Point>,
@@ -317,6 +321,7 @@ fn build(file: File, urdf: &str) -> Result<BipedProfile, ProfileError> {
         joint_angles: None,
         tuning: nao::TUNING,
         self_collision: SelfCollision::default(),
+        servo_saturation: file.servo_saturation,
     };
     profile.validate()?;
     let scaled = nao::TUNING.scaled(&nao::SIZE, &profile.size()?);

@@ -1,0 +1,151 @@
+//! Servo targets: the posture to command so that stiff position servos settle at the planned one.
+//!
+//! A position servo of stiffness `k` (N·m/rad) that holds a torque `τ` settles `τ / k` short of
+//! its target. A standing robot's joints hold its weight, so every loaded joint sags: on the G1's
+//! physics model (stiffness = effort / 35 mrad) the stance hip and ankle rolls gave 10–30 mrad,
+//! which put the centre of mass 13–27 mm outward of the plan on one foot, at the edge of a sole
+//! 50–60 mm wide. Commanding
+//!
+//! ```text
+//! target = q + τ(q) / k,        τ = Model::static_torques(q, loads)
+//! ```
+//!
+//! removes the static part of that error. `k = effort / servo_saturation` per variable
+//! ([`BipedProfile::servo_saturation`], [`Variable::effort`](crate::model::Variable::effort);
+//! a variable without an effort limit is taken as rigid). The loads are the model's: rooted at
+//! its root sole, which takes what the other sole does not. The other sole carries nothing while
+//! it is in the air ([`SupportPhase::airborne_foot`]) and otherwise the share of the weight that
+//! the lever rule gives for the centre of mass between the two soles,
+//!
+//! ```text
+//! w = clamp(((c − p_root) · (p_other − p_root)) / |p_other − p_root|², 0, 1)   (ground plane)
+//! ```
+//!
+//! at the point of its sole as far beside the line between the soles as the CoM (so both soles'
+//! centres of pressure lie under the CoM along the feet, and the ankles share the moment of a CoM
+//! ahead of them as the soles share the weight). The two legs of a double support form a closed
+//! chain whose load split statics alone does not fix; this split leaves no moment about either
+//! sole's centre of pressure. Targets stay inside the joint limits.
+
+use faer::Mat;
+
+use super::phase::SupportPhase;
+use crate::human::Side;
+use nalgebra::{Vector2, Vector3};
+
+use crate::model::{FrameId, Model, ModelData, ModelError, PointLoad};
+use crate::robots::BipedProfile;
+
+/// Standard gravity (m/s²).
+const GRAVITY: f64 = 9.81;
+
+/// The servo stiffness of each variable and a row of scratch: [`ServoSag::targets`] allocates
+/// nothing.
+#[derive(Debug, Clone)]
+pub(crate) struct ServoSag {
+    /// N·m/rad (or N/m) per variable; infinite for a variable without an effort limit.
+    stiffness: Vec<f64>,
+    /// The static torques, 1×n.
+    torques: Mat<f64>,
+}
+
+impl ServoSag {
+    /// The sag model of `profile`'s servos; `None` when the profile states no servo stiffness.
+    pub(crate) fn new(profile: &BipedProfile) -> Option<Self> {
+        let saturation = profile.servo_saturation?;
+        let model = profile.model(Side::Right);
+        let stiffness = model
+            .variables()
+            .iter()
+            .map(|v| v.effort / saturation)
+            .collect();
+        Some(Self {
+            stiffness,
+            torques: Mat::zeros(1, model.nv()),
+        })
+    }
+
+    /// Writes into `out` the servo targets of the posture `q` whose forward kinematics `data`
+    /// holds, in `model` rooted at `root` (`soles[foot]`: the soles' frames in that model), in
+    /// `phase`.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn targets(
+        &mut self,
+        model: &Model,
+        data: &ModelData,
+        root: Side,
+        soles: &[FrameId; 2],
+        phase: SupportPhase,
+        q: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), ModelError> {
+        let other = root.other();
+        let (root_sole, other_sole) = (soles[root.index()], soles[other.index()]);
+        let load = match phase.airborne_foot() {
+            Some(foot) if foot == other => None,
+            Some(_) => Some(whole_weight_on(model, data, other_sole)?),
+            None => Some(lever_load(model, data, root_sole, other_sole)?),
+        };
+        let loads = load.as_slice();
+        model.static_torques(data, GRAVITY, loads, self.torques.as_mut())?;
+        let variables = model.variables();
+        for (k, (target, &angle)) in out.iter_mut().zip(q).enumerate() {
+            let sag = self.torques[(0, k)] / self.stiffness[k];
+            let sag = if sag.is_finite() { sag } else { 0.0 };
+            *target = (angle + sag).clamp(variables[k].lower, variables[k].upper);
+        }
+        Ok(())
+    }
+}
+
+/// The load on the sole `other` with both soles down: the lever rule's share of the weight
+/// (module docs), at the point of that sole as far beside the line between the soles as the
+/// CoM.
+fn lever_load(
+    model: &Model,
+    data: &ModelData,
+    root: FrameId,
+    other: FrameId,
+) -> Result<PointLoad, ModelError> {
+    let at = |frame: FrameId| data.frame_placement(frame).translation.vector.xy();
+    let (from, span) = (at(root), at(other) - at(root));
+    let beside = model.com(data)?.xy() - from;
+    let along = beside.dot(&span) / span.norm_squared();
+    if !along.is_finite() {
+        // The soles on top of each other: each takes half, under the CoM.
+        return Ok(weight_on(data, other, beside + from, 0.5 * weight(model)));
+    }
+    let across = beside - span * along;
+    let share = along.clamp(0.0, 1.0);
+    Ok(weight_on(
+        data,
+        other,
+        at(other) + across,
+        share * weight(model),
+    ))
+}
+
+/// The whole weight on the sole `sole`, under the centre of mass.
+fn whole_weight_on(
+    model: &Model,
+    data: &ModelData,
+    sole: FrameId,
+) -> Result<PointLoad, ModelError> {
+    Ok(weight_on(data, sole, model.com(data)?.xy(), weight(model)))
+}
+
+/// `force` (N) pushing up on the sole `sole` at the floor point `point` (base frame x, y).
+fn weight_on(data: &ModelData, sole: FrameId, point: Vector2<f64>, force: f64) -> PointLoad {
+    let placement = data.frame_placement(sole);
+    let point = Vector3::new(point.x, point.y, placement.translation.z);
+    PointLoad {
+        frame: sole,
+        offset: placement.inverse_transform_point(&point.into()).coords,
+        force,
+    }
+}
+
+/// The model's weight (N).
+fn weight(model: &Model) -> f64 {
+    model.total_mass() * GRAVITY
+}
