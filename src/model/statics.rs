@@ -36,7 +36,8 @@ pub struct PointLoad {
 impl Model {
     /// The actuator torques (1×n row `out`, N·m or N per variable) that hold the posture of
     /// `data` still with the base fixed, under gravity `gravity` (m/s², along −z of the base
-    /// frame) and the upward forces `loads`. See the [module docs](self) for the formula.
+    /// frame) and the upward forces `loads`: `τ = M g ∂z_c/∂q − Σ f_i ∂z_i/∂q`, the gradient of
+    /// the potential energy (`z_c` the height of the CoM, `z_i` of load `i`'s point).
     ///
     /// # Errors
     /// Kinematics not computed on `data`, a wrong output shape, a model without mass, a frame
