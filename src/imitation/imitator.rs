@@ -13,7 +13,7 @@ use super::footsteps::GroundPose;
 use super::koenemann::imitator::KoenemannImitator;
 use super::phase::SupportPhase;
 use super::poubel::PoubelImitator;
-use super::servo::ServoSag;
+use super::servo::{ServoSag, other_sole_load};
 use super::tables::TaskTable;
 use crate::human::{HumanFrame, HumanJoint, Side};
 use crate::model::{FrameId, Model, ModelData, ModelError};
@@ -302,17 +302,17 @@ impl Shared {
         out.time = time + self.paused;
         out.human_time = time;
         out.q.copy_from_slice(&self.q);
-        let soles = &self.soles[root];
         match &mut self.servo {
-            Some(servo) => servo.targets(
-                model,
-                data,
-                self.root,
-                soles,
-                phase,
-                &self.q,
-                &mut out.servo_targets,
-            )?,
+            Some(servo) => {
+                let load = other_sole_load(model, data, self.root, &self.soles[root], phase)?;
+                servo.targets(
+                    model,
+                    data,
+                    load.as_slice(),
+                    &self.q,
+                    &mut out.servo_targets,
+                )?;
+            }
             None => out.servo_targets.copy_from_slice(&self.q),
         }
         for (position, &id) in out.effectors.iter_mut().zip(effectors) {

@@ -28,11 +28,10 @@
 //! sole's centre of pressure. Targets stay inside the joint limits.
 
 use faer::Mat;
+use nalgebra::{Vector2, Vector3};
 
 use super::phase::SupportPhase;
 use crate::human::Side;
-use nalgebra::{Vector2, Vector3};
-
 use crate::model::{FrameId, Model, ModelData, ModelError, PointLoad};
 use crate::robots::BipedProfile;
 
@@ -66,27 +65,15 @@ impl ServoSag {
     }
 
     /// Writes into `out` the servo targets of the posture `q` whose forward kinematics `data`
-    /// holds, in `model` rooted at `root` (`soles[foot]`: the soles' frames in that model), in
-    /// `phase`.
-    #[allow(clippy::too_many_arguments)]
+    /// holds, the model's root sole fixed and `loads` pushing up (see [`other_sole_load`]).
     pub(crate) fn targets(
         &mut self,
         model: &Model,
         data: &ModelData,
-        root: Side,
-        soles: &[FrameId; 2],
-        phase: SupportPhase,
+        loads: &[PointLoad],
         q: &[f64],
         out: &mut [f64],
     ) -> Result<(), ModelError> {
-        let other = root.other();
-        let (root_sole, other_sole) = (soles[root.index()], soles[other.index()]);
-        let load = match phase.airborne_foot() {
-            Some(foot) if foot == other => None,
-            Some(_) => Some(whole_weight_on(model, data, other_sole)?),
-            None => Some(lever_load(model, data, root_sole, other_sole)?),
-        };
-        let loads = load.as_slice();
         model.static_torques(data, GRAVITY, loads, self.torques.as_mut())?;
         let variables = model.variables();
         for (k, (target, &angle)) in out.iter_mut().zip(q).enumerate() {
@@ -96,6 +83,25 @@ impl ServoSag {
         }
         Ok(())
     }
+}
+
+/// What the sole that is not the root carries in `phase` (module docs), in the model rooted at
+/// `root` (`soles[foot]`: the soles' frames in that model): nothing while it is in the air, the
+/// whole weight while the root sole is, the lever rule's share with both down.
+pub(crate) fn other_sole_load(
+    model: &Model,
+    data: &ModelData,
+    root: Side,
+    soles: &[FrameId; 2],
+    phase: SupportPhase,
+) -> Result<Option<PointLoad>, ModelError> {
+    let other = root.other();
+    let (root_sole, other_sole) = (soles[root.index()], soles[other.index()]);
+    Ok(match phase.airborne_foot() {
+        Some(foot) if foot == other => None,
+        Some(_) => Some(whole_weight_on(model, data, other_sole)?),
+        None => Some(lever_load(model, data, root_sole, other_sole)?),
+    })
 }
 
 /// The load on the sole `other` with both soles down: the lever rule's share of the weight
