@@ -62,6 +62,7 @@ fn walk_and_check(profile: &BipedProfile, motion: GroundPose) -> f64 {
     let mut coms: Vec<[f64; 3]> = Vec::new();
     let mut states = Vec::new();
     let mut ticks = 0;
+    let mut largest_sag = 0.0_f64;
     while !walker.generator().is_stopped() || ticks < 100 {
         let frame = *walker.tick().unwrap();
         ticks += 1;
@@ -73,6 +74,25 @@ fn walk_and_check(profile: &BipedProfile, motion: GroundPose) -> f64 {
                 "{} = {qi} outside its limits",
                 v.name
             );
+        }
+        // What the servos are told: the angles plus their sag (robots::servo), in the limits.
+        let targets = walker.servo_targets();
+        for ((v, &qi), &target) in variables.iter().zip(q).zip(targets) {
+            assert!(
+                target >= v.lower && target <= v.upper,
+                "{} target {target}",
+                v.name
+            );
+            if profile.servo_saturation.is_none() {
+                assert_eq!(target, qi, "{}", v.name);
+            }
+            assert!(
+                (target - qi).abs() < 0.05,
+                "{} sags {} rad",
+                v.name,
+                target - qi
+            );
+            largest_sag = largest_sag.max((target - qi).abs());
         }
         let root_pose = walker.generator().standing_feet()[frame.root.index()];
         let soles = Side::BOTH.map(|s| sole_in_world(profile, q, frame.root, &root_pose, s));
@@ -130,6 +150,10 @@ fn walk_and_check(profile: &BipedProfile, motion: GroundPose) -> f64 {
         assert!((end[side.index()].xy - goal[side.index()].xy).norm() < 1e-9);
     }
     assert!(steps.len() >= 2);
+    if profile.servo_saturation.is_some() {
+        // Stiff servos still sag under a stance leg's load: several mrad.
+        assert!(largest_sag > 0.003, "largest sag {largest_sag} rad");
+    }
     com_margin
 }
 

@@ -37,7 +37,8 @@ const MAX_STEPS: usize = 1000;
 ///
 /// The goal is the midpoint between the soles moved by --forward and --left (m) and turned by
 /// --turn (rad), in the robot's starting frame (x forward, y left). Writes OUT/joints.csv (time
-/// in s, joint angles in rad, 100 Hz; the format of `imitate`, playable by the physics check),
+/// in s, joint angles in rad, 100 Hz; the format of `imitate`, playable by the physics check:
+/// the angles plus their servos' static sag when the profile states the servos' stiffness),
 /// OUT/plan.csv (the plan's CoM, ZMP and sole heights, m), OUT/view.html (the 3D viewer) and
 /// OUT/walk.json (steps, duration, speed, the smallest margins of the plan's ZMP and CoM
 /// inside the support polygon, the solver's largest foot and CoM errors).
@@ -90,7 +91,7 @@ pub(crate) fn run(args: WalkArgs, report: Report) -> Result<ExitCode> {
     // The generator's queue is bounded: steps are fed as they land.
     let capacity = walker.generator().settings().capacity;
     let mut pending = steps.iter();
-    let mut recorder = Recorder::new(&profile, walker.q())?;
+    let mut recorder = Recorder::new(&profile, walker.servo_targets())?;
     let mut stopped_at = None;
     loop {
         while walker.generator().queued() < capacity
@@ -102,7 +103,7 @@ pub(crate) fn run(args: WalkArgs, report: Report) -> Result<ExitCode> {
         let footsteps: Vec<Footstep> = (walker.generator().queued_steps())
             .map(|(_, _, step)| *step)
             .collect();
-        recorder.record(&frame, walker.q(), &footsteps)?;
+        recorder.record(&frame, walker.q(), walker.servo_targets(), &footsteps)?;
         let time = frame.walk.time;
         if walker.generator().is_stopped() && pending.len() == 0 && stopped_at.is_none() {
             stopped_at = Some(time);
@@ -159,13 +160,13 @@ struct Recorder {
 }
 
 impl Recorder {
-    /// Starts the outputs with the robot standing in `q` at time 0.
-    fn new(profile: &BipedProfile, q: &[f64]) -> Result<Self> {
+    /// Starts the outputs with the robot standing at time 0, its servos told `targets` (rad).
+    fn new(profile: &BipedProfile, targets: &[f64]) -> Result<Self> {
         let outlines = Side::BOTH.map(|s| profile.foot(s).outline.as_slice());
         let mut joints = JointsWriter::new(Vec::new());
         let names = profile.model(Side::Right).variables().iter();
         joints.header_names(names.map(|v| v.name.as_str()))?;
-        joints.row(0.0, q)?;
+        joints.row(0.0, targets)?;
         let title = format!("{} walking", profile.name);
         Ok(Self {
             polygon: SupportPolygon::new(outlines),
@@ -179,8 +180,15 @@ impl Recorder {
         })
     }
 
-    /// One tick: the joints `q` (rad) that realise `frame`, the `footsteps` not yet landed.
-    fn record(&mut self, frame: &WalkerFrame, q: &[f64], footsteps: &[Footstep]) -> Result<()> {
+    /// One tick: the joints `q` (rad) that realise `frame`, what the servos are told for them
+    /// (`targets`, rad: joints.csv), the `footsteps` not yet landed.
+    fn record(
+        &mut self,
+        frame: &WalkerFrame,
+        q: &[f64],
+        targets: &[f64],
+        footsteps: &[Footstep],
+    ) -> Result<()> {
         let w = &frame.walk;
         let [left, right] = w.feet.map(|f| f.position);
         let _ = writeln!(
@@ -192,7 +200,7 @@ impl Recorder {
         self.com_margin = self.com_margin.min(self.polygon.margin(w, w.com.xy()));
         self.foot_error = self.foot_error.max(frame.foot_error);
         self.com_error = self.com_error.max(frame.com_error);
-        self.joints.row(w.time, q)?;
+        self.joints.row(w.time, targets)?;
         let soles = w.feet.map(|f| {
             IsometryMatrix3::from_parts(
                 Translation3::from(Vector3::from(f.position)),

@@ -13,11 +13,11 @@ use super::footsteps::GroundPose;
 use super::koenemann::imitator::KoenemannImitator;
 use super::phase::SupportPhase;
 use super::poubel::PoubelImitator;
-use super::servo::{ServoSag, other_sole_load};
 use super::tables::TaskTable;
 use crate::human::{HumanFrame, HumanJoint, Side};
 use crate::model::{FrameId, Model, ModelData, ModelError};
 use crate::robots::BipedProfile;
+use crate::robots::servo::{LoadedSoles, ServoSag, other_sole_load};
 use crate::solver::{JointBounds, SolverError};
 
 pub use super::config::{ImitationMethod, ImitatorConfig};
@@ -304,7 +304,14 @@ impl Shared {
         out.q.copy_from_slice(&self.q);
         match &mut self.servo {
             Some(servo) => {
-                let load = other_sole_load(model, data, self.root, &self.soles[root], phase)?;
+                let other = self.root.other();
+                let soles = [self.soles[root][root], self.soles[root][other.index()]];
+                let loaded = match phase.airborne_foot() {
+                    Some(foot) if foot == other => LoadedSoles::Root,
+                    Some(_) => LoadedSoles::Other,
+                    None => LoadedSoles::Both,
+                };
+                let load = other_sole_load(model, data, soles, loaded)?;
                 servo.targets(
                     model,
                     data,

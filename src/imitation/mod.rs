@@ -27,7 +27,6 @@ mod phase_solver;
 mod poubel;
 pub mod reach;
 pub mod scaler;
-mod servo;
 pub mod shaping;
 pub mod support;
 pub mod tables;

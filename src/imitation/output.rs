@@ -48,8 +48,8 @@ pub struct RobotFrame {
     pub q: Vec<f64>,
     /// What to command the robot's position servos (model variable order, rad): `q` plus the
     /// deflection under which servos of the profile's stiffness hold this posture's static load
-    /// ([`BipedProfile::servo_saturation`]; the module `servo` of the imitation states the
-    /// maths), inside the joint limits; equal to `q` when the profile states no stiffness.
+    /// ([`BipedProfile::servo_saturation`], [`crate::robots::servo`]), inside the joint
+    /// limits; equal to `q` when the profile states no stiffness.
     /// `joints.csv` holds these.
     pub servo_targets: Vec<f64>,
     /// The human's support at this frame.

@@ -19,7 +19,9 @@ use super::schedule::smooth;
 use super::swing::SolePose;
 use crate::Error;
 use crate::human::Side;
+use crate::model::{FrameId, Model, ModelData};
 use crate::robots::BipedProfile;
+use crate::robots::servo::{LoadedSoles, ServoSag, other_sole_load};
 use crate::solver::driver::{DriverSettings, PositionDriver};
 use crate::solver::{JointBounds, Solver};
 use crate::tasks::{ComTask, PoseTask, TaskSet, UprightTask};
@@ -61,6 +63,13 @@ pub struct WholeBodyWalker<'p> {
     frame: WalkerFrame,
     /// Half the distance between the soles standing (m).
     half_span: f64,
+    /// The servos' static sag, when the profile states their stiffness.
+    servo: Option<ServoSag>,
+    /// Forward kinematics of each rooted model for the servo targets.
+    data: [ModelData; 2],
+    /// `[root sole, other sole]` of the model rooted at each side.
+    soles: [[FrameId; 2]; 2],
+    servo_targets: Vec<f64>,
 }
 
 impl<'p> WholeBodyWalker<'p> {
@@ -85,7 +94,18 @@ impl<'p> WholeBodyWalker<'p> {
         let bounds = crate::tasks::joint_bounds(profile.model(Side::Right))?;
         let state = *generator.state();
         let half_span = (feet[0].xy - feet[1].xy).norm() / 2.0;
-        Ok(Self {
+        let sole = |root: Side, side: Side| profile.model(root).frame_id(&profile.foot(side).sole);
+        let soles = [
+            [
+                sole(Side::Left, Side::Left)?,
+                sole(Side::Left, Side::Right)?,
+            ],
+            [
+                sole(Side::Right, Side::Right)?,
+                sole(Side::Right, Side::Left)?,
+            ],
+        ];
+        let mut walker = Self {
             profile,
             params,
             generator,
@@ -100,7 +120,13 @@ impl<'p> WholeBodyWalker<'p> {
                 com_error: 0.0,
             },
             half_span,
-        })
+            servo: ServoSag::new(profile),
+            data: profile.models.each_ref().map(Model::new_data),
+            soles,
+            servo_targets: profile.stand.clone(),
+        };
+        walker.update_servo_targets(LoadedSoles::Both)?;
+        Ok(walker)
     }
 
     /// The pattern generator (its queue, settings and state).
@@ -116,6 +142,13 @@ impl<'p> WholeBodyWalker<'p> {
     /// The joint angles of the last tick (rad, model variable order).
     pub fn q(&self) -> &[f64] {
         &self.q
+    }
+
+    /// What to command position servos after the last tick (rad, model variable order): its
+    /// joint angles plus their static sag ([`crate::robots::servo`]); the angles themselves
+    /// when the profile states no servo stiffness.
+    pub fn servo_targets(&self) -> &[f64] {
+        &self.servo_targets
     }
 
     /// Queues a step (see [`PatternGenerator::push`]); returns its landing time (s).
@@ -153,13 +186,41 @@ impl<'p> WholeBodyWalker<'p> {
                 .driver
                 .run(&mut stack.solver, &mut stack.set, &mut self.q, &self.bounds)?;
         let errors = report.task_errors();
+        let (foot_error, com_error) = (errors[0], errors[1]);
+        let loaded = match walk.support {
+            Support::Single { .. } => LoadedSoles::Root,
+            Support::Double => LoadedSoles::Both,
+        };
+        self.update_servo_targets(loaded)?;
         self.frame = WalkerFrame {
             walk,
             root,
-            foot_error: errors[0],
-            com_error: errors[1],
+            foot_error,
+            com_error,
         };
         Ok(&self.frame)
+    }
+
+    /// The servo targets of `q` in the root's model with `loaded` soles.
+    fn update_servo_targets(&mut self, loaded: LoadedSoles) -> Result<(), Error> {
+        let Some(servo) = &mut self.servo else {
+            self.servo_targets.copy_from_slice(&self.q);
+            return Ok(());
+        };
+        let (model, data) = (
+            self.profile.model(self.root),
+            &mut self.data[self.root.index()],
+        );
+        model.forward_kinematics(data, &self.q)?;
+        let load = other_sole_load(model, data, self.soles[self.root.index()], loaded)?;
+        servo.targets(
+            model,
+            data,
+            load.as_slice(),
+            &self.q,
+            &mut self.servo_targets,
+        )?;
+        Ok(())
     }
 
     /// The CoM height at `time` (m): from standing down to the walking height over the start

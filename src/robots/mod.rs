@@ -7,6 +7,7 @@ pub mod nao;
 pub mod profile;
 pub mod profile_toml;
 pub mod self_collision;
+pub mod servo;
 mod size;
 pub mod tuning;
 

@@ -1,5 +1,5 @@
-//! Servo targets (`RobotFrame::servo_targets`): the planned posture plus the static sag of the
-//! profile's position servos. On one foot the expected sag is computed here from forward
+//! Servo targets (`robots::servo`, `RobotFrame::servo_targets`): the planned posture plus the
+//! static sag of the profile's position servos. On one foot the expected sag is computed here from forward
 //! kinematics alone: the gradient of the potential energy `M g z_c` by central differences,
 //! divided by each servo's stiffness `effort / servo_saturation`.
 
@@ -98,4 +98,19 @@ fn a_servo_saturation_that_is_not_a_positive_angle_is_refused() {
         let err = profile.validate().unwrap_err();
         assert!(err.to_string().contains("servo_saturation"), "{err}");
     }
+}
+
+#[test]
+fn targets_of_the_wrong_length_are_refused() {
+    use taskstack::model::ModelError;
+    use taskstack::robots::servo::ServoSag;
+    let profile = g1::profile();
+    let model = profile.model(taskstack::human::Side::Right);
+    let mut data = model.new_data();
+    model.forward_kinematics(&mut data, &profile.stand).unwrap();
+    let mut servo = ServoSag::new(&profile).unwrap();
+    let mut out = vec![0.0; model.nv() - 1];
+    let short = servo.targets(model, &data, &[], &profile.stand, &mut out);
+    assert!(matches!(short, Err(ModelError::WrongQLength { .. })));
+    assert!(ServoSag::new(&nao::profile()).is_none());
 }

@@ -13,9 +13,10 @@
 //! removes the static part of that error. `k = effort / servo_saturation` per variable
 //! ([`BipedProfile::servo_saturation`], [`Variable::effort`](crate::model::Variable::effort);
 //! a variable without an effort limit is taken as rigid). The loads are the model's: rooted at
-//! its root sole, which takes what the other sole does not. The other sole carries nothing while
-//! it is in the air ([`SupportPhase::airborne_foot`]) and otherwise the share of the weight that
-//! the lever rule gives for the centre of mass between the two soles,
+//! its root sole, which takes what the other sole does not ([`other_sole_load`]). The other sole
+//! carries nothing while it is in the air, the whole weight (under the CoM) while the root sole
+//! is, and with both down the share of the weight that the lever rule gives for the centre of
+//! mass between the two soles,
 //!
 //! ```text
 //! w = clamp(((c − p_root) · (p_other − p_root)) / |p_other − p_root|², 0, 1)   (ground plane)
@@ -30,10 +31,9 @@
 use faer::Mat;
 use nalgebra::{Vector2, Vector3};
 
-use super::phase::SupportPhase;
+use super::BipedProfile;
 use crate::human::Side;
 use crate::model::{FrameId, Model, ModelData, ModelError, PointLoad};
-use crate::robots::BipedProfile;
 
 /// Standard gravity (m/s²).
 const GRAVITY: f64 = 9.81;
@@ -41,7 +41,7 @@ const GRAVITY: f64 = 9.81;
 /// The servo stiffness of each variable and a row of scratch: [`ServoSag::targets`] allocates
 /// nothing.
 #[derive(Debug, Clone)]
-pub(crate) struct ServoSag {
+pub struct ServoSag {
     /// N·m/rad (or N/m) per variable; infinite for a variable without an effort limit.
     stiffness: Vec<f64>,
     /// The static torques, 1×n.
@@ -50,7 +50,7 @@ pub(crate) struct ServoSag {
 
 impl ServoSag {
     /// The sag model of `profile`'s servos; `None` when the profile states no servo stiffness.
-    pub(crate) fn new(profile: &BipedProfile) -> Option<Self> {
+    pub fn new(profile: &BipedProfile) -> Option<Self> {
         let saturation = profile.servo_saturation?;
         let model = profile.model(Side::Right);
         let stiffness = model
@@ -64,9 +64,13 @@ impl ServoSag {
         })
     }
 
-    /// Writes into `out` the servo targets of the posture `q` whose forward kinematics `data`
-    /// holds, the model's root sole fixed and `loads` pushing up (see [`other_sole_load`]).
-    pub(crate) fn targets(
+    /// Writes into `out` the servo targets (rad, model variable order) of the posture `q` whose
+    /// forward kinematics `data` holds in `model` (one of the profile's), its root sole fixed and
+    /// `loads` pushing up (see [`other_sole_load`]).
+    ///
+    /// # Errors
+    /// `q` or `out` not one entry per variable, or the errors of [`Model::static_torques`].
+    pub fn targets(
         &mut self,
         model: &Model,
         data: &ModelData,
@@ -74,6 +78,14 @@ impl ServoSag {
         q: &[f64],
         out: &mut [f64],
     ) -> Result<(), ModelError> {
+        for len in [q.len(), out.len()] {
+            if len != self.stiffness.len() {
+                return Err(ModelError::WrongQLength {
+                    expected: self.stiffness.len(),
+                    got: len,
+                });
+            }
+        }
         model.static_torques(data, GRAVITY, loads, self.torques.as_mut())?;
         let variables = model.variables();
         for (k, (target, &angle)) in out.iter_mut().zip(q).enumerate() {
@@ -85,22 +97,33 @@ impl ServoSag {
     }
 }
 
-/// What the sole that is not the root carries in `phase` (module docs), in the model rooted at
-/// `root` (`soles[foot]`: the soles' frames in that model): nothing while it is in the air, the
-/// whole weight while the root sole is, the lever rule's share with both down.
-pub(crate) fn other_sole_load(
+/// Which soles carry the robot.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LoadedSoles {
+    /// The model's root sole alone (the other is in the air).
+    Root,
+    /// The other sole alone (the root sole is in the air).
+    Other,
+    /// Both.
+    Both,
+}
+
+/// What the sole that is not the root carries: nothing, the whole weight under the CoM, or
+/// the lever rule's share (module docs); `soles` are `[root, other]` in `model`, whose forward
+/// kinematics `data` holds.
+///
+/// # Errors
+/// Frames of another model, kinematics not computed, a model without mass.
+pub fn other_sole_load(
     model: &Model,
     data: &ModelData,
-    root: Side,
-    soles: &[FrameId; 2],
-    phase: SupportPhase,
+    [root_sole, other_sole]: [FrameId; 2],
+    loaded: LoadedSoles,
 ) -> Result<Option<PointLoad>, ModelError> {
-    let other = root.other();
-    let (root_sole, other_sole) = (soles[root.index()], soles[other.index()]);
-    Ok(match phase.airborne_foot() {
-        Some(foot) if foot == other => None,
-        Some(_) => Some(whole_weight_on(model, data, other_sole)?),
-        None => Some(lever_load(model, data, root_sole, other_sole)?),
+    Ok(match loaded {
+        LoadedSoles::Root => None,
+        LoadedSoles::Other => Some(whole_weight_on(model, data, other_sole)?),
+        LoadedSoles::Both => Some(lever_load(model, data, root_sole, other_sole)?),
     })
 }
 
