@@ -185,6 +185,8 @@ fn hold(value: Option<&Bound<'_, PyAny>>) -> PyResult<Hold> {
 /// Everything `imitate_clip` returns, gathered without the GIL.
 struct ClipRun {
     track: MotionTrack,
+    /// Each frame's servo targets (`joints.csv`'s rows), concatenated.
+    servo_targets: Vec<f64>,
     phases: Vec<String>,
     metrics: String,
 }
@@ -215,18 +217,20 @@ fn run(
     }
     let mut imitator = Imitator::new(profile, config).map_err(to_py)?;
     let mut recorder = MotionRecorder::new(&imitator).map_err(to_py)?;
-    let mut phases = Vec::new();
+    let (mut phases, mut servo_targets) = (Vec::new(), Vec::new());
     let mut recorded = Ok(());
     let metrics = run_clip(path, source, &mut imitator, hold, |frame| {
         if recorded.is_ok() {
             recorded = recorder.record(frame);
         }
+        servo_targets.extend_from_slice(&frame.servo_targets);
         phases.push(frame.phase.to_string());
     })
     .map_err(to_py)?;
     recorded.map_err(to_py)?;
     Ok(ClipRun {
         track: recorder.finish(),
+        servo_targets,
         phases,
         metrics: metrics_json(&metrics, path),
     })
@@ -248,7 +252,12 @@ pub(crate) fn imitate_clip<'py>(
     let hold = self::hold(hold)?;
     let profile = profile(robot)?;
     let run = py.detach(|| run(&path, profile, &settings, offline, hold))?;
+    let joints = run.track.joint_count().max(1);
+    let frames = run.servo_targets.len() / joints;
+    let targets = Array2::from_shape_vec((frames, joints), run.servo_targets)
+        .map_err(|e| value_error(e.to_string()))?;
     let out = track_dict(py, run.track)?;
+    out.set_item("servo_targets", targets.into_pyarray(py))?;
     out.set_item("phase", PyList::new(py, run.phases)?)?;
     out.set_item("metrics_json", run.metrics)?;
     Ok(out)

@@ -5,7 +5,8 @@ World frame of an imitation: z up, x forward, the floor at z = 0, the first fram
 at the origin.
 
 * :func:`imitate_clip` imitates a clip file (BVH or Kinect v2 CSV) and returns an
-  :class:`ImitationResult`: the numbers of ``taskstack imitate`` (its ``joints.csv``) with the
+  :class:`ImitationResult`: the numbers of ``taskstack imitate`` (its ``joints.csv``, the
+  planned postures and their servo targets) with the
   floating base's pose and the soles' contacts, as numpy arrays.
 * :class:`Imitator` imitates live, one human frame at a time; :func:`read_clip` reads a clip's
   human joint positions.
@@ -47,7 +48,11 @@ class ImitationResult:
 
     Attributes:
         time: (N,) frame times in seconds (the clip's, then the held frames 1/120 s apart).
-        q: (N, J) joint angles in radians, columns named by ``joint_names``.
+        q: (N, J) joint angles in radians, columns named by ``joint_names``: the planned
+            postures (``motion.npz``'s ``dof_pos``).
+        servo_targets: (N, J) what the robot's position servos are told (rad; ``joints.csv``):
+            ``q`` plus the servos' static sag under each posture's load, for a robot whose
+            profile states its servos' stiffness (the G1); equal to ``q`` otherwise (the NAO).
         joint_names: the J joint names (the robot model's variable order; for the G1 its
             URDF's joint order).
         root_pos: (N, 3) the floating base's origin in metres (world; NAO ``torso``, G1
@@ -61,6 +66,7 @@ class ImitationResult:
 
     time: np.ndarray
     q: np.ndarray
+    servo_targets: np.ndarray
     joint_names: List[str]
     root_pos: np.ndarray
     root_quat: np.ndarray
@@ -139,6 +145,7 @@ def imitate_clip(
     return ImitationResult(
         time=raw["time"],
         q=raw["q"],
+        servo_targets=raw["servo_targets"],
         joint_names=list(raw["joint_names"]),
         root_pos=raw["root_pos"],
         root_quat=raw["root_quat"],
