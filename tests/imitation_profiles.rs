@@ -201,6 +201,17 @@ fn profile_errors_name_the_field() {
     assert_eq!(profile.servo_saturation, Some(0.02));
     let err = load(&servos(-0.02));
     assert!(err.to_string().contains("servo_saturation"), "{err}");
+    let sway = |period: f64| format!("sway_period = {period}\n{toml}");
+    let profile = BipedProfile::from_toml_str(&sway(0.9), &urdf).unwrap();
+    assert_eq!(profile.sway_period, Some(0.9));
+    assert_eq!(
+        BipedProfile::from_toml_str(&toml, &urdf)
+            .unwrap()
+            .sway_period,
+        None
+    );
+    let err = load(&sway(0.0));
+    assert!(err.to_string().contains("sway_period"), "{err}");
 
     let missing = BipedProfile::from_toml_file(format!("{TINY}nowhere.toml")).unwrap_err();
     assert!(matches!(missing, ProfileError::Io { .. }), "{missing}");

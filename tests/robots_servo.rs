@@ -34,7 +34,11 @@ fn a_robot_without_servo_stiffness_commands_its_postures() {
 
 #[test]
 fn on_one_foot_the_g1_commands_each_posture_plus_its_servos_sag() {
-    let profile = g1::profile();
+    // Without the sway shaper, whose delay `tests/robots_sway.rs` checks.
+    let profile = BipedProfile {
+        sway_period: None,
+        ..g1::profile()
+    };
     let saturation = profile.servo_saturation.expect("the G1 states its servos");
     let variables = profile
         .model(taskstack::human::Side::Right)

@@ -10,6 +10,7 @@ use super::tables::TableError;
 use crate::locomotion::LocomotionError;
 use crate::model::ModelError;
 use crate::robots::ProfileError;
+use crate::robots::sway::SwayError;
 use crate::solver::SolverError;
 use crate::tasks::TaskError;
 
@@ -44,6 +45,10 @@ pub enum ImitationError {
     /// Invalid support-detection configuration.
     #[error(transparent)]
     Support(#[from] SupportError),
+    /// The sway shaper refused a command (never expected: the imitator's are finite and in
+    /// time order).
+    #[error(transparent)]
+    Sway(#[from] SwayError),
     /// A configuration value out of range.
     #[error("invalid {name} = {value}: {reason}")]
     InvalidParameter {

@@ -18,6 +18,7 @@ use crate::human::{HumanFrame, HumanJoint, Side};
 use crate::model::{FrameId, Model, ModelData, ModelError};
 use crate::robots::BipedProfile;
 use crate::robots::servo::{LoadedSoles, ServoSag, other_sole_load};
+use crate::robots::sway::SwayShaper;
 use crate::solver::{JointBounds, SolverError};
 
 pub use super::config::{ImitationMethod, ImitatorConfig};
@@ -166,6 +167,8 @@ pub(crate) struct Shared {
     pub(crate) output: RobotFrame,
     /// The servos' static deflection, when the profile states their stiffness.
     servo: Option<ServoSag>,
+    /// The servo commands' sway shaper, when the profile states the sway period.
+    sway: Option<SwayShaper>,
     /// Whether the root's forward kinematics are known to be at `q` and untouched since
     /// ([`Shared::note_kinematics_current`]): the next [`Shared::refresh`] then skips them.
     kinematics_current: bool,
@@ -197,6 +200,10 @@ impl Shared {
         let left_sole = *data[right].frame_placement(soles[right][Side::Left.index()]);
         let output = RobotFrame::at_start(&q, left_sole, &[0, 0]);
         let servo = ServoSag::new(&profile);
+        let sway = profile
+            .sway_period
+            .map(|period| SwayShaper::new(period, q.len(), config.nominal_dt))
+            .transpose()?;
         let shared = Shared {
             profile,
             data,
@@ -212,6 +219,7 @@ impl Shared {
             paused: 0.0,
             output,
             servo,
+            sway,
             kinematics_current: false,
         };
         Ok((shared, position_bounds))
@@ -321,6 +329,9 @@ impl Shared {
                 )?;
             }
             None => out.servo_targets.copy_from_slice(&self.q),
+        }
+        if let Some(sway) = &mut self.sway {
+            sway.shape(out.time, &mut out.servo_targets)?;
         }
         for (position, &id) in out.effectors.iter_mut().zip(effectors) {
             *position = data.frame_placement(id).translation.vector;

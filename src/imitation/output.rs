@@ -49,7 +49,9 @@ pub struct RobotFrame {
     /// What to command the robot's position servos (model variable order, rad): `q` plus the
     /// deflection under which servos of the profile's stiffness hold this posture's static load
     /// ([`BipedProfile::servo_saturation`], [`crate::robots::servo`]), inside the joint
-    /// limits; equal to `q` when the profile states no stiffness.
+    /// limits; equal to `q` when the profile states no stiffness. When the profile states its
+    /// sway period ([`BipedProfile::sway_period`]) these commands are then played through the
+    /// sway shaper ([`crate::robots::sway`]): they follow `q` about half that period later.
     /// `joints.csv` holds these.
     pub servo_targets: Vec<f64>,
     /// The human's support at this frame.

@@ -9,6 +9,7 @@ pub mod profile_toml;
 pub mod self_collision;
 pub mod servo;
 mod size;
+pub mod sway;
 pub mod tuning;
 
 pub use profile::{

@@ -244,6 +244,12 @@ pub struct BipedProfile {
     /// deflection `τ / k` under which a servo holds the posture's static load `τ`
     /// ([`Model::static_torques`]); `None`: it commands the postures.
     pub servo_saturation: Option<f64>,
+    /// The period (s) of the robot's sway on one stance foot under its servos
+    /// ([`crate::robots::sway`]: `T = 2π √(m h² / (k − m g h))` for the stance ankle roll's
+    /// stiffness `k`, mass `m` and CoM height `h` above the ankle). With it the imitation plays
+    /// its servo commands through a ZVD shaper at this period, which leaves the sway unexcited
+    /// and delays the commands by about `T / 2`; `None`: commands as planned.
+    pub sway_period: Option<f64>,
 }
 
 impl BipedProfile {
@@ -332,6 +338,14 @@ impl BipedProfile {
             return Err(invalid(
                 "servo_saturation",
                 format!("{saturation} is not a finite angle > 0 (rad)"),
+            ));
+        }
+        if let Some(period) = self.sway_period
+            && !(period.is_finite() && period > 0.0)
+        {
+            return Err(invalid(
+                "sway_period",
+                format!("{period} is not a finite time > 0 (s)"),
             ));
         }
         self.validate_self_collision()

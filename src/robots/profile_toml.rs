@@ -1,7 +1,8 @@
 //! A [`BipedProfile`] from a small TOML file next to the robot's URDF.
 //!
 //! Lengths in metres, angles in radians, frames as in the URDF (x forward, y left, z up). Every
-//! field but `variables`, `locked`, `stand`, `servo_saturation`, `frames` and `tuning` is
+//! field but `variables`, `locked`, `stand`, `servo_saturation`, `sway_period`, `frames` and
+//! `tuning` is
 //! required; an unknown field is an
 //! error (it is a typo more often than not).
 //!
@@ -15,6 +16,8 @@
 //! stand = { l_knee = 0.3, r_knee = 0.3 }  # standing posture; joints not named are 0
 //! servo_saturation = 0.035           # optional: rad of error at which a position servo gives
 //!                                    # its URDF effort (BipedProfile::servo_saturation)
+//! sway_period = 1.1                  # optional: s, the sway on one foot that the servo
+//!                                    # commands are shaped not to excite (robots::sway)
 //!
 //! [feet.left]
 //! link = "l_foot"                    # the URDF link the sole hangs from
@@ -88,6 +91,7 @@ struct File {
     #[serde(default)]
     stand: BTreeMap<String, f64>,
     servo_saturation: Option<f64>,
+    sway_period: Option<f64>,
     feet: Feet,
     step_envelope: Envelope,
     points: BTreeMap<String, Point>,
@@ -322,6 +326,7 @@ fn build(file: File, urdf: &str) -> Result<BipedProfile, ProfileError> {
         tuning: nao::TUNING,
         self_collision: SelfCollision::default(),
         servo_saturation: file.servo_saturation,
+        sway_period: file.sway_period,
     };
     profile.validate()?;
     let scaled = nao::TUNING.scaled(&nao::SIZE, &profile.size()?);

@@ -381,6 +381,7 @@ pub fn profile_with(models: [Model; 2]) -> BipedProfile {
         // The NAO's DH tables state no torque limits. Its servos, stiff for their load
         // (the physics check's NAO reaches its torque limit at 5 mrad), sag a few mrad at most.
         servo_saturation: None,
+        sway_period: None,
     }
 }
 

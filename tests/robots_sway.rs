@@ -1,0 +1,166 @@
+//! The sway shaper (`robots::sway`): commands that leave a lightly damped mode at the design
+//! period still. Checked on an oscillator integrated here (`ẍ = ω² (u − x) − 2ζω ẋ`, the sway
+//! mode driven by the command `u`), not against the shaper's own weights.
+
+use taskstack::human::HumanFrame;
+use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
+use taskstack::imitation::support::SupportConfig;
+use taskstack::io::clip::Clip;
+use taskstack::robots::sway::{SWAY_DAMPING, SwayError, SwayShaper};
+use taskstack::robots::{BipedProfile, g1};
+
+const DT: f64 = 1.0 / 120.0;
+
+/// The largest swing `|x − 1|` of the mode (period `mode_period`) after a unit step of the
+/// command at t = 0.2 s, shaped for `design_period` (or not shaped), once the shaped command
+/// has settled.
+fn residual_sway(design_period: Option<f64>, mode_period: f64) -> f64 {
+    let mut shaper = design_period.map(|p| SwayShaper::new(p, 1, DT).unwrap());
+    let omega = 2.0 * std::f64::consts::PI / mode_period;
+    let (mut x, mut v, mut largest) = (0.0_f64, 0.0_f64, 0.0_f64);
+    let settled = 0.2 + design_period.unwrap_or(0.0);
+    for k in 0..(8.0 / DT) as usize {
+        let t = k as f64 * DT;
+        let mut u = [if t >= 0.2 { 1.0 } else { 0.0 }];
+        if let Some(shaper) = &mut shaper {
+            shaper.shape(t, &mut u).unwrap();
+        }
+        // Semi-implicit Euler in 100 substeps: the mode is integrated, the command held.
+        let h = DT / 100.0;
+        for _ in 0..100 {
+            v += h * (omega * omega * (u[0] - x) - 2.0 * SWAY_DAMPING * omega * v);
+            x += h * v;
+        }
+        if t > settled + DT {
+            largest = largest.max((x - 1.0).abs());
+        }
+    }
+    largest
+}
+
+#[test]
+fn a_shaped_step_leaves_the_sway_mode_still_near_its_period() {
+    let unshaped = residual_sway(None, 1.0);
+    assert!(
+        unshaped > 0.8,
+        "an unshaped step rocks the mode: {unshaped}"
+    );
+    let at_period = residual_sway(Some(1.0), 1.0);
+    assert!(at_period < 0.01 * unshaped, "{at_period} of {unshaped}");
+    // The derivative's zero: a mode 10 % off the design period rocks at under 5 % of an
+    // unshaped step's (undamped: cos²(πr/2) for the frequency ratio r: 2.4 %), 25 % off at
+    // under 20 % (14.6 % at r = 1.25, 9.5 % at 0.8).
+    for (mode, share) in [(0.9, 0.05), (1.1, 0.05), (0.8, 0.2), (1.25, 0.2)] {
+        let off = residual_sway(Some(1.0), mode);
+        let unshaped = residual_sway(None, mode);
+        assert!(off < share * unshaped, "mode {mode} s: {off} of {unshaped}");
+    }
+}
+
+#[test]
+fn the_shaped_command_follows_a_ramp_half_a_period_late() {
+    let period = 1.1;
+    let mut shaper = SwayShaper::new(period, 2, DT).unwrap();
+    let delay = shaper.mean_delay();
+    assert!(delay > 0.45 * period && delay <= 0.5 * period, "{delay}");
+    for k in 0..400 {
+        let t = k as f64 * DT;
+        let mut u = [t, -2.0 * t];
+        shaper.shape(t, &mut u).unwrap();
+        if t >= period {
+            assert!((u[0] - (t - delay)).abs() < 1e-12, "t {t}: {}", u[0]);
+            assert!((u[1] + 2.0 * (t - delay)).abs() < 1e-12, "t {t}: {}", u[1]);
+        }
+    }
+}
+
+#[test]
+fn shaped_commands_stay_between_the_commands_at_any_frame_times() {
+    // Frames at uneven times (a repeated time too): the shaped value is a mix of commands.
+    let mut shaper = SwayShaper::new(0.5, 1, 0.1).unwrap();
+    let (mut t, mut seen) = (0.0_f64, (f64::INFINITY, f64::NEG_INFINITY));
+    for k in 0..300_u32 {
+        t += [0.0, 0.003, 0.02, 0.007][(k % 4) as usize];
+        let value = (f64::from(k) * 0.37).sin() * f64::from(k % 7);
+        seen = (seen.0.min(value), seen.1.max(value));
+        let mut u = [value];
+        shaper.shape(t, &mut u).unwrap();
+        assert!(u[0] >= seen.0 - 1e-12 && u[0] <= seen.1 + 1e-12, "k {k}");
+    }
+}
+
+#[test]
+fn bad_periods_and_commands_are_refused() {
+    for bad in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+        assert!(matches!(
+            SwayShaper::new(bad, 3, DT),
+            Err(SwayError::Period(_))
+        ));
+    }
+    let mut shaper = SwayShaper::new(1.0, 2, DT).unwrap();
+    shaper.shape(1.0, &mut [0.1, 0.2]).unwrap();
+    let err = shaper.shape(0.5, &mut [0.1, 0.2]).unwrap_err();
+    assert!(matches!(err, SwayError::Time { .. }), "{err}");
+    assert!(matches!(
+        shaper.shape(f64::NAN, &mut [0.1, 0.2]),
+        Err(SwayError::Time { .. })
+    ));
+    assert!(matches!(
+        shaper.shape(2.0, &mut [0.1]),
+        Err(SwayError::Length {
+            expected: 2,
+            got: 1
+        })
+    ));
+    let mut nan = [0.1, f64::NAN];
+    assert!(matches!(
+        shaper.shape(2.0, &mut nan),
+        Err(SwayError::NonFinite(_))
+    ));
+    // A refused command leaves the shaper as it was: the next one is shaped from 1.0 s on.
+    let mut u = [0.1, 0.2];
+    shaper.shape(1.0, &mut u).unwrap();
+    assert!(
+        (u[0] - 0.1).abs() < 1e-15 && (u[1] - 0.2).abs() < 1e-15,
+        "{u:?}"
+    );
+}
+
+#[test]
+fn the_g1_commands_its_servo_targets_through_the_shaper() {
+    let profile = g1::profile();
+    let period = profile.sway_period.expect("the G1 states its sway");
+    let unshaped = BipedProfile {
+        sway_period: None,
+        ..profile.clone()
+    };
+    let path = format!(
+        "{}/tests/data/mocap/cmu_05_12_slow_dance_tendu_arms_high.bvh",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let mut clip = Clip::open(path).unwrap();
+    let config = ImitatorConfig {
+        support: SupportConfig::for_capture(clip.capture()),
+        ..ImitatorConfig::default()
+    };
+    let mut shaped = Imitator::new(profile, config.clone()).unwrap();
+    let mut plain = Imitator::new(unshaped, config.clone()).unwrap();
+    let n = shaped.variable_names().count();
+    let mut shaper = SwayShaper::new(period, n, config.nominal_dt).unwrap();
+    let mut frame = HumanFrame::new(0.0);
+    let mut largest_lag = 0.0_f64;
+    while clip.read_frame(&mut frame).unwrap() {
+        let a = shaped.step(&frame).unwrap().clone();
+        let b = plain.step(&frame).unwrap();
+        assert_eq!(a.q, b.q, "the plan is not shaped");
+        let mut expected = b.servo_targets.clone();
+        shaper.shape(b.time, &mut expected).unwrap();
+        assert_eq!(a.servo_targets, expected, "t = {}", a.time);
+        let lag = a.servo_targets.iter().zip(&b.servo_targets);
+        largest_lag = lag.fold(largest_lag, |m, (x, y)| m.max((x - y).abs()));
+    }
+    assert!(
+        largest_lag > 0.01,
+        "the shaper moved nothing: {largest_lag}"
+    );
+}
