@@ -42,7 +42,10 @@ const CHECK_HOLD: f64 = 1.0;
 ///
 ///   joints.csv     time (s) and the robot's joint angles (rad), one line per frame: what
 ///                  its position servos are told, the planned posture plus the servos'
-///                  static sag when the profile states their stiffness (the G1)
+///                  static sag when the profile states their stiffness (the G1), played
+///                  through a shaper that leaves the robot's sway on one foot unexcited
+///                  when it states that sway's period (the G1: 0.52 s later; see
+///                  --no-sway-shaping)
 ///   motion.npz     for learning pipelines (numpy): fps, time (s), joint_names, dof_pos (rad),
 ///                  root_pos (m) and root_quat (x y z w) of the floating base (NAO torso, G1
 ///                  pelvis; world: z up, the first right sole at the origin), contacts (left,

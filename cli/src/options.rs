@@ -20,6 +20,13 @@ pub(crate) struct ImitationOptions {
     /// (TOML next to a URDF; see `taskstack::robots::BipedProfile::from_toml_file`).
     #[arg(long, value_name = "nao|g1|PROFILE.toml", default_value = "nao")]
     pub(crate) robot: String,
+    /// Write the servo commands of joints.csv as planned, not through the sway shaper of a
+    /// robot whose profile states its sway period on one foot (the G1: 1.1 s). The shaper
+    /// keeps stiff servos from rocking the robot on its stance ankle (more G1 runs stand in
+    /// physics) and delays the commands by about half that period (0.52 s on the G1); a
+    /// robot with its own balance feedback may want the plan on time.
+    #[arg(long)]
+    pub(crate) no_sway_shaping: bool,
     /// Let the robot's feet follow the human's footprints: it walks where the human walks, one
     /// step at a time. Without it the robot stands on one leg when the human does, and puts the
     /// foot back where it was.
@@ -136,7 +143,11 @@ pub(crate) enum MethodName {
 impl ImitationOptions {
     /// The robot named by `--robot`.
     pub(crate) fn profile(&self) -> Result<BipedProfile> {
-        robot_profile(&self.robot)
+        let mut profile = robot_profile(&self.robot)?;
+        if self.no_sway_shaping {
+            profile.sway_period = None;
+        }
+        Ok(profile)
     }
 
     /// The motion exports asked for.

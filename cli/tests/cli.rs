@@ -277,6 +277,57 @@ fn imitate_exports_unitree_csv_rows_at_the_asked_rate() {
 }
 
 #[test]
+fn the_g1_plays_its_servo_commands_through_the_sway_shaper_unless_told_not_to() {
+    let dir = temp_dir("sway");
+    let kinect = clip(KINECT);
+    let rows = |name: &str, extra: &[&str]| -> Vec<Vec<f64>> {
+        let out = dir.join(name);
+        let args = ["imitate", s(&kinect), "--robot", "g1", "--out", s(&out)];
+        let run = taskstack(&[&args[..], &["--hold", "1"], extra].concat());
+        assert_eq!(run.code, Some(0), "{}", run.stderr);
+        let joints = std::fs::read_to_string(out.join("joints.csv")).unwrap();
+        (joints.lines().skip(1))
+            .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+            .collect()
+    };
+    let (shaped, planned) = (rows("shaped", &[]), rows("planned", &["--no-sway-shaping"]));
+    assert_eq!(shaped.len(), planned.len());
+    // ZVD at T = 1.1 s for a damping ratio of 0.03 (`robots::sway`'s docs): copies of the plan
+    // delayed 0, T/2 and T, weighted 1, 2K, K² over (1 + K)², K = exp(−ζπ / √(1 − ζ²)).
+    let (period, zeta) = (1.1, 0.03_f64);
+    let k = (-zeta * std::f64::consts::PI / (1.0 - zeta * zeta).sqrt()).exp();
+    let copies = [(0.0, 1.0), (period / 2.0, 2.0 * k), (period, k * k)];
+    let planned_at = |t: f64, j: usize| -> f64 {
+        let after = planned.partition_point(|r| r[0] <= t);
+        match after {
+            0 => planned[0][j],
+            n if n == planned.len() => planned[n - 1][j],
+            n => {
+                let (a, b) = (&planned[n - 1], &planned[n]);
+                a[j] + (t - a[0]) / (b[0] - a[0]) * (b[j] - a[j])
+            }
+        }
+    };
+    let mut largest_lag = 0.0_f64;
+    for (row, plan) in shaped.iter().zip(&planned) {
+        assert_eq!(row[0], plan[0], "the same times");
+        for j in 1..row.len() {
+            let expected: f64 = (copies.iter())
+                .map(|(delay, weight)| weight * planned_at(row[0] - delay, j))
+                .sum::<f64>()
+                / (1.0 + k).powi(2);
+            // Six decimals in joints.csv, on each of three copies' inputs and the output.
+            assert!((row[j] - expected).abs() < 4e-6, "t {} column {j}", row[0]);
+            largest_lag = largest_lag.max((row[j] - plan[j]).abs());
+        }
+    }
+    assert!(
+        largest_lag > 0.01,
+        "the shaper changed nothing: {largest_lag} rad"
+    );
+}
+
+#[test]
 fn a_failed_run_leaves_the_folder_as_it_was() {
     let dir = temp_dir("whole");
     let out = dir.join("out");
