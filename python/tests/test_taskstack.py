@@ -75,9 +75,12 @@ def test_imitate_clip_gives_the_cli_joint_angles(tmp, clip, robot, args, kwargs)
     # joints.csv has six decimals: the same numbers to within its rounding (half a unit of
     # the sixth decimal; numpy and Rust round a value on the .5 boundary differently).
     assert np.max(np.abs(r.servo_targets - rows[:, 1:])) <= 0.5e-6 + 1e-12
-    # The NAO's profile states no servo stiffness; the G1's servos sag by a few mrad.
+    # The NAO's profile states no servo stiffness; the G1's servos sag by a few mrad, and its
+    # commands follow the plan through the sway shaper, 0.52 s late on average: on the first
+    # frame (the shaper holds it) only the sag is left.
     sag = np.max(np.abs(r.servo_targets - r.q))
-    assert (sag == 0.0) if robot == "nao" else (1e-3 < sag < 0.05), sag
+    first = np.max(np.abs(r.servo_targets[0] - r.q[0]))
+    assert (sag == 0.0) if robot == "nao" else (1e-3 < first < 0.05 and sag >= first), sag
     assert np.max(np.abs(r.time - rows[:, 0])) <= 0.5e-6 + 1e-12
     with open(tmp / "out" / "metrics.json") as f:
         metrics = json.load(f)
