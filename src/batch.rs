@@ -308,7 +308,9 @@ pub const HOLD_CAP: f64 = 60.0;
 pub const MAX_HOLD: f64 = 3600.0;
 
 /// How long [`Hold::UntilFinished`] waits with the robot finished before it ends the run (s):
-/// the CoM's last motion toward its goal settles.
+/// the CoM's last motion toward its goal settles. A robot whose profile states its sway period
+/// ([`BipedProfile::sway_period`](crate::robots::BipedProfile::sway_period)) waits that much
+/// longer: its shaped servo commands arrive that long after the plan.
 pub const SETTLE_TIME: f64 = 1.0;
 
 /// How long the human's last pose is held after a clip.
@@ -343,13 +345,11 @@ impl Hold {
     }
 
     /// Whether the hold is over after `held` frames, the robot finished for the last
-    /// `finished` of them.
-    fn is_over(self, held: u64, finished: u64) -> bool {
+    /// `finished` of them and settled after `settle` seconds of that.
+    fn is_over(self, held: u64, finished: u64, settle: f64) -> bool {
         match self {
             Hold::Fixed(seconds) => held > hold_frames(seconds),
-            Hold::UntilFinished => {
-                held > hold_frames(HOLD_CAP) || finished > hold_frames(SETTLE_TIME)
-            }
+            Hold::UntilFinished => held > hold_frames(HOLD_CAP) || finished > hold_frames(settle),
         }
     }
 
@@ -390,6 +390,7 @@ pub fn imitate_clip(
     mut each: impl FnMut(&RobotFrame),
 ) -> Result<ImitationMetrics, BatchError> {
     let hold = hold.into().validated()?;
+    let settle = SETTLE_TIME + imitator.profile().sway_period.unwrap_or(0.0);
     let mut recorder = MetricsRecorder::new(imitator);
     let mut frame = HumanFrame::new(0.0);
     let mut last: Option<HumanFrame> = None;
@@ -418,7 +419,7 @@ pub fn imitate_clip(
                 held.time
             });
             held_frames += 1;
-            if hold.is_over(held_frames, finished_frames) {
+            if hold.is_over(held_frames, finished_frames, settle) {
                 break;
             }
             held.time = end + held_frames as f64 * HOLD_STEP;

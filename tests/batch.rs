@@ -219,19 +219,26 @@ fn imitate_clip_holds_the_last_pose() {
 }
 
 /// The automatic hold ends once the robot has finished (a continuous phase, no step pending, on
-/// the human's feet) for a second, and no sooner; a fixed hold too short for the robot's last
-/// step says the robot had not finished.
+/// the human's feet) for a second (the NAO; the G1 a second plus its sway period, the time its
+/// shaped servo commands take to arrive), and no sooner; a fixed hold too short for the robot's
+/// last step says the robot had not finished.
 #[test]
 fn the_automatic_hold_waits_for_the_robot_to_finish() {
-    use taskstack::batch::{HOLD_CAP, HOLD_STEP, Hold, SETTLE_TIME, imitate_clip};
+    use taskstack::robots::{g1, nao};
+    for (profile, settle) in [(nao::profile(), 1.0), (g1::profile(), 2.1)] {
+        automatic_hold_waits(profile, settle);
+    }
+}
+
+fn automatic_hold_waits(profile: taskstack::robots::BipedProfile, settle_time: f64) {
+    use taskstack::batch::{HOLD_CAP, HOLD_STEP, Hold, imitate_clip};
     use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
     use taskstack::io::clip::Clip;
-    use taskstack::robots::nao;
 
     // The slow dance ends with the robot still bringing its CoM back from a one-leg stance.
     let path = mocap("cmu_05_12_slow_dance_tendu_arms_high.bvh");
     let run = |hold: Hold| {
-        let mut imitator = Imitator::new(nao::profile(), ImitatorConfig::default()).unwrap();
+        let mut imitator = Imitator::new(profile.clone(), ImitatorConfig::default()).unwrap();
         let mut finished = Vec::new();
         let source = Clip::open(&path).unwrap();
         let metrics = imitate_clip(&path, source, &mut imitator, hold, |r| {
@@ -248,9 +255,9 @@ fn the_automatic_hold_waits_for_the_robot_to_finish() {
     let (auto, finished) = run(Hold::UntilFinished);
     assert!(auto.finished);
     let hold = auto.duration - auto.clip_duration;
-    assert!(hold > 0.5 + SETTLE_TIME && hold < HOLD_CAP, "held {hold} s");
-    // The last second of frames is finished, and the frame before it was not.
-    let settle = (SETTLE_TIME / HOLD_STEP).round() as usize;
+    assert!(hold > 0.5 + settle_time && hold < HOLD_CAP, "held {hold} s");
+    // The last settle time of frames is finished, and the frame before it was not.
+    let settle = (settle_time / HOLD_STEP).round() as usize;
     let n = finished.len();
     assert!(finished[n - settle..].iter().all(|&f| f));
     assert!(
