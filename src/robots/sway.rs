@@ -136,12 +136,13 @@ impl SwayShaper {
             return Err(SwayError::NonFinite(bad));
         }
         self.push(time, command);
+        let copies = self.delays.map(|delay| self.bracket(time - delay));
         for (j, value) in command.iter_mut().enumerate() {
-            *value = self
-                .delays
-                .iter()
-                .zip(&self.weights)
-                .map(|(&delay, &weight)| weight * self.at(time - delay, j))
+            *value = (copies.iter().zip(&self.weights))
+                .map(|(&(k0, k1, s), &weight)| {
+                    let value = |k: usize| self.commands[k * self.n + j];
+                    weight * (value(k0) + s * (value(k1) - value(k0)))
+                })
                 .sum();
         }
         Ok(())
@@ -159,19 +160,17 @@ impl SwayShaper {
         }
     }
 
-    /// Variable `j` of the command at `time` (s), interpolated linearly between the commands
-    /// held; the oldest one before them.
-    fn at(&self, time: f64, j: usize) -> f64 {
+    /// Where `time` (s) falls among the commands held: the command is `c[k0] + s (c[k1] −
+    /// c[k0])`, linear between its neighbours; the oldest one before them, the newest after.
+    fn bracket(&self, time: f64) -> (usize, usize, f64) {
         let after = self.times.partition_point(|&t| t <= time);
-        let value = |k: usize| self.commands[k * self.n + j];
         if after == 0 {
-            return value(0);
+            return (0, 0, 0.0);
         }
         if after == self.times.len() {
-            return value(after - 1);
+            return (after - 1, after - 1, 0.0);
         }
         let (t0, t1) = (self.times[after - 1], self.times[after]);
-        let s = (time - t0) / (t1 - t0);
-        value(after - 1) + s * (value(after) - value(after - 1))
+        (after - 1, after, (time - t0) / (t1 - t0))
     }
 }
