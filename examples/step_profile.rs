@@ -1,10 +1,13 @@
 //! Where `Imitator::step`'s slow frames go: imitates a clip and prints the step's wall time (µs)
-//! per support phase (frames, median, p99, max) and the fifteen slowest frames with their phase,
-//! the solver's levels (`rank/rows`, `s` when the level was scaled), clamped joints and the
-//! driver's stop reason.
+//! per support phase and per number of solver passes (`RobotFrame::solve_passes`; frames,
+//! median, p99, max), the passes per frame, and the fifteen slowest frames with their phase,
+//! the solver's levels (`rank/rows`, `s` when the level was scaled), clamped joints and passes
+//! (marked when the solve did not converge). A step costs a fixed part plus one projection and
+//! factorization of every level per pass, so the pass table shows what the tail is made of.
 //!
-//! `cargo run --release --example step_profile -- CLIP [g1] [koenemann] [--walk | --dynamic-walk]`
-//! (default: the NAO, Poubel et al.'s method, standing in place).
+//! `cargo run --release --example step_profile -- CLIP [g1] [koenemann] [--walk | --dynamic-walk]
+//! [--max-passes N]` (default: the NAO, Poubel et al.'s method, standing in place, no budget of
+//! passes: see `Settings::max_passes`).
 
 use std::collections::BTreeMap;
 
@@ -22,7 +25,8 @@ type Frame = (f64, usize, String);
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let usage = "usage: step_profile CLIP [g1] [koenemann] [--walk | --dynamic-walk]";
+    let usage =
+        "usage: step_profile CLIP [g1] [koenemann] [--walk | --dynamic-walk] [--max-passes N]";
     let clip_path = args.first().ok_or(usage)?;
     let has = |s: &str| args.iter().any(|a| a == s);
     let mut clip = Clip::open(clip_path)?;
@@ -35,6 +39,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     config.footsteps.follow = has("--walk") || has("--dynamic-walk");
     config.footsteps.dynamic = has("--dynamic-walk");
+    if let Some(at) = args.iter().position(|a| a == "--max-passes") {
+        let budget = args.get(at + 1).and_then(|n| n.parse().ok()).ok_or(usage)?;
+        config.solver.max_passes = Some(budget);
+    }
     let profile = if has("g1") {
         g1::profile()
     } else {
@@ -43,6 +51,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut imitator = Imitator::new(profile, config)?;
 
     let mut per_phase: BTreeMap<String, Vec<f64>> = BTreeMap::new();
+    let mut per_passes: BTreeMap<usize, Vec<f64>> = BTreeMap::new();
+    let mut passes: Vec<f64> = Vec::new();
     let mut frames: Vec<Frame> = Vec::new();
     let mut human = HumanFrame::new(0.0);
     while clip.read_frame(&mut human)? {
@@ -52,6 +62,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .entry(phase.clone())
             .or_default()
             .push(robot.micros);
+        (per_passes.entry(robot.solve_passes).or_default()).push(robot.micros);
+        passes.push(robot.solve_passes as f64);
         frames.push((
             robot.micros,
             frames.len(),
@@ -60,8 +72,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let mut all: Vec<f64> = frames.iter().map(|f| f.0).collect();
     println!("{}", spread("all", &mut all));
+    println!("{}", spread("solver passes per frame", &mut passes));
     for (phase, mut times) in per_phase {
         println!("{}", spread(&phase, &mut times));
+    }
+    for (passes, mut times) in per_passes {
+        println!("{}", spread(&format!("{passes} solver passes"), &mut times));
     }
     frames.sort_by(|a, b| b.0.total_cmp(&a.0));
     for (micros, index, description) in frames.iter().take(15) {
@@ -89,10 +105,15 @@ fn solve(robot: &RobotFrame) -> String {
         })
         .collect();
     format!(
-        "levels {}  clamped {}  {:?}",
+        "levels {}  clamped {}  passes {}{}",
         levels.join(" "),
         robot.clamped_count,
-        robot.stop
+        robot.solve_passes,
+        if robot.solve_converged {
+            ""
+        } else {
+            " (not converged)"
+        }
     )
 }
 

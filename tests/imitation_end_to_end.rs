@@ -559,3 +559,30 @@ fn each_frame_reports_the_kinematics_of_its_posture() {
         "the clip roots the model at both soles"
     );
 }
+
+/// With a budget of passes (`Settings::max_passes`) every frame's solve of Poubel's method
+/// takes at most that many, and the invariants of `run_held` hold. CMU 131_01 steps onto one
+/// leg and back: without a budget its lift and landing frames took up to 21 passes, so both
+/// budgets are reached there (a solve cut short reports itself not converged).
+#[test]
+fn each_frame_solves_within_its_pass_budget() {
+    let name = "cmu_131_01_start_walk_stop_maxskel.bvh";
+    for budget in [8, 3] {
+        let mut config = ImitatorConfig::default();
+        config.solver.max_passes = Some(budget);
+        run_held(name, config.clone(), HELD_FOOT_TOLERANCE, 1.0);
+        let (mut clip, _) = nao_on(name);
+        config.support = SupportConfig::for_capture(clip.capture());
+        let mut imitator = Imitator::new(nao::profile(), config).unwrap();
+        let (mut frame, mut most, mut cut) = (HumanFrame::new(0.0), 0, 0);
+        while clip.read_frame(&mut frame).unwrap() {
+            let out = imitator.step(&frame).unwrap();
+            let passes = out.solve_passes;
+            assert!(passes <= budget, "t = {}: {passes} passes", out.time);
+            most = most.max(passes);
+            cut += usize::from(passes == budget && !out.solve_converged);
+        }
+        assert_eq!(most, budget);
+        assert!(cut > 0, "no solve was cut short at {budget} passes");
+    }
+}

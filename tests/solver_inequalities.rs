@@ -509,6 +509,71 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(256))]
+
+    /// A budget of passes (`Settings::max_passes`) bounds every solve. A solve that needs no
+    /// more passes than the budget gives the unbudgeted velocity bit for bit; one the budget
+    /// cuts short takes exactly the budget, says it did not converge, and its iterate is
+    /// feasible: every joint inside its interval and the top level's inequalities (the top
+    /// level made of inequalities that allow 0, the cold start) within their bounds.
+    #[test]
+    fn a_pass_budget_bounds_the_solve_and_keeps_its_iterate_feasible(
+        seed in any::<u64>(),
+        budget in 1_usize..6,
+    ) {
+        let mut problem = random_problem(seed, true);
+        let top = &mut problem.levels[0];
+        top.equalities.clear();
+        for (_, lower, upper) in &mut top.inequalities {
+            *lower = lower.min(-0.01);
+            *upper = upper.max(0.01);
+        }
+        if top.inequalities.is_empty() {
+            top.inequalities.push((vec![1.0; problem.n], -0.01, 0.01));
+        }
+        let levels = problem.levels.len();
+        let (free, unbudgeted) = solve(&problem, levels);
+        let passes = unbudgeted.report().active_set_iterations();
+        let settings = Settings {
+            damping_threshold: 0.0,
+            limits_by_active_set: true,
+            max_passes: Some(budget),
+            ..Settings::default()
+        };
+        let mut solver = Solver::with_settings(&shape(&problem, levels), settings).unwrap();
+        let v = solve_with(&mut solver, &problem, levels);
+        let report = solver.report();
+        if passes <= budget {
+            prop_assert_eq!(&v, &free);
+            prop_assert_eq!(report.active_set_iterations(), passes);
+            return Ok(());
+        }
+        prop_assert_eq!(report.active_set_iterations(), budget);
+        prop_assert!(!report.converged());
+        for (i, x) in v.iter().enumerate() {
+            prop_assert!(problem.lo[i] <= *x && *x <= problem.hi[i], "joint {i}: {x} in [{}, {}]", problem.lo[i], problem.hi[i]);
+        }
+        for (row, lower, upper) in &problem.levels[0].inequalities {
+            let value: f64 = row.iter().zip(&v).map(|(a, b)| a * b).sum();
+            let slack = |b: f64| 1e-8 * (1.0 + b.abs());
+            prop_assert!(*lower - slack(*lower) <= value && value <= *upper + slack(*upper));
+        }
+    }
+}
+
+/// A budget of no pass is refused by name.
+#[test]
+fn a_budget_of_no_pass_is_refused() {
+    let shape = StackShape::new(2).with_inequality_level("limit", &[("sum", 1)]);
+    let settings = Settings {
+        max_passes: Some(0),
+        ..Settings::default()
+    };
+    let error = Solver::with_settings(&shape, settings).unwrap_err();
+    assert!(error.to_string().contains("max_passes"), "{error}");
+}
+
 /// A hand-made case: one joint pair, `q̇0 + q̇1 ≤ 1` at the top, `q̇0 = 2, q̇1 = 2` below. The
 /// answer by hand: the lower level is met as well as the bound allows, `(0.5, 0.5)`, and the
 /// bound is active.

@@ -80,6 +80,13 @@ pub struct RobotFrame {
     pub clamped_count: usize,
     /// Why the per-frame iteration stopped.
     pub stop: StopReason,
+    /// Prioritized passes (one projection and factorization of every level) the last solve
+    /// took: its active-set steps, or its clamping iterations when the phase has no
+    /// inequality rows. The step's time grows with it: this is what a slow frame is made of.
+    pub solve_passes: usize,
+    /// Whether the last solve's active-set method converged (`false` when it met an active
+    /// set again or reached its cap; its iterate still keeps every joint limit).
+    pub solve_converged: bool,
     /// The scaled human reference of this frame, in the model root's frame (m): the targets of
     /// the `Scaled` tasks come from here.
     pub reference: [Option<Vector3<f64>>; HumanJoint::COUNT],
@@ -154,6 +161,8 @@ impl RobotFrame {
             clamped: vec![0; q.len()],
             clamped_count: 0,
             stop: StopReason::Converged,
+            solve_passes: 0,
+            solve_converged: true,
             reference: [None; HumanJoint::COUNT],
             world_t_root: IsometryMatrix3::identity(),
             micros: 0.0,
@@ -184,5 +193,7 @@ impl RobotFrame {
         let clamped = report.clamped_joints();
         self.clamped_count = clamped.len().min(self.clamped.len());
         self.clamped[..self.clamped_count].copy_from_slice(&clamped[..self.clamped_count]);
+        self.solve_passes = report.active_set_iterations() + report.clamping_iterations();
+        self.solve_converged = report.converged();
     }
 }

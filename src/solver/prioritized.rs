@@ -131,6 +131,20 @@ pub struct Settings {
     /// warm (a stack with inequality rows, or [`Settings::limits_by_active_set`]); the
     /// clamping loop's result depends on the order it pins joints in, so it always starts cold.
     pub warm_start: bool,
+    /// Largest number of prioritized passes (each a projection and factorization of every
+    /// level) one solve of the active-set method may take, a warm start and its cold retry
+    /// together: a bound on a solve's time for a controller that must keep its rate. A solve
+    /// that reaches it returns its iterate, which keeps every joint interval and every
+    /// inequality row it had not given up (the method is primal feasible) and has moved from
+    /// the start toward the optimum, and reports it not converged; the next solve starts
+    /// cold, as after any solve that did not converge (warm starts from sets cut short, tick
+    /// after tick, kept the higher levels from their motion: on the NAO a held foot turned).
+    /// A budget trades progress for time: where a cold solve needs more passes than the
+    /// budget tick after tick, each tick gets only part of the way. `None`
+    /// (default): the method's own cap, `4 (n + p) + 8` passes, with a warm start that does
+    /// not converge retried cold. `Some(0)` is refused. The clamping loop ignores it (it
+    /// takes at most one pass per joint).
+    pub max_passes: Option<usize>,
 }
 
 impl Default for Settings {
@@ -144,6 +158,7 @@ impl Default for Settings {
             method: Method::Prioritized,
             limits_by_active_set: false,
             warm_start: false,
+            max_passes: None,
         }
     }
 }
@@ -184,6 +199,13 @@ impl Settings {
                 })
             }
         };
+        if self.max_passes == Some(0) {
+            return Err(SolverError::InvalidParameter {
+                name: "max_passes",
+                value: 0.0,
+                reason: "a solve takes at least one pass",
+            });
+        }
         check("rank_tolerance", self.rank_tolerance, true)?;
         check("damping_threshold", self.damping_threshold, false)?;
         check("max_damping", self.max_damping, false)?;

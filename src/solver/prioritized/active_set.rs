@@ -57,7 +57,9 @@
 //! its support in a test. An iteration cap (`4 (n + p) + 8` prioritized solves, `p` the
 //! inequality rows) bounds any other cycle; the report says whether the method converged. The
 //! iterate keeps every joint interval at every step, so even a capped solve never violates a
-//! limit.
+//! limit. A budget of passes per solve
+//! ([`Settings::max_passes`](crate::solver::Settings::max_passes)) bounds a control tick's time
+//! more tightly: the iterate it ends at is feasible in the same way.
 
 use super::super::householder::{dot, norm, solve_upper};
 use super::{Bound, Solver, UsedRow, apply_chain, used_row};
@@ -143,6 +145,17 @@ fn held_bound(clamped: bool, fixed: f64, hi: f64) -> Option<Bound> {
     })
 }
 
+/// Why a run of the active-set method ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum End {
+    /// At the lexicographic optimum.
+    Converged,
+    /// At an active set met at its optimum before in this run.
+    Cycle,
+    /// After the steps it was allowed (the method's cap or the settings' budget).
+    Budget,
+}
+
 /// A bound that enters or leaves the active set: a joint's interval, or an inequality row.
 #[derive(Debug, Clone, Copy)]
 enum Constraint {
@@ -183,36 +196,50 @@ impl Solver {
     /// after frame (on the NAO's hand levels it left the hands 15 cm off), where a cold
     /// start's path would not have met it. After a solve that did not converge the next one
     /// starts cold: where the cold method itself cycles (the NAO's lift and landing phases,
-    /// frame after frame), a warm try first only doubled the cost.
+    /// frame after frame), a warm try first only doubled the cost. With a budget
+    /// ([`Settings::max_passes`](crate::solver::Settings::max_passes)) the two runs share it; a
+    /// run that spends it ends there.
     pub(super) fn solve_active_set(&mut self) {
         let n = self.stack.dof();
         self.scales.fill(1.0);
+        let cap = iteration_cap(n, self.stack.total_inequality_rows());
+        let budget = self.settings.max_passes;
+        let limit = budget.map_or(cap, |b| b.min(cap));
         let warm = self.settings.warm_start && self.active_set.warm_valid;
-        let (mut iterations, mut converged) = self.run_active_set(warm);
-        if warm && !converged {
-            let (cold, cold_converged) = self.run_active_set(false);
-            (iterations, converged) = (iterations + cold, cold_converged);
+        let (mut iterations, mut end) = self.run_active_set(warm, limit);
+        // Out of budget, the warm iterate is the answer; otherwise a warm start that did not
+        // converge is retried cold with what is left.
+        let retry = match budget {
+            None => cap,
+            Some(_) if end == End::Budget => 0,
+            Some(_) => limit - iterations,
+        };
+        if warm && end != End::Converged && retry > 0 {
+            let (cold, cold_end) = self.run_active_set(false, retry);
+            (iterations, end) = (iterations + cold, cold_end);
         }
         self.velocity.copy_from_slice(&self.active_set.point);
         self.keep_active_set();
-        self.active_set.warm_valid = converged;
+        // Only an optimum's set is a start: a set cut short by the budget is one the method
+        // was passing through, and warm starts from such sets, frame after frame, left the
+        // NAO's higher levels a fraction of their motion (a held foot turned 2–6° in physics).
+        self.active_set.warm_valid = end == End::Converged;
         self.report.clamped.clear();
         self.report
             .clamped
             .extend((0..n).filter(|&i| self.clamped[i]));
         self.report.clamping_iterations = 0;
         self.report.active_set_iterations = iterations;
-        self.report.converged = converged;
+        self.report.converged = end == End::Converged;
     }
 
     /// The method's steps from a cold or `warm` start until it converges, meets an active set
-    /// again or reaches its cap; the iterate is left in the workspace's `point`. Returns the
-    /// steps taken and whether it converged.
-    fn run_active_set(&mut self, warm: bool) -> (usize, bool) {
+    /// again or has taken `limit` steps; the iterate is left in the workspace's `point`.
+    /// Returns the steps taken and why it ended.
+    fn run_active_set(&mut self, warm: bool, limit: usize) -> (usize, End) {
         let n = self.stack.dof();
         self.start_active_set(warm);
-        let cap = iteration_cap(n, self.stack.total_inequality_rows());
-        for iterations in 1..=cap {
+        for iterations in 1..=limit {
             self.prioritized_pass();
             // A warm set's first solution that meets every bound is a feasible iterate
             // itself: the method goes on from there.
@@ -236,14 +263,14 @@ impl Solver {
             self.active_set.point.copy_from_slice(&self.velocity);
             if self.met_before() {
                 // The same steps would follow again, and end here again.
-                return (iterations, false);
+                return (iterations, End::Cycle);
             }
             match self.release_candidate() {
                 Some(bound) => self.release(bound),
-                None => return (iterations, true),
+                None => return (iterations, End::Converged),
             }
         }
-        (cap, false)
+        (limit, End::Budget)
     }
 
     /// Records the bounds held at the end of this solve for the next one's warm start.
@@ -381,6 +408,8 @@ impl Solver {
                     Bound::Lower => self.step_lo[i],
                     Bound::Upper => self.step_hi[i],
                 };
+                // The step onto the bound may round past it; the iterate holds it exactly.
+                self.active_set.point[i] = self.fixed_velocity[i];
             }
             Constraint::Row(r, bound) => self.inequality_state[r] = Some(bound),
         }
