@@ -47,6 +47,7 @@ pub(crate) struct Settings {
     iterations: usize,
     calibration: String,
     retargeting: String,
+    sway_shaping: bool,
 }
 
 impl Settings {
@@ -65,6 +66,7 @@ impl Settings {
             iterations: 1,
             calibration: "auto".into(),
             retargeting: "shift-both-feet".into(),
+            sway_shaping: true,
         };
         let Some(kwargs) = kwargs else {
             return Ok(s);
@@ -83,6 +85,7 @@ impl Settings {
                 "iterations" => s.iterations = value.extract()?,
                 "calibration" => s.calibration = value.extract()?,
                 "retargeting" => s.retargeting = value.extract()?,
+                "sway_shaping" => s.sway_shaping = value.extract()?,
                 other => {
                     return Err(PyTypeError::new_err(format!(
                         "unexpected keyword argument {other:?}"
@@ -91,6 +94,16 @@ impl Settings {
             }
         }
         Ok(s)
+    }
+
+    /// The robot named `robot` (see [`profile`]), its commands played through its sway
+    /// shaper unless `sway_shaping` is off (the CLI's `--no-sway-shaping`).
+    fn profile(&self, robot: &str) -> PyResult<BipedProfile> {
+        let mut profile = profile(robot)?;
+        if !self.sway_shaping {
+            profile.sway_period = None;
+        }
+        Ok(profile)
     }
 
     fn config(&self, capture: CaptureSystem) -> PyResult<ImitatorConfig> {
@@ -250,7 +263,7 @@ pub(crate) fn imitate_clip<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let settings = Settings::from_kwargs(options)?;
     let hold = self::hold(hold)?;
-    let profile = profile(robot)?;
+    let profile = settings.profile(robot)?;
     let run = py.detach(|| run(&path, profile, &settings, offline, hold))?;
     let joints = run.track.joint_count().max(1);
     let frames = run.servo_targets.len() / joints;
@@ -339,7 +352,8 @@ impl PyImitator {
             }
         };
         let settings = Settings::from_kwargs(options)?;
-        let imitator = Imitator::new(profile(robot)?, settings.config(capture)?).map_err(to_py)?;
+        let profile = settings.profile(robot)?;
+        let imitator = Imitator::new(profile, settings.config(capture)?).map_err(to_py)?;
         let recorder = MotionRecorder::new(&imitator).map_err(to_py)?;
         Ok(Self {
             imitator,

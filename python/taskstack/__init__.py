@@ -98,6 +98,7 @@ def imitate_clip(
     iterations: int = 1,
     calibration: str = "auto",
     retargeting: str = "shift-both-feet",
+    sway_shaping: bool = True,
 ) -> ImitationResult:
     """Imitate a motion clip with a humanoid; the run of ``taskstack imitate`` with the same
     options (same joint angles as its ``joints.csv``).
@@ -120,6 +121,10 @@ def imitate_clip(
         iterations: solver iterations per frame (1 to 100).
         calibration: ``method="koenemann"``: ``"auto"``, ``"first-frame"`` or ``"ideal"``.
         retargeting: ``method="koenemann"``: ``"shift-both-feet"`` or ``"move-one-foot"``.
+        sway_shaping: play ``servo_targets`` through the robot's sway shaper when its profile
+            states a sway period (the G1; about half that period late, see
+            ``taskstack::robots::sway``); ``False``: the commands as planned, for a robot with
+            balance feedback of its own (the CLI's ``--no-sway-shaping``).
 
     Raises:
         FileNotFoundError, OSError: the clip or the profile cannot be read.
@@ -141,6 +146,7 @@ def imitate_clip(
         iterations=iterations,
         calibration=calibration,
         retargeting=retargeting,
+        sway_shaping=sway_shaping,
     )
     return ImitationResult(
         time=raw["time"],

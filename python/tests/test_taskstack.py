@@ -64,6 +64,7 @@ def cli_joints(clip: Path, out: Path, *args: str):
         (KINECT, "nao", ["--hold", "0.5"], {"hold": 0.5}),
         (STAND_ON_ONE_LEG, "nao", [], {}),
         (KINECT, "g1", ["--hold", "0.25"], {"hold": 0.25}),
+        (KINECT, "g1", ["--hold", "0.25", "--no-sway-shaping"], {"hold": 0.25, "sway_shaping": False}),
         (KINECT, "nao", ["--hold", "0", "--method", "koenemann"], {"hold": 0, "method": "koenemann"}),
     ],
 )
@@ -81,6 +82,8 @@ def test_imitate_clip_gives_the_cli_joint_angles(tmp, clip, robot, args, kwargs)
     sag = np.max(np.abs(r.servo_targets - r.q))
     first = np.max(np.abs(r.servo_targets[0] - r.q[0]))
     assert (sag == 0.0) if robot == "nao" else (1e-3 < first < 0.05 and sag >= first), sag
+    # Without the shaper the commands are the plan plus the sag on every frame.
+    assert kwargs.get("sway_shaping", True) or sag < 0.05, sag
     assert np.max(np.abs(r.time - rows[:, 0])) <= 0.5e-6 + 1e-12
     with open(tmp / "out" / "metrics.json") as f:
         metrics = json.load(f)
