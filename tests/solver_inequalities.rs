@@ -196,6 +196,21 @@ fn same_shape(problem: &Problem, seed: u64) -> Problem {
 }
 
 /// Level `j`'s cost `½‖J q̇ − ẋ‖² + ½‖v(q̇)‖²`.
+/// `problem` with a top level of inequalities only, each allowing 0 (which the joint intervals
+/// allow too): a feasible top level, met by the cold start.
+fn with_feasible_top(mut problem: Problem) -> Problem {
+    let top = &mut problem.levels[0];
+    top.equalities.clear();
+    for (_, lower, upper) in &mut top.inequalities {
+        *lower = lower.min(-0.01);
+        *upper = upper.max(0.01);
+    }
+    if top.inequalities.is_empty() {
+        top.inequalities.push((vec![1.0; problem.n], -0.01, 0.01));
+    }
+    problem
+}
+
 fn level_cost(level: &Level, v: &[f64]) -> f64 {
     let dot = |a: &[f64]| a.iter().zip(v).map(|(x, y)| x * y).sum::<f64>();
     let eq: f64 = level
@@ -483,16 +498,7 @@ proptest! {
     /// exactly, and the report lists its active rows, each held at its bound.
     #[test]
     fn a_feasible_top_level_is_met_and_active_rows_hold_their_bound(seed in any::<u64>()) {
-        let mut problem = random_problem(seed, true);
-        let top = &mut problem.levels[0];
-        top.equalities.clear();
-        for (_, lower, upper) in &mut top.inequalities {
-            *lower = lower.min(-0.01);
-            *upper = upper.max(0.01);
-        }
-        if top.inequalities.is_empty() {
-            top.inequalities.push((vec![1.0; problem.n], -0.01, 0.01));
-        }
+        let problem = with_feasible_top(random_problem(seed, true));
         let (v, solver) = solve(&problem, problem.levels.len());
         let report = solver.report();
         prop_assert!(report.levels()[0].feasible, "{report:?}");
@@ -522,16 +528,7 @@ proptest! {
         seed in any::<u64>(),
         budget in 1_usize..6,
     ) {
-        let mut problem = random_problem(seed, true);
-        let top = &mut problem.levels[0];
-        top.equalities.clear();
-        for (_, lower, upper) in &mut top.inequalities {
-            *lower = lower.min(-0.01);
-            *upper = upper.max(0.01);
-        }
-        if top.inequalities.is_empty() {
-            top.inequalities.push((vec![1.0; problem.n], -0.01, 0.01));
-        }
+        let problem = with_feasible_top(random_problem(seed, true));
         let levels = problem.levels.len();
         let (free, unbudgeted) = solve(&problem, levels);
         let passes = unbudgeted.report().active_set_iterations();

@@ -329,16 +329,8 @@ impl PhaseSolver {
         self.frame_start.copy_from_slice(q);
         // A hand placed on a support moves with the pelvis: then only the other leg settles.
         let legs_may_settle = targets.hand_contacts.iter().all(Option::is_none);
-        let mut tasks = PhaseTasks {
-            model,
-            data,
-            tasks: &self.tasks,
-            constraints: &self.constraints,
-            targets,
-            gradients: &self.table.gradients,
-            criteria,
-            fresh: true,
-        };
+        let (table, resolved) = (&self.table, (&self.tasks[..], &self.constraints[..]));
+        let mut tasks = PhaseTasks::new(model, data, resolved, table, targets, criteria);
         self.driver.run(&mut self.solver, &mut tasks, q, bounds)?;
         let frame_dt = settings.dt * settings.max_iterations as f64;
         self.settle_contact(model, data, q, bounds, frame_dt, legs_may_settle)?;
@@ -369,16 +361,8 @@ impl PhaseSolver {
         if self.contact.is_none() {
             return Ok(0.0);
         }
-        let mut tasks = PhaseTasks {
-            model,
-            data,
-            tasks: &self.tasks,
-            constraints: &self.constraints,
-            targets,
-            gradients: &self.table.gradients,
-            criteria,
-            fresh: true,
-        };
+        let (table, resolved) = (&self.table, (&self.tasks[..], &self.constraints[..]));
+        let mut tasks = PhaseTasks::new(model, data, resolved, table, targets, criteria);
         let stack = self.solver.stack_mut();
         for task in self.tasks.iter().filter(|t| t.level == 0) {
             let mut level = stack.level_mut(0);
@@ -518,6 +502,30 @@ struct PhaseTasks<'a> {
     /// evaluation of a run is at the run's starting posture, whose kinematics the caller
     /// provides.
     fresh: bool,
+}
+
+impl<'a> PhaseTasks<'a> {
+    /// The `tasks` and `constraints` of `table` (resolved against `model`) aiming at `targets`,
+    /// from the posture in `data`, whose kinematics are current.
+    fn new(
+        model: &'a Model,
+        data: &'a mut ModelData,
+        (tasks, constraints): (&'a [ResolvedTask], &'a [ResolvedConstraint]),
+        table: &'a TaskTable,
+        targets: FrameTargets<'a>,
+        criteria: Criteria<'a>,
+    ) -> Self {
+        Self {
+            model,
+            data,
+            tasks,
+            constraints,
+            targets,
+            gradients: &table.gradients,
+            criteria,
+            fresh: true,
+        }
+    }
 }
 
 /// `goal` in the root frame (m), from the current forward kinematics in `data`.
