@@ -494,6 +494,12 @@ fn bad_options_are_usage_errors_naming_the_option() {
     fails(&["imitate", c, "--hold", "abc"], 2, &["--hold", "abc"]);
     fails(&["imitate", c, "--hold", "1e12"], 2, &["--hold"]);
     fails(&["imitate", c, "--hold", "-1"], 2, &["--hold"]);
+    // The arms follow the human only in the dynamic walk.
+    fails(
+        &["imitate", c, "--walking-arms"],
+        2,
+        &["--walking-arms", "--dynamic-walk"],
+    );
     fails(
         &["imitate", c, "--velocity-fraction", "2"],
         2,

@@ -12,7 +12,7 @@ use super::tables::{
     Axes, ComGoal, Constraint, Gradient, GradientKind, OrientationTarget, PointTarget, Task,
     TaskTable,
 };
-use crate::human::{HumanJoint, Side};
+use crate::human::HumanJoint;
 use crate::model::{Axis, FrameId, Model, ModelData};
 use crate::robots::BipedProfile;
 use crate::solver::driver::{DriverReport, DriverSettings, PositionDriver, TaskModel};
@@ -135,6 +135,8 @@ pub(super) struct PhaseSolver {
     step: Vec<f64>,
     other_ankle: FrameId,
     other_sole: FrameId,
+    /// The joints the solve may move ([`PhaseSolver::restricted`]); `None`: all.
+    joints: Option<Vec<bool>>,
 }
 
 /// The tracked axes of `axes` in row order, padded with z.
@@ -227,13 +229,49 @@ impl PhaseSolver {
             contact,
             frame_start: vec![0.0; model.nv()],
             reach: JointBounds::unbounded(model.nv()),
-            movable: free_leg(model, &initial, profile, table.model_root.other())?,
+            movable: own_joints(
+                model,
+                &initial,
+                &profile.foot(table.model_root.other()).sole,
+                &profile.torso,
+            )?,
             legs: profile.sole_chain_variables(initial_q)?,
             row: vec![0.0; model.nv()],
             step: vec![0.0; model.nv()],
             other_ankle: model.frame_id(&other.ankle)?,
             other_sole: model.frame_id(&other.sole)?,
+            joints: None,
         })
+    }
+
+    /// `table` resolved as [`PhaseSolver::new`] does, for a solve that moves only `joints` (per
+    /// model variable): the other columns of every row, and the gradient's entries, are zero
+    /// ([`PhaseTasks::evaluate`]), and a constraint between bodies those joints do not move
+    /// relative to each other is left out (its rows would be zero).
+    pub(super) fn restricted(
+        table: &TaskTable,
+        profile: &BipedProfile,
+        initial_q: &[f64],
+        settings: Settings,
+        joints: Vec<bool>,
+    ) -> Result<Self, ImitationError> {
+        let model = profile.model(table.model_root);
+        let mut data = model.new_data();
+        model.forward_kinematics(&mut data, initial_q)?;
+        let mut table = table.clone();
+        for level in &mut table.levels {
+            let mut kept = Vec::new();
+            for c in level.constraints.drain(..) {
+                if moves_apart(&c, profile, model, &data, &joints)? {
+                    kept.push(c);
+                }
+            }
+            level.constraints = kept;
+        }
+        table.levels.retain(|level| level.rows() > 0);
+        let mut solver = Self::new(&table, profile, initial_q, settings)?;
+        solver.joints = Some(joints);
+        Ok(solver)
     }
 
     /// Number of tasks (entries of the driver's task errors).
@@ -330,7 +368,8 @@ impl PhaseSolver {
         // A hand placed on a support moves with the pelvis: then only the other leg settles.
         let legs_may_settle = targets.hand_contacts.iter().all(Option::is_none);
         let (table, resolved) = (&self.table, (&self.tasks[..], &self.constraints[..]));
-        let mut tasks = PhaseTasks::new(model, data, resolved, table, targets, criteria);
+        let mut tasks = PhaseTasks::new(model, data, resolved, table, targets, criteria)
+            .moving(self.joints.as_deref());
         self.driver.run(&mut self.solver, &mut tasks, q, bounds)?;
         let frame_dt = settings.dt * settings.max_iterations as f64;
         self.settle_contact(model, data, q, bounds, frame_dt, legs_may_settle)?;
@@ -442,23 +481,45 @@ impl PhaseSolver {
     }
 }
 
-/// Per joint of `model` (posture in `data`): whether it turns the sole of `foot` but not the
-/// profile's torso frame (its axis shows in the one's orientation Jacobian, not in the other's).
-fn free_leg(
+/// Per variable of `model` (posture in `data`): whether it turns `frame` (its axis shows in the
+/// frame's orientation Jacobian).
+fn turning(model: &Model, data: &ModelData, frame: FrameId) -> Result<Vec<bool>, ImitationError> {
+    let mut jacobian = faer::Mat::<f64>::zeros(3, model.nv());
+    model.orientation_jacobian(data, frame, jacobian.as_mut())?;
+    Ok((0..model.nv())
+        .map(|i| (0..3).any(|r| jacobian[(r, i)] != 0.0))
+        .collect())
+}
+
+/// The joints that turn `frame` but not `torso` in `model` (at the posture in `data`): a
+/// foot's own leg joints, a hand's own arm joints.
+pub(super) fn own_joints(
     model: &Model,
     data: &ModelData,
-    profile: &BipedProfile,
-    foot: Side,
+    frame: &str,
+    torso: &str,
 ) -> Result<Vec<bool>, ImitationError> {
-    let turns = |frame: &str| -> Result<Vec<bool>, ImitationError> {
-        let mut jacobian = faer::Mat::<f64>::zeros(3, model.nv());
-        model.orientation_jacobian(data, model.frame_id(frame)?, jacobian.as_mut())?;
-        Ok((0..model.nv())
-            .map(|i| (0..3).any(|r| jacobian[(r, i)] != 0.0))
-            .collect())
+    let own = turning(model, data, model.frame_id(frame)?)?;
+    let torso = turning(model, data, model.frame_id(torso)?)?;
+    Ok(own.iter().zip(torso).map(|(&o, t)| o && !t).collect())
+}
+
+/// Whether any of `joints` moves the bodies of `constraint` relative to each other in `model`
+/// (at the posture in `data`): a joint that turns one body's frame but not the other's.
+fn moves_apart(
+    constraint: &Constraint,
+    profile: &BipedProfile,
+    model: &Model,
+    data: &ModelData,
+    joints: &[bool],
+) -> Result<bool, ImitationError> {
+    let Constraint::Distance { first, second, .. } = constraint;
+    let body = |name: &str| -> Result<Vec<bool>, ImitationError> {
+        let frame = (profile.self_collision.body(name)?).capsule(model, &profile.stand)?;
+        turning(model, data, frame.frame)
     };
-    let (sole, torso) = (turns(&profile.foot(foot).sole)?, turns(&profile.torso)?);
-    Ok(sole.iter().zip(torso).map(|(&s, t)| s && !t).collect())
+    let (first, second) = (body(first)?, body(second)?);
+    Ok((first.iter().zip(&second).zip(joints)).any(|((&a, &b), &j)| j && a != b))
 }
 
 /// The table's constraints as inequality tasks on `model`, the bodies from the profile's
@@ -502,6 +563,8 @@ struct PhaseTasks<'a> {
     /// evaluation of a run is at the run's starting posture, whose kinematics the caller
     /// provides.
     fresh: bool,
+    /// The joints the solve may move; `None`: all.
+    joints: Option<&'a [bool]>,
 }
 
 impl<'a> PhaseTasks<'a> {
@@ -524,7 +587,20 @@ impl<'a> PhaseTasks<'a> {
             gradients: &table.gradients,
             criteria,
             fresh: true,
+            joints: None,
         }
+    }
+
+    /// The same, for a solve that moves only `joints` (`None`: all).
+    fn moving(self, joints: Option<&'a [bool]>) -> Self {
+        Self { joints, ..self }
+    }
+}
+
+/// Zeroes the columns of `jacobian` whose joint is not in `joints` (`None`: none).
+fn keep_columns(mut jacobian: MatMut<'_, f64>, joints: Option<&[bool]>) {
+    for (c, _) in (joints.unwrap_or_default().iter().enumerate()).filter(|(_, moves)| !**moves) {
+        jacobian.as_mut().col_mut(c).fill(0.0);
     }
 }
 
@@ -584,8 +660,9 @@ impl TaskModel for PhaseTasks<'_> {
         }
         for task in self.tasks {
             let mut level = stack.level_mut(task.level);
-            let (jacobian, target) = level.rows_mut(task.row, task.rows);
-            self.write(task, jacobian, target)?;
+            let (mut jacobian, target) = level.rows_mut(task.row, task.rows);
+            self.write(task, jacobian.as_mut(), target)?;
+            keep_columns(jacobian, self.joints);
         }
         for c in self.constraints {
             let mut level = stack.level_mut(c.level);
@@ -598,6 +675,7 @@ impl TaskModel for PhaseTasks<'_> {
                 &mut lower[rows.clone()],
                 &mut upper[rows],
             )?;
+            keep_columns(jacobian.subrows_mut(c.row, c.rows.rows()), self.joints);
         }
         stack.clear_gradient();
         for g in self.gradients {
@@ -609,6 +687,12 @@ impl TaskModel for PhaseTasks<'_> {
                     stack.add_gradient(g.kappa, self.criteria.tracking, q)?
                 }
             }
+        }
+        let gradient = stack.gradient_mut();
+        for (g, _) in
+            (gradient.iter_mut().zip(self.joints.unwrap_or_default())).filter(|(_, m)| !**m)
+        {
+            *g = 0.0;
         }
         Ok(())
     }

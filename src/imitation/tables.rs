@@ -352,7 +352,7 @@ impl Level {
     }
 
     /// Rows of the equality tasks and of the inequalities.
-    fn rows(&self) -> usize {
+    pub(crate) fn rows(&self) -> usize {
         let tasks: usize = self.tasks.iter().map(Task::rows).sum();
         tasks + self.constraints.iter().map(Constraint::rows).sum::<usize>()
     }
@@ -533,7 +533,7 @@ fn outer_edge(profile: &BipedProfile, foot: Side) -> [f64; 3] {
 
 /// The "collision" level of the executable tables: every self-collision pair of the profile
 /// kept at its margin; none when the profile has no pairs.
-fn self_collision_level(profile: &BipedProfile) -> Option<Level> {
+pub(crate) fn self_collision_level(profile: &BipedProfile) -> Option<Level> {
     let collision = &profile.self_collision;
     let constraints: Vec<Constraint> = (collision.pairs.iter())
         .map(|[first, second]| Constraint::Distance {

@@ -7,7 +7,7 @@ use crate::human::Side;
 use crate::imitation::error::ImitationError;
 use crate::imitation::footsteps::{FootstepConfig, GroundPose};
 use crate::imitation::phase::{Landing, SupportPhase};
-use crate::imitation::phase_solver::{Criteria, FrameTargets, PhaseSolver};
+use crate::imitation::phase_solver::{Criteria, FrameTargets, PhaseSolver, own_joints};
 use crate::locomotion::footstep::{mean_heading, wrap_angle};
 use crate::locomotion::preview::GRAVITY;
 use crate::locomotion::schedule::smooth;
@@ -48,6 +48,16 @@ fn following_timing(com_height: f64) -> StepTiming {
     }
 }
 
+/// The joints that move the hands of `profile` but not its torso (standing in `q`): the arms.
+fn arm_joints(profile: &BipedProfile, q: &[f64]) -> Result<Vec<bool>, ImitationError> {
+    let model = profile.model(Side::Right);
+    let mut data = model.new_data();
+    model.forward_kinematics(&mut data, q)?;
+    let [left, right] =
+        (profile.hands.clone()).map(|hand| own_joints(model, &data, &hand, &profile.torso));
+    Ok((left?.iter().zip(right?)).map(|(&l, r)| l || r).collect())
+}
+
 /// The robot's walk toward the scaled human's footprints (see the module docs).
 #[derive(Debug)]
 pub(in crate::imitation) struct WalkFollower {
@@ -55,6 +65,13 @@ pub(in crate::imitation) struct WalkFollower {
     params: WalkParams,
     /// The walking table's solver of each root, `[left, right]`.
     solvers: [PhaseSolver; 2],
+    /// The arm step's solver of each root ([`super::walking_arms_table`], the arm joints
+    /// alone), with [`FootstepConfig::walking_arms`].
+    arms: Option<[PhaseSolver; 2]>,
+    /// The posture at the start of the frame, and the joint bounds within the frame's reach
+    /// of it: the arm step uses what the walking solve left of the frame's velocity budget.
+    frame_start: Vec<f64>,
+    reach: JointBounds,
     /// The joint bounds of a walking frame: the legs at the walking velocity fraction.
     bounds: JointBounds,
     envelope: FootArea,
@@ -126,12 +143,26 @@ impl WalkFollower {
             };
             PhaseSolver::new(&table, profile, q, settings)
         };
+        let arms = match config.walking_arms {
+            true => {
+                let joints = arm_joints(profile, q)?;
+                let arms = |root| {
+                    let table = super::walking_arms_table(root, profile);
+                    PhaseSolver::restricted(&table, profile, q, settings, joints.clone())
+                };
+                Some([arms(Side::Left)?, arms(Side::Right)?])
+            }
+            false => None,
+        };
         Ok(Self {
             previous: *generator.state(),
             state: *generator.state(),
             generator,
             params,
             solvers: [solver(Side::Left)?, solver(Side::Right)?],
+            arms,
+            frame_start: q.to_vec(),
+            reach: bounds.clone(),
             bounds,
             envelope,
             near: (config.distance, config.heading),
@@ -425,8 +456,25 @@ impl WalkFollower {
             max_joint_step: f64::INFINITY,
             patience: 0,
         };
+        self.frame_start.copy_from_slice(q);
         let solver = &mut self.solvers[self.root.index()];
-        solver.run(model, data, targets, criteria, q, &self.bounds, settings)
+        solver.run(model, data, targets, criteria, q, &self.bounds, settings)?;
+        let Some(arms) = &mut self.arms else {
+            return Ok(());
+        };
+        // The arms, alone, with what the walking solve left of the frame's velocity budget.
+        self.reach
+            .copy_within_reach(&self.bounds, &self.frame_start, dt);
+        let settings = DriverSettings {
+            gain: 1.0 / dt,
+            dt,
+            max_iterations: 1,
+            tolerance: 0.0,
+            stall_tolerance: 0.0,
+            ..settings
+        };
+        let arms = &mut arms[self.root.index()];
+        arms.run(model, data, targets, criteria, q, &self.reach, settings)
     }
 }
 
