@@ -39,6 +39,7 @@ pub(crate) struct Settings {
     method: String,
     walk: bool,
     dynamic_walk: bool,
+    walking_arms: bool,
     velocity_fraction: f64,
     upper_body_fraction: Option<f64>,
     task_speed: Option<f64>,
@@ -58,6 +59,7 @@ impl Settings {
             method: "poubel".into(),
             walk: false,
             dynamic_walk: false,
+            walking_arms: false,
             velocity_fraction: 0.1,
             upper_body_fraction: None,
             task_speed: None,
@@ -77,6 +79,7 @@ impl Settings {
                 "method" => s.method = value.extract()?,
                 "walk" => s.walk = value.extract()?,
                 "dynamic_walk" => s.dynamic_walk = value.extract()?,
+                "walking_arms" => s.walking_arms = value.extract()?,
                 "velocity_fraction" => s.velocity_fraction = value.extract()?,
                 "upper_body_fraction" => s.upper_body_fraction = value.extract()?,
                 "task_speed" => s.task_speed = value.extract()?,
@@ -150,6 +153,12 @@ impl Settings {
             }
             v => Ok(v),
         };
+        if self.walking_arms && !self.dynamic_walk {
+            return Err(value_error(
+                "walking_arms = True: the arms follow the human only in the dynamic walk \
+                 (dynamic_walk = True)",
+            ));
+        }
         if !(1..=100).contains(&self.iterations) {
             return Err(value_error(format!(
                 "iterations = {}: must be 1–100",
@@ -174,6 +183,7 @@ impl Settings {
         };
         config.footsteps.follow = self.walk || self.dynamic_walk;
         config.footsteps.dynamic = self.dynamic_walk;
+        config.footsteps.walking_arms = self.walking_arms;
         Ok(config)
     }
 }

@@ -89,6 +89,7 @@ def imitate_clip(
     method: str = "poubel",
     walk: bool = False,
     dynamic_walk: bool = False,
+    walking_arms: bool = False,
     offline: bool = False,
     velocity_fraction: float = 0.1,
     upper_body_fraction: Optional[float] = None,
@@ -111,6 +112,9 @@ def imitate_clip(
         method: ``"poubel"`` (support phases and task tables) or ``"koenemann"``.
         walk: the robot's feet follow the human's footprints (quasi-static steps).
         dynamic_walk: experimental, walk with the pattern generator (implies ``walk``).
+        walking_arms: experimental, with ``dynamic_walk``: the hands follow the human while
+            the robot walks (for kinematic retargeting: the physics judge's weak NAO falls on
+            the bundled walks).
         offline: read the whole clip first and time weight shifts ahead of the human.
         velocity_fraction: share of the rated joint velocity the legs may use, in (0, 1].
         upper_body_fraction: the same for arms, head and torso (default: the robot's).
@@ -137,6 +141,7 @@ def imitate_clip(
         method=method,
         walk=walk,
         dynamic_walk=dynamic_walk,
+        walking_arms=walking_arms,
         offline=offline,
         velocity_fraction=velocity_fraction,
         upper_body_fraction=upper_body_fraction,

@@ -66,6 +66,12 @@ def cli_joints(clip: Path, out: Path, *args: str):
         (KINECT, "g1", ["--hold", "0.25"], {"hold": 0.25}),
         (KINECT, "g1", ["--hold", "0.25", "--no-sway-shaping"], {"hold": 0.25, "sway_shaping": False}),
         (KINECT, "nao", ["--hold", "0", "--method", "koenemann"], {"hold": 0, "method": "koenemann"}),
+        (
+            STAND_ON_ONE_LEG,
+            "nao",
+            ["--hold", "0", "--dynamic-walk", "--walking-arms"],
+            {"hold": 0, "dynamic_walk": True, "walking_arms": True},
+        ),
     ],
 )
 def test_imitate_clip_gives_the_cli_joint_angles(tmp, clip, robot, args, kwargs):
@@ -143,6 +149,8 @@ def test_bad_input_raises_python_exceptions_with_the_rust_message(tmp):
         taskstack.imitate_clip(KINECT, method="magic")
     with pytest.raises(ValueError, match="velocity_fraction"):
         taskstack.imitate_clip(KINECT, velocity_fraction=0.0)
+    with pytest.raises(ValueError, match="dynamic_walk"):
+        taskstack.imitate_clip(KINECT, walking_arms=True)
     with pytest.raises(FileNotFoundError, match="missing_profile.toml"):
         taskstack.imitate_clip(KINECT, robot=str(tmp / "missing_profile.toml"))
     with pytest.raises(TypeError, match="velocity_fractoin"):
