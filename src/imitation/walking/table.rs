@@ -69,6 +69,12 @@ pub fn walking_table(root: Side, profile: &BipedProfile) -> TaskTable {
         }],
     ));
     levels.push(level("height", vec![Task::ComHeight]));
+    stance_table(root, levels, Gradient::paper().to_vec())
+}
+
+/// The table of a walking frame of the model rooted at `root`, the stance sole, with the
+/// clamping loop.
+fn stance_table(root: Side, levels: Vec<Level>, gradients: Vec<Gradient>) -> TaskTable {
     TaskTable {
         phase: match root {
             Side::Right => SupportPhase::Right,
@@ -76,7 +82,7 @@ pub fn walking_table(root: Side, profile: &BipedProfile) -> TaskTable {
         },
         model_root: root,
         levels,
-        gradients: Gradient::paper().to_vec(),
+        gradients,
         clamping: true,
     }
 }
@@ -104,16 +110,7 @@ pub fn walking_arms_table(root: Side, profile: &BipedProfile) -> TaskTable {
     let levels = (self_collision_level(profile).into_iter())
         .chain([Level::of_tasks("hands", hands)])
         .collect();
-    TaskTable {
-        phase: match root {
-            Side::Right => SupportPhase::Right,
-            Side::Left => SupportPhase::Left,
-        },
-        model_root: root,
-        levels,
-        gradients: Vec::new(),
-        clamping: true,
-    }
+    stance_table(root, levels, Vec::new())
 }
 
 #[cfg(test)]
