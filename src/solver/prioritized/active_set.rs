@@ -459,6 +459,10 @@ impl Solver {
         self.active_set.decided_rows.fill(false);
         self.active_set.decided_joints.fill(false);
         for j in 0..=levels {
+            // A level only speaks on the bounds no level above decided on.
+            if self.every_bound_decided() {
+                return None;
+            }
             let mut worst: Worst = None;
             if j < levels {
                 self.judge_own_rows(j, &mut worst);
@@ -474,6 +478,17 @@ impl Solver {
             }
         }
         None
+    }
+
+    /// Whether a level above decided the fate of every active bound: every active inequality
+    /// row, and every clamped joint whose interval has room (a zero-width one is pinned
+    /// whatever the levels want). The levels below then have nothing to release.
+    fn every_bound_decided(&self) -> bool {
+        let ws = &self.active_set;
+        let rows = (self.inequality_state.iter().zip(&ws.decided_rows))
+            .all(|(state, &decided)| state.is_none() || decided);
+        rows && (0..self.stack.dof())
+            .all(|i| !self.clamped[i] || ws.decided_joints[i] || self.step_lo[i] >= self.step_hi[i])
     }
 
     /// Level j's active rows at their own level: the residual beyond the bound is the multiplier
