@@ -68,6 +68,10 @@ const SHORT: [&str; 3] = [
     "kinect2_labanotation_ges02_balancinghands.csv",
 ];
 
+/// A walk three times: the first pass warms the walk up, the others walk again (from the end
+/// of the clip back to its start first).
+const WALKS: [&str; 3] = ["cmu_07_04_slow_walk.bvh"; 3];
+
 fn load(names: &[&str]) -> Vec<Vec<HumanFrame>> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/mocap");
     names
@@ -302,23 +306,29 @@ fn g1_full_soak_all_clips_ten_passes() {
 #[test]
 fn g1_step_does_not_allocate_after_warm_up() {
     let imitator = Imitator::new(g1::profile(), ImitatorConfig::default()).unwrap();
-    assert_no_allocation_after_warm_up(imitator);
+    assert_no_allocation_after_warm_up(imitator, &SHORT);
 }
 
-/// Nor does the dynamic walk ([`FootstepConfig::dynamic`]): the pattern generator, its step
-/// planning and the walking tables are allocated in `new` (the slow walk, second of the clips,
-/// starts its walks after the warm-up).
+/// Nor does the dynamic walk ([`FootstepConfig::dynamic`]), with and without the arms
+/// following the human ([`FootstepConfig::walking_arms`]): the pattern generator, its step
+/// planning, the walking tables and the arm step's are allocated in `new` (the slow walk,
+/// second of the clips, starts its walks after the warm-up).
 #[test]
 fn dynamic_walk_step_does_not_allocate_after_warm_up() {
-    let config = ImitatorConfig {
-        footsteps: FootstepConfig {
-            follow: true,
-            dynamic: true,
-            ..FootstepConfig::default()
-        },
-        ..ImitatorConfig::default()
-    };
-    assert_no_allocation_after_warm_up(Imitator::new(nao::profile(), config).unwrap());
+    for walking_arms in [false, true] {
+        let config = ImitatorConfig {
+            footsteps: FootstepConfig {
+                follow: true,
+                dynamic: true,
+                walking_arms,
+                ..FootstepConfig::default()
+            },
+            ..ImitatorConfig::default()
+        };
+        let imitator = Imitator::new(nao::profile(), config).unwrap();
+        let walking = assert_no_allocation_after_warm_up(imitator, &WALKS);
+        assert!(walking > 100, "{walking} walking frames after the warm-up");
+    }
 }
 
 /// Nor does Koenemann et al.'s method (its IK problems, goals and bounds are built in `new`).
@@ -328,7 +338,7 @@ fn koenemann_step_does_not_allocate_after_warm_up() {
         method: ImitationMethod::Koenemann(KoenemannConfig::default()),
         ..ImitatorConfig::default()
     };
-    assert_no_allocation_after_warm_up(Imitator::new(nao::profile(), config).unwrap());
+    assert_no_allocation_after_warm_up(Imitator::new(nao::profile(), config).unwrap(), &SHORT);
 }
 
 /// Nor does the imitator with hands as supports, through placing, the paused clock and holding
@@ -404,11 +414,12 @@ fn look_ahead_step_does_not_allocate_after_warm_up() {
 }
 
 /// Allocations counted on this thread over the short clips after the first (the warm-up).
-fn assert_no_allocation_after_warm_up(mut imitator: Imitator) {
-    let clips = load(&SHORT);
+fn assert_no_allocation_after_warm_up(mut imitator: Imitator, clips: &[&str]) -> usize {
+    let clips = load(clips);
     let mut next_start = 0.0;
     let mut after_warm_up = 0;
     let mut frames = 0;
+    let mut walking = 0;
     for (c, clip) in clips.iter().enumerate() {
         let offset = next_start - clip[0].time;
         for human in clip {
@@ -421,6 +432,7 @@ fn assert_no_allocation_after_warm_up(mut imitator: Imitator) {
             if c > 0 {
                 after_warm_up += n;
                 frames += 1;
+                walking += usize::from(r.walk.is_some());
             }
         }
     }
@@ -429,6 +441,7 @@ fn assert_no_allocation_after_warm_up(mut imitator: Imitator) {
         after_warm_up, 0,
         "{after_warm_up} allocations in {frames} steps"
     );
+    walking
 }
 
 /// The clip loop with its metrics keeps a flat heap however long the clip or the hold: live

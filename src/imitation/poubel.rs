@@ -248,10 +248,10 @@ impl PoubelImitator {
             human_q,
             iterations: config.iterations_per_frame,
             max_task_speed: config.max_task_speed.unwrap_or(tuning.task_speed),
+            walking_arms: config.footsteps.walking_arms,
             // A dynamic walk starts from double support and holds the arms where they are: at
             // the double-support speed they stopped within a frame and the judge's weak NAO
             // fell on CMU 05_02 (16 of 16 runs passed at the stance speed).
-            walking_arms: config.footsteps.walking_arms,
             hand_speed: match (walk.is_some(), config.hand_speed_for(&tuning)) {
                 (true, speed) => HandSpeed {
                     double: speed.stance,
