@@ -35,8 +35,9 @@
 //!    go. For level `j` (and last the gradient level), `−∇_j = −J_jᵀ (J_j x − ẋ_j)` (active rows
 //!    included) is written as `Σ_{p<j} J_pᵀ ν_p + Σ_clamped ν_i e_i` by back-substitution through
 //!    the factorization: `U_pᵀ r = R_p Π_pᵀ ν_p` for the range basis `U_p` of level `p`, deepest
-//!    level first, subtracting `J_pᵀ ν_p` as it goes; what remains on a clamped joint is its
-//!    multiplier. A row held at its upper bound is wanted there at level `j` if `ν > 0`, at its
+//!    level first, subtracting `J_pᵀ ν_p` as it goes (from `r`'s coordinates `U_iᵀ r` too, by
+//!    the rows' projections `U_iᵀ J_pᵀ` kept from the pass, so that the reflectors are applied
+//!    once per level judged); what remains on a clamped joint is its multiplier. A row held at its upper bound is wanted there at level `j` if `ν > 0`, at its
 //!    lower bound if `ν < 0` (a clamped joint likewise). A row's own level speaks first: its
 //!    residual `C q̇ − u` is its multiplier there. Levels are read top-down; the first level that
 //!    has a bound it does not want, among bounds no higher level decided on, releases the most
@@ -469,6 +470,7 @@ impl Solver {
             }
             self.load_negative_gradient(j);
             let tolerance = MULTIPLIER_TOLERANCE * (1.0 + norm(&self.active_set.residual));
+            self.residual_coordinates(j);
             for p in (0..j).rev() {
                 self.back_substitute(p);
             }
@@ -536,26 +538,39 @@ impl Solver {
         }
     }
 
+    /// `r`'s coordinates along the range bases of levels `0..j` into `coords`: one pass
+    /// through their reflectors per level judged, instead of one per level above it.
+    fn residual_coordinates(&mut self, j: usize) {
+        if j == 0 {
+            return;
+        }
+        let ws = &self.active_set;
+        for (c, &i) in self.coords.iter_mut().zip(&self.free) {
+            *c = ws.residual[i];
+        }
+        let (n, factors) = (self.stack.dof(), &self.factors[..j]);
+        apply_chain(
+            &self.qr,
+            n,
+            &self.tau,
+            factors,
+            &self.seg_start,
+            &mut self.coords,
+        );
+    }
+
     /// Finds level p's multipliers `ν_p` from `U_pᵀ r = R_p Π_pᵀ ν_p` (rows beyond the rank get
-    /// 0) and subtracts `J_pᵀ ν_p` from `r`.
+    /// 0; `U_pᵀ r` read from `coords`, which hold `r`'s coordinates along the range bases of
+    /// levels `0..=p`) and subtracts `J_pᵀ ν_p` from `r`, and its coordinates along the levels
+    /// above p (the rows' stored projections) from `coords`.
     fn back_substitute(&mut self, p: usize) {
         let n = self.stack.dof();
         let f = self.factors[p];
         let seg = self.seg_start[p];
+        let above: usize = self.factors[..p].iter().map(|f| f.rank).sum();
         let ws = &mut self.active_set;
-        for (c, &i) in self.coords.iter_mut().zip(&self.free) {
-            *c = ws.residual[i];
-        }
-        let end = apply_chain(
-            &self.qr,
-            n,
-            &self.tau,
-            &self.factors[..=p],
-            &self.seg_start,
-            &mut self.coords,
-        );
         let mu = &mut ws.mu[..f.rank];
-        mu.copy_from_slice(&self.coords[end - f.rank..end]);
+        mu.copy_from_slice(&self.coords[above..above + f.rank]);
         solve_upper(&self.qr[n * seg..], f.dim, f.rank, mu);
         let nu = &mut ws.multipliers[seg..seg + f.rows];
         nu.fill(0.0);
@@ -568,6 +583,10 @@ impl Solver {
                 let (row, _) = used_row(&self.stack, self.used[seg + t], 1.0);
                 for (r, a) in ws.residual.iter_mut().zip(row) {
                     *r -= weight * a;
+                }
+                let projection = &self.projections[n * (seg + t)..n * (seg + t) + above];
+                for (c, a) in self.coords[..above].iter_mut().zip(projection) {
+                    *c -= weight * a;
                 }
             }
         }
