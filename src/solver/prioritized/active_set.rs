@@ -37,11 +37,11 @@
 //!    the factorization: `U_pᵀ r = R_p Π_pᵀ ν_p` for the range basis `U_p` of level `p`, deepest
 //!    level first, subtracting `J_pᵀ ν_p` as it goes (from `r`'s coordinates `U_iᵀ r` too, by
 //!    the rows' projections `U_iᵀ J_pᵀ` kept from the pass, so that the reflectors are applied
-//!    once per level judged); what remains on a clamped joint is its multiplier. A row held at its upper bound is wanted there at level `j` if `ν > 0`, at its
-//!    lower bound if `ν < 0` (a clamped joint likewise). A row's own level speaks first: its
-//!    residual `C q̇ − u` is its multiplier there. Levels are read top-down; the first level that
-//!    has a bound it does not want, among bounds no higher level decided on, releases the most
-//!    unwanted one.
+//!    once per level judged); what remains on a clamped joint is its multiplier. A row held at
+//!    its upper bound is wanted there at level `j` if `ν > 0`, at its lower bound if `ν < 0` (a
+//!    clamped joint likewise). A row's own level speaks first: its residual `C q̇ − u` is its
+//!    multiplier there. Levels are read top-down; the first level that has a bound it does not
+//!    want, among bounds no higher level decided on, releases the most unwanted one.
 //!
 //! With exact least squares at every level the objective decreases lexicographically at every
 //! step, so no active set comes back and the method ends. A **damped** level (near-singular, see
