@@ -1,15 +1,19 @@
 //! Inequality tasks and the contact-normal task: Jacobians against central finite differences of
 //! the quantity they bound, distances against hand calculations, and the CoM-in-polygon task
-//! holding in a driven solve where the equality stack without it lets the CoM out.
+//! holding in a driven solve where the equality stack without it lets the CoM out; the ZMP task
+//! against the links' momentum by differences.
 
+mod common;
+
+use faer::Mat;
 use nalgebra::Vector3;
 use taskstack::model::{Model, ModelData};
 use taskstack::robots::nao;
 use taskstack::solver::Solver;
 use taskstack::solver::driver::{DriverSettings, PositionDriver};
 use taskstack::tasks::{
-    Capsule, CapsuleDistanceTask, ComPolygonTask, ContactNormalTask, InequalityTask,
-    PlaneDistanceTask, PositionTask, Task, TaskError, TaskSet, closest_segment_parameters,
+    Capsule, CapsuleDistanceTask, ComPolygonTask, ContactNormalTask, GRAVITY, InequalityTask,
+    PlaneDistanceTask, PositionTask, Task, TaskError, TaskSet, ZmpTask, closest_segment_parameters,
     joint_bounds,
 };
 
@@ -322,4 +326,126 @@ fn an_inequality_only_stack_is_driven_out_of_violation() {
     let end = task.distance(&model, &data_at(&model, &q)).unwrap();
     assert!(report.iterations > 1, "{report:?}");
     assert!(end >= margin - 1e-4, "ends {end} m apart, {report:?}");
+}
+
+/// The NAO's right sole as a rectangle (m, sole frame, counter-clockwise).
+const SOLE: [[f64; 2]; 4] = [[-0.05, -0.04], [0.1, -0.04], [0.1, 0.04], [-0.05, 0.04]];
+
+/// The ZMP task's rows at `q` for a frame that started at `start` after joint velocity
+/// `velocity`, `dt` s long: the Jacobian and the upper room of every row.
+fn zmp_rows(
+    model: &Model,
+    start: &[f64],
+    velocity: &[f64],
+    q: &[f64],
+    dt: f64,
+) -> (Mat<f64>, Vec<f64>, Vec<f64>) {
+    let mut task = ZmpTask::new(model, 4, &SOLE, 0.01, 0.5).unwrap();
+    task.begin_frame(start, velocity, dt).unwrap();
+    let mut jacobian = Mat::zeros(task.rows(), model.nv());
+    let (mut lower, mut upper) = (vec![0.0; task.rows()], vec![0.0; task.rows()]);
+    task.write(
+        model,
+        &data_at(model, q),
+        q,
+        jacobian.as_mut(),
+        &mut lower,
+        &mut upper,
+    )
+    .unwrap();
+    (jacobian, lower, upper)
+}
+
+#[test]
+fn zmp_rows_match_the_momentum_of_the_links() {
+    let model = nao::rfoot();
+    let q0 = bent(&model);
+    let dt = 0.01;
+    let velocity: Vec<f64> = (0..model.nv())
+        .map(|i| 0.5 * ((i as f64) * 0.9).cos())
+        .collect();
+    // At the frame's start the joints stop: Ḣ = −H₋/Δt, H₋ the links' momentum at `velocity`.
+    let (_, lower, upper) = zmp_rows(&model, &q0, &velocity, &q0, dt);
+    let h_rate = -common::momentum_by_differences(&model, &q0, &velocity) / dt;
+    let weight = model.total_mass() * GRAVITY;
+    let c = model.com(&data_at(&model, &q0)).unwrap();
+    let zmp = [c.x - h_rate.y / weight, c.y + h_rate.x / weight];
+    // Edge 0 runs from (−0.05, −0.04) to (0.1, −0.04): outward normal −y, offset 0.04.
+    let expected = 0.04 - 0.01 + zmp[1];
+    assert!(
+        (upper[0] - expected).abs() < 1e-6,
+        "{} vs {expected}",
+        upper[0]
+    );
+    // Edge 1 (x = 0.1, normal +x): room 0.1 − 0.01 − p_x.
+    assert!((upper[1] - (0.09 - zmp[0])).abs() < 1e-6);
+    assert!(
+        (upper[4] - (0.5 - h_rate.z)).abs() < 1e-4 && (lower[4] - (-0.5 - h_rate.z)).abs() < 1e-4
+    );
+    assert!(lower[..4].iter().all(|l| *l == f64::NEG_INFINITY));
+}
+
+#[test]
+fn zmp_jacobian_is_the_derivative_of_its_rows() {
+    let model = nao::rfoot();
+    let q0 = bent(&model);
+    let (dt, rest) = (0.01, vec![0.0; model.nv()]);
+    let (jacobian, _, _) = zmp_rows(&model, &q0, &rest, &q0, dt);
+    for k in [0, 5, 12, 20] {
+        let h = 1e-7;
+        let mut q = q0.clone();
+        q[k] += h;
+        let (_, _, upper_plus) = zmp_rows(&model, &q0, &rest, &q, dt);
+        q[k] -= 2.0 * h;
+        let (_, _, upper_minus) = zmp_rows(&model, &q0, &rest, &q, dt);
+        for r in 0..5 {
+            // The room shrinks as the row's value grows.
+            let fd = -(upper_plus[r] - upper_minus[r]) / (2.0 * h);
+            let scale = jacobian[(r, k)].abs().max(1.0);
+            assert!(
+                (fd - jacobian[(r, k)]).abs() < 1e-4 * scale,
+                "row {r} var {k}: {fd} vs {}",
+                jacobian[(r, k)]
+            );
+        }
+    }
+}
+
+#[test]
+fn zmp_task_rejects_bad_input() {
+    let model = nao::rfoot();
+    let n = model.nv();
+    assert!(matches!(
+        ZmpTask::new(&model, 3, &SOLE[..3], 0.0, 1.0),
+        Err(TaskError::InvalidGeometry { .. })
+    ));
+    assert!(matches!(
+        ZmpTask::new(&model, 4, &SOLE, 0.0, f64::NAN),
+        Err(TaskError::InvalidGeometry { .. })
+    ));
+    let mut task = ZmpTask::new(&model, 4, &SOLE, 0.0, 1.0).unwrap();
+    assert!(
+        task.begin_frame(&vec![0.0; n], &vec![0.0; n - 1], 0.01)
+            .is_err()
+    );
+    assert!(
+        task.begin_frame(&vec![f64::NAN; n], &vec![0.0; n], 0.01)
+            .is_err()
+    );
+    assert!(task.begin_frame(&vec![0.0; n], &vec![0.0; n], 0.0).is_err());
+    let mut jacobian = Mat::zeros(task.rows(), n);
+    let (mut lower, mut upper) = (vec![0.0; 5], vec![0.0; 5]);
+    let data = data_at(&model, &vec![0.0; n]);
+    let short = vec![0.0; n - 1];
+    assert!(
+        task.write(
+            &model,
+            &data,
+            &short,
+            jacobian.as_mut(),
+            &mut lower,
+            &mut upper
+        )
+        .is_err()
+    );
 }

@@ -291,6 +291,53 @@ impl Model {
         Ok(())
     }
 
+    /// 3×n Jacobian of the whole body's angular momentum about the base frame's origin:
+    /// `H_O = A_O q̇` (kg·m²/s per unit q̇, base-frame axes), written into `out`.
+    ///
+    /// `H_O = Σ_i m_i x_i × ẋ_i + R_i I_i R_iᵀ ω_i` over the links (`x_i` the link's centre of
+    /// mass, `R_i` its orientation, `I_i` its [`Link::inertia`](super::Link::inertia), taken as
+    /// zero when the model has none: point masses, as a DH table gives). A revolute joint of
+    /// axis `a` through `o` moves link `i` of its subtree with `ẋ_i = a × (x_i − o) θ̇` and
+    /// `ω_i = a θ̇`, so its column is `Σ_i m_i x_i × (a × (x_i − o)) + R_i I_i R_iᵀ a`; a
+    /// prismatic joint's is `Σ_i m_i x_i × a`. About the centre of mass `c` instead (the
+    /// centroidal momentum): `A_G = A_O − m [c]× J_c`. With the base fixed in the world (a
+    /// standing sole) `Ḣ_O` is the moment of the external forces about `O`: gravity's and the
+    /// ground's, which is how a whole-body ZMP is read off it
+    /// ([`ZmpTask`](crate::tasks::ZmpTask)).
+    pub fn angular_momentum_jacobian(
+        &self,
+        data: &ModelData,
+        mut out: MatMut<'_, f64>,
+    ) -> Result<(), ModelError> {
+        self.check_computed(data)?;
+        self.check_shape(&out, 3)?;
+        out.fill(0.0);
+        for (i, link) in self.links.iter().enumerate().skip(1) {
+            let placement = &data.link_placements[i];
+            let x = placement.transform_point(&link.com.into()).coords;
+            let rotational = link.inertia.map(|inertia| {
+                let r = placement.rotation.matrix();
+                r * inertia * r.transpose()
+            });
+            for &j in &self.chain[self.chain_start[i]..self.chain_start[i + 1]] {
+                let axis = data.axes[j];
+                let column = match self.joints[j - 1].kind {
+                    JointKind::Revolute => {
+                        let o = data.link_placements[j].translation.vector;
+                        let spin = rotational.map_or(Vector3::zeros(), |r| r * axis);
+                        x.cross(&axis.cross(&(x - o))) * link.mass + spin
+                    }
+                    JointKind::Prismatic | JointKind::Fixed => x.cross(&axis) * link.mass,
+                };
+                let (k, column) = self.driven(j, column);
+                for r in 0..3 {
+                    out[(r, k)] += column[r];
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// Column contribution of the moving joint of link `i` to the velocity of the point `x`.
     fn point_column(&self, data: &ModelData, i: usize, x: &Vector3<f64>) -> (usize, Vector3<f64>) {
         let axis = data.axes[i];

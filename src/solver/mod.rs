@@ -89,7 +89,7 @@ mod gradient;
 mod householder;
 pub mod prioritized;
 mod report;
-mod stack;
+pub(crate) mod stack;
 
 pub use bounds::JointBounds;
 pub use error::SolverError;

@@ -85,7 +85,7 @@ impl ComPolygonTask {
     }
 
     /// Edge `i`'s outward unit normal `n_i` and offset `n_iᵀ v_i` (m), or `None` for a spare row.
-    fn edge_normal(&self, i: usize) -> Option<([f64; 2], f64)> {
+    pub(crate) fn edge_normal(&self, i: usize) -> Option<([f64; 2], f64)> {
         let k = self.vertices.len();
         if i >= k {
             return None;
@@ -95,6 +95,16 @@ impl ComPolygonTask {
         let length = dx.hypot(dy);
         let n = [dy / length, -dx / length];
         Some((n, n[0] * a[0] + n[1] * a[1]))
+    }
+
+    /// The most vertices the task holds (its rows).
+    pub fn capacity(&self) -> usize {
+        self.capacity
+    }
+
+    /// The distance kept from every edge (m).
+    pub fn margin(&self) -> f64 {
+        self.margin
     }
 
     /// The vertices (m, base frame, counter-clockwise).

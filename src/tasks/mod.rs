@@ -4,7 +4,8 @@
 //! ([`ContactNormalTask`], Di Fava et al. eq. 11), a frame's z axis along a direction
 //! ([`UprightTask`], its heading free); inequality tasks ([`InequalityTask`]): the
 //! CoM inside a support polygon ([`ComPolygonTask`]), capsule–capsule and capsule–plane
-//! distances above a margin ([`CapsuleDistanceTask`], [`PlaneDistanceTask`]); and [`TaskSet`],
+//! distances above a margin ([`CapsuleDistanceTask`], [`PlaneDistanceTask`]); the whole-body ZMP
+//! inside a support polygon ([`ZmpTask`], rows of a frame's motion); and [`TaskSet`],
 //! which stacks them in priority levels and drives the solver with them
 //! ([`TaskModel`](crate::solver::driver::TaskModel)).
 //!
@@ -47,6 +48,7 @@ mod position;
 mod posture;
 mod set;
 mod upright;
+mod zmp;
 
 use std::any::Any;
 use std::fmt::Debug;
@@ -69,6 +71,7 @@ pub use position::{FramePoint, PositionTask, point_rows};
 pub use posture::PostureTask;
 pub use set::TaskSet;
 pub use upright::{UprightTask, upright_rows};
+pub use zmp::{GRAVITY, ZmpTask};
 
 /// Errors of building or evaluating tasks.
 #[derive(Debug, Clone, PartialEq, Error)]

@@ -168,3 +168,30 @@ pub fn small_rotation_vector(r: &nalgebra::Rotation3<f64>) -> Vector3<f64> {
 pub fn rotation_error(a: &nalgebra::Rotation3<f64>, b: &nalgebra::Rotation3<f64>) -> f64 {
     (a.matrix() - b.matrix()).amax()
 }
+
+/// The whole body's angular momentum about the base origin (kg·m²/s) when `q` moves at `v`,
+/// from the links' motion alone: `Σ m x × ẋ + R I Rᵀ ω`, with `ẋ` and `ω` central differences
+/// of the links' placements (no Jacobian of the crate).
+pub fn momentum_by_differences(model: &Model, q: &[f64], v: &[f64]) -> Vector3<f64> {
+    let at = |t: f64| {
+        let mut data = model.new_data();
+        let q: Vec<f64> = q.iter().zip(v).map(|(q, v)| q + t * v).collect();
+        model.forward_kinematics(&mut data, &q).unwrap();
+        data
+    };
+    let (now, ahead, behind) = (at(0.0), at(H), at(-H));
+    let mut momentum = Vector3::zeros();
+    for (i, link) in model.links().iter().enumerate() {
+        let com = |d: &ModelData| d.link_placement(i) * nalgebra::Point3::from(link.com);
+        let x = com(&now).coords;
+        let velocity = (com(&ahead) - com(&behind)) / (2.0 * H);
+        let turn = ahead.link_placement(i).rotation * behind.link_placement(i).rotation.inverse();
+        let omega = small_rotation_vector(&turn) / (2.0 * H);
+        let r = now.link_placement(i).rotation.matrix();
+        let spin = (link.inertia).map_or(Vector3::zeros(), |inertia| {
+            r * inertia * r.transpose() * omega
+        });
+        momentum += x.cross(&velocity) * link.mass + spin;
+    }
+    momentum
+}
