@@ -9,6 +9,8 @@
 //! a robot moving at 10 % of its rated speed can finish the step it is taking.
 //! `cargo test --release --test imitation_end_to_end -- --nocapture` prints the per-clip metrics.
 
+mod common;
+
 use taskstack::human::{HumanFrame, Side};
 use taskstack::imitation::config::ImitationMethod;
 use taskstack::imitation::footsteps::FootstepConfig;
@@ -614,4 +616,82 @@ fn each_frame_solves_within_its_pass_budget() {
         assert_eq!(most, budget);
         assert!(cut > 0, "no solve was cut short at {budget} passes");
     }
+}
+
+/// The largest vertical moment (N·m) the arms' motion asks of the floor over `name` with
+/// `config`: recomputed from the frames' postures, `Ḣ_z = (H(q₋, v) − H(q₋, v₋))/Δt` with `H`
+/// the links' momentum by differences (`common::momentum_by_differences`) for the arms'
+/// joints' velocities alone (picked by name), in the model of the frame's root.
+fn arms_yaw_moment(name: &str, config: ImitatorConfig) -> (f64, ImitationMetrics) {
+    let mut clip = Clip::open(clip_path(name)).unwrap();
+    let config = ImitatorConfig {
+        support: SupportConfig::for_capture(clip.capture()),
+        ..config
+    };
+    let mut imitator = Imitator::new(nao::profile(), config).unwrap();
+    let profile = imitator.profile().clone();
+    let arms: Vec<bool> = (imitator.variable_names())
+        .map(|n| ["Shoulder", "Elbow", "Wrist"].iter().any(|a| n.contains(a)))
+        .collect();
+    assert_eq!(arms.iter().filter(|a| **a).count(), 10);
+    let mut recorder = MetricsRecorder::new(&imitator);
+    let mut frames: Vec<(Side, Vec<f64>, f64)> = Vec::new();
+    let mut frame = HumanFrame::new(0.0);
+    while clip.read_frame(&mut frame).unwrap() {
+        let out = imitator.step(&frame).unwrap();
+        recorder.record(out);
+        frames.push((out.root, out.q.clone(), out.time));
+    }
+    let mut worst: f64 = 0.0;
+    for w in frames.windows(3) {
+        let [(r0, q0, t0), (r1, q1, t1), (r2, q2, t2)] = [&w[0], &w[1], &w[2]];
+        if r0 != r1 || r1 != r2 {
+            continue;
+        }
+        let velocity = |a: &[f64], b: &[f64], dt: f64| -> Vec<f64> {
+            (a.iter().zip(b).zip(&arms))
+                .map(|((a, b), arm)| if *arm { (b - a) / dt } else { 0.0 })
+                .collect()
+        };
+        let (before, now) = (velocity(q0, q1, t1 - t0), velocity(q1, q2, t2 - t1));
+        let model = profile.model(*r1);
+        let rate = (common::momentum_by_differences(model, q1, &now)
+            - common::momentum_by_differences(model, q1, &before))
+            / (t2 - t1);
+        if rate.z.abs() > 0.35 {
+            eprintln!("t {t2:.3} yaw {:.3}", rate.z);
+        }
+        worst = worst.max(rate.z.abs());
+    }
+    (worst, recorder.finish())
+}
+
+/// The ZMP balance with hands at 1 m/s (10 m/s²): the arms' vertical moment on the floor,
+/// recomputed from the postures, stays within the profile's bound; without it the same hands
+/// ask the floor for several times more (the judge's loaded feet turned 3.5–4.6° on this clip),
+/// and the hands follow about as closely either way.
+#[test]
+fn zmp_balance_bounds_the_arms_moment_on_the_floor() {
+    let name = "kinect2_labanotation_ges02_balancinghands.csv";
+    let fast = |zmp_balance| ImitatorConfig {
+        max_tracking_speed: Some(1.0),
+        max_tracking_acceleration: Some(10.0),
+        zmp_balance,
+        ..ImitatorConfig::default()
+    };
+    let bound = nao::profile().max_floor_yaw_moment();
+    let (free, free_metrics) = arms_yaw_moment(name, fast(false));
+    let (balanced, balanced_metrics) = arms_yaw_moment(name, fast(true));
+    let hands = |m: &ImitationMetrics| {
+        let e = &m.effectors_clip[..2];
+        (e[0].double_support.mean + e[1].double_support.mean) / 2.0
+    };
+    eprintln!(
+        "{name}: arms' vertical moment {free:.3} → {balanced:.3} N·m (bound {bound:.3}); hands {:.4} → {:.4} m",
+        hands(&free_metrics),
+        hands(&balanced_metrics)
+    );
+    assert!(free > 2.0 * bound, "{free} N·m without the ZMP level");
+    assert!(balanced < 1.1 * bound, "{balanced} N·m, bound {bound}");
+    assert!(hands(&balanced_metrics) < hands(&free_metrics) + 0.005);
 }

@@ -750,10 +750,50 @@ fn executable_tables_keep_the_bodies_apart_below_balance() {
         .iter_mut()
         .find(|l| l.name == "collision")
         .unwrap();
-    let Constraint::Distance { margin, .. } = &mut level.constraints[0];
+    let Constraint::Distance { margin, .. } = &mut level.constraints[0] else {
+        panic!("the collision level holds distances");
+    };
     *margin = -0.01;
     assert!(matches!(
         table.validate(),
         Err(TableError::InvalidMargin { .. })
+    ));
+}
+
+/// The ZMP balance adds a "dynamics" level to every table right below the feet, the CoM and
+/// the collision level, with room for both soles' outlines; a bound that is not > 0 is refused.
+#[test]
+fn zmp_balance_sits_below_the_feet_and_the_com() {
+    use taskstack::imitation::tables::Constraint;
+    let profile = nao::profile();
+    let mut tables = TaskTables::executable(&PhaseConfig::default(), &profile);
+    tables.add_zmp_balance(&profile);
+    for phase in SupportPhase::ALL {
+        let table = tables.table(phase);
+        table.validate().unwrap();
+        let names: Vec<&str> = table.levels.iter().map(|l| l.name.as_str()).collect();
+        let at = names.iter().position(|n| *n == "dynamics").unwrap();
+        assert_eq!(names[at - 1], "collision", "{phase:?}: {names:?}");
+        assert_eq!(names[at + 1], "posture", "{phase:?}: {names:?}");
+        let Constraint::Zmp {
+            margin,
+            max_yaw_moment,
+            vertices,
+        } = table.levels[at].constraints[0]
+        else {
+            panic!("{phase:?}: not a ZMP row");
+        };
+        // Two four-corner outlines; μ 0.5 × a fifth of the weight × the corners' mean lever.
+        assert_eq!((margin, vertices), (0.0, 8));
+        assert!((0.1..1.0).contains(&max_yaw_moment), "{max_yaw_moment} N·m");
+    }
+    let mut rs = tables.table(P::Right).clone();
+    let level = rs.levels.iter_mut().find(|l| l.name == "dynamics").unwrap();
+    if let Constraint::Zmp { max_yaw_moment, .. } = &mut level.constraints[0] {
+        *max_yaw_moment = 0.0;
+    }
+    assert!(matches!(
+        rs.validate(),
+        Err(TableError::InvalidZmpBound { .. })
     ));
 }

@@ -331,6 +331,17 @@ fn dynamic_walk_step_does_not_allocate_after_warm_up() {
     }
 }
 
+/// Nor does the ZMP balance ([`ImitatorConfig::zmp_balance`]): its polygons, rows and the
+/// joints' velocity are sized in `new`.
+#[test]
+fn zmp_balance_step_does_not_allocate_after_warm_up() {
+    let config = ImitatorConfig {
+        zmp_balance: true,
+        ..ImitatorConfig::default()
+    };
+    assert_no_allocation_after_warm_up(Imitator::new(nao::profile(), config).unwrap(), &SHORT);
+}
+
 /// Nor does Koenemann et al.'s method (its IK problems, goals and bounds are built in `new`).
 #[test]
 fn koenemann_step_does_not_allocate_after_warm_up() {

@@ -1,5 +1,6 @@
-//! The position-level driver: per-task error limits ([`TaskModel::max_task_error`]) and the
-//! patience rule ([`DriverSettings::patience`]).
+//! The position-level driver: per-task error limits ([`TaskModel::max_task_error`]), per-row
+//! inequality corrections ([`TaskModel::max_inequality_correction`]) and the patience rule
+//! ([`DriverSettings::patience`]).
 
 use taskstack::solver::driver::{
     DriverReport, DriverSettings, PositionDriver, StopReason, TaskModel,
@@ -122,4 +123,51 @@ fn patience_ends_a_circling_run_at_its_best_iterate() {
         (q - 0.15625).abs() < 1e-12 || (q - 0.03125).abs() < 1e-12,
         "{q}"
     );
+}
+
+/// One joint, no task, one inequality row `q ≥ 1` (violated by 1 at q = 0), whose largest
+/// correction per iteration is `limit` when given.
+struct Floor {
+    limit: Option<f64>,
+}
+
+impl TaskModel for Floor {
+    type Error = SolverError;
+    fn evaluate(&mut self, q: &[f64], stack: &mut TaskStack) -> Result<(), SolverError> {
+        let mut level = stack.level_mut(0);
+        let (mut jacobian, lower, upper) = level.inequalities_mut();
+        jacobian[(0, 0)] = 1.0;
+        (lower[0], upper[0]) = (1.0 - q[0], f64::INFINITY);
+        stack.clear_gradient();
+        Ok(())
+    }
+
+    fn max_inequality_correction(&self, level: usize, row: usize) -> Option<f64> {
+        assert_eq!((level, row), (0, 0));
+        self.limit
+    }
+}
+
+#[test]
+fn an_inequality_row_may_take_its_whole_room_in_one_step() {
+    let shape = StackShape::new(1).with_mixed_level("floor", &[], &[("q >= 1", 1)]);
+    let step = |limit| {
+        let mut solver = Solver::new(&shape).unwrap();
+        let settings = DriverSettings {
+            max_iterations: 1,
+            max_joint_step: f64::INFINITY,
+            ..DriverSettings::default()
+        };
+        let mut driver = PositionDriver::new(&solver, settings).unwrap();
+        let mut q = [0.0];
+        let bounds = JointBounds::unbounded(1);
+        (driver.run(&mut solver, &mut Floor { limit }, &mut q, &bounds)).unwrap();
+        q[0]
+    };
+    // The driver's 0.05 by default (and for a limit that is not > 0); the whole violation
+    // with an unbounded correction.
+    for (limit, expected) in [(None, 0.05), (Some(0.0), 0.05), (Some(f64::INFINITY), 1.0)] {
+        let q = step(limit);
+        assert!((q - expected).abs() < 1e-12, "{limit:?}: {q}");
+    }
 }

@@ -449,3 +449,39 @@ fn zmp_task_rejects_bad_input() {
         .is_err()
     );
 }
+
+/// Seeing no joint's momentum, the ZMP rows are the CoM's: the room of an edge is its offset less
+/// the margin and the CoM's reach toward it, however fast the joints moved before; a mask of
+/// the wrong length is refused.
+#[test]
+fn zmp_task_seeing_no_joint_is_the_com_polygon() {
+    let model = nao::rfoot();
+    let (q0, n) = (bent(&model), model.nv());
+    let velocity = vec![1.0; n];
+    let mut task = (ZmpTask::new(&model, 4, &SOLE, 0.01, 0.5).unwrap())
+        .seeing(vec![false; n])
+        .unwrap();
+    task.begin_frame(&q0, &velocity, 0.01).unwrap();
+    let mut jacobian = Mat::zeros(task.rows(), n);
+    let (mut lower, mut upper) = (vec![0.0; 5], vec![0.0; 5]);
+    let data = data_at(&model, &q0);
+    (task.write(
+        &model,
+        &data,
+        &q0,
+        jacobian.as_mut(),
+        &mut lower,
+        &mut upper,
+    ))
+    .unwrap();
+    let c = model.com(&data).unwrap();
+    assert!((upper[0] - (0.04 - 0.01 + c.y)).abs() < 1e-12);
+    assert!((upper[1] - (0.1 - 0.01 - c.x)).abs() < 1e-12);
+    assert_eq!((lower[4], upper[4]), (-0.5, 0.5));
+    assert!((0..n).all(|k| jacobian[(4, k)] == 0.0));
+    let task = ZmpTask::new(&model, 4, &SOLE, 0.01, 0.5).unwrap();
+    assert!(matches!(
+        task.seeing(vec![true; n - 1]),
+        Err(TaskError::Solver(_))
+    ));
+}

@@ -46,6 +46,13 @@ pub(crate) struct ImitationOptions {
     /// walking clip: for kinematic retargeting, not yet for a robot.
     #[arg(long, requires = "dynamic_walk")]
     pub(crate) walking_arms: bool,
+    /// Experimental (Poubel's method): balance that sees the whole body's dynamics. A level
+    /// below the feet and the CoM keeps the whole body's ZMP (the arms' acceleration
+    /// included) inside the support polygon and the floor's vertical moment on the feet below
+    /// what friction holds, so faster hands (--tracking-speed) are held back only when they
+    /// would tip the robot or turn a foot.
+    #[arg(long)]
+    pub(crate) zmp_balance: bool,
     /// After the clip, hold the human's last pose (frames 1/120 s apart) so the robot can
     /// finish the step it is taking; those frames are in every output. `auto`: until the robot
     /// has finished (a continuous phase, no step pending, on the feet the human stands on) for
@@ -205,6 +212,7 @@ impl ImitationOptions {
         config.footsteps.follow = self.walk || self.dynamic_walk;
         config.footsteps.dynamic = self.dynamic_walk;
         config.footsteps.walking_arms = self.walking_arms;
+        config.zmp_balance = self.zmp_balance;
         config
     }
 }

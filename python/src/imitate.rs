@@ -40,6 +40,7 @@ pub(crate) struct Settings {
     walk: bool,
     dynamic_walk: bool,
     walking_arms: bool,
+    zmp_balance: bool,
     velocity_fraction: f64,
     upper_body_fraction: Option<f64>,
     task_speed: Option<f64>,
@@ -60,6 +61,7 @@ impl Settings {
             walk: false,
             dynamic_walk: false,
             walking_arms: false,
+            zmp_balance: false,
             velocity_fraction: 0.1,
             upper_body_fraction: None,
             task_speed: None,
@@ -80,6 +82,7 @@ impl Settings {
                 "walk" => s.walk = value.extract()?,
                 "dynamic_walk" => s.dynamic_walk = value.extract()?,
                 "walking_arms" => s.walking_arms = value.extract()?,
+                "zmp_balance" => s.zmp_balance = value.extract()?,
                 "velocity_fraction" => s.velocity_fraction = value.extract()?,
                 "upper_body_fraction" => s.upper_body_fraction = value.extract()?,
                 "task_speed" => s.task_speed = value.extract()?,
@@ -184,6 +187,7 @@ impl Settings {
         config.footsteps.follow = self.walk || self.dynamic_walk;
         config.footsteps.dynamic = self.dynamic_walk;
         config.footsteps.walking_arms = self.walking_arms;
+        config.zmp_balance = self.zmp_balance;
         Ok(config)
     }
 }

@@ -90,6 +90,7 @@ def imitate_clip(
     walk: bool = False,
     dynamic_walk: bool = False,
     walking_arms: bool = False,
+    zmp_balance: bool = False,
     offline: bool = False,
     velocity_fraction: float = 0.1,
     upper_body_fraction: Optional[float] = None,
@@ -115,6 +116,10 @@ def imitate_clip(
         walking_arms: experimental, with ``dynamic_walk``: the hands follow the human while
             the robot walks (for kinematic retargeting: the physics judge's weak NAO falls on
             the bundled walks).
+        zmp_balance: experimental, balance that sees the arms' dynamics (the CLI's
+            ``--zmp-balance``): the ZMP of the CoM and the arms' acceleration stays in the
+            support polygon and their vertical moment below what friction holds, so faster
+            hands (``tracking_speed``) do not tip the robot or turn a loaded foot.
         offline: read the whole clip first and time weight shifts ahead of the human.
         velocity_fraction: share of the rated joint velocity the legs may use, in (0, 1].
         upper_body_fraction: the same for arms, head and torso (default: the robot's).
@@ -142,6 +147,7 @@ def imitate_clip(
         walk=walk,
         dynamic_walk=dynamic_walk,
         walking_arms=walking_arms,
+        zmp_balance=zmp_balance,
         offline=offline,
         velocity_fraction=velocity_fraction,
         upper_body_fraction=upper_body_fraction,

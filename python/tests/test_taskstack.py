@@ -72,6 +72,12 @@ def cli_joints(clip: Path, out: Path, *args: str):
             ["--hold", "0", "--dynamic-walk", "--walking-arms"],
             {"hold": 0, "dynamic_walk": True, "walking_arms": True},
         ),
+        (
+            KINECT,
+            "nao",
+            ["--hold", "0", "--zmp-balance", "--tracking-speed", "1.0"],
+            {"hold": 0, "zmp_balance": True, "tracking_speed": 1.0},
+        ),
     ],
 )
 def test_imitate_clip_gives_the_cli_joint_angles(tmp, clip, robot, args, kwargs):

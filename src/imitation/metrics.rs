@@ -470,25 +470,6 @@ fn effector_errors(series: &[Vec<Series>; SupportKind::COUNT]) -> Vec<EffectorEr
         .collect()
 }
 
-/// Which feet (left, right) stand on the floor in `phase`: the support, and both while the free
-/// foot is on the ground (DS and the CoM steps of the transitions).
-fn standing_feet(phase: SupportPhase) -> [bool; 2] {
-    use super::phase::{Landing, TakeOff};
-    match phase {
-        SupportPhase::Double
-        | SupportPhase::DoubleToRight(TakeOff::ComToFoot)
-        | SupportPhase::DoubleToLeft(TakeOff::ComToFoot)
-        | SupportPhase::RightToDouble(Landing::ComToMiddle)
-        | SupportPhase::LeftToDouble(Landing::ComToMiddle) => [true, true],
-        SupportPhase::Right
-        | SupportPhase::DoubleToRight(TakeOff::LiftFoot)
-        | SupportPhase::RightToDouble(Landing::LowerFoot) => [false, true],
-        SupportPhase::Left
-        | SupportPhase::DoubleToLeft(TakeOff::LiftFoot)
-        | SupportPhase::LeftToDouble(Landing::LowerFoot) => [true, false],
-    }
-}
-
 /// Signed distance of `p` to the boundary of the convex hull of `points` (positive inside).
 pub fn convex_margin(points: &[Vector2<f64>], p: Vector2<f64>) -> f64 {
     let mut corners: Vec<[f64; 2]> = points.iter().map(|v| [v.x, v.y]).collect();
@@ -584,7 +565,7 @@ impl MetricsRecorder {
             // The frame's q has the model's length: the imitator wrote it.
             meter.record(&frame.q).ok();
         }
-        let standing = standing_feet(frame.phase);
+        let standing = frame.phase.standing_feet();
         self.record_slip(frame, standing);
 
         // Travel and steps.

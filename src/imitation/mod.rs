@@ -32,3 +32,4 @@ pub mod support;
 pub mod tables;
 pub mod travel;
 pub mod walking;
+mod zmp_balance;

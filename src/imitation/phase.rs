@@ -141,6 +141,24 @@ impl SupportPhase {
         }
     }
 
+    /// Which feet (`[left, right]`) stand on the floor: the support, and both while the free
+    /// foot is on the ground (DS and the CoM steps of the transitions).
+    pub const fn standing_feet(self) -> [bool; 2] {
+        match self {
+            SupportPhase::Double
+            | SupportPhase::DoubleToRight(TakeOff::ComToFoot)
+            | SupportPhase::DoubleToLeft(TakeOff::ComToFoot)
+            | SupportPhase::RightToDouble(Landing::ComToMiddle)
+            | SupportPhase::LeftToDouble(Landing::ComToMiddle) => [true, true],
+            SupportPhase::Right
+            | SupportPhase::DoubleToRight(TakeOff::LiftFoot)
+            | SupportPhase::RightToDouble(Landing::LowerFoot) => [false, true],
+            SupportPhase::Left
+            | SupportPhase::DoubleToLeft(TakeOff::LiftFoot)
+            | SupportPhase::LeftToDouble(Landing::LowerFoot) => [true, false],
+        }
+    }
+
     /// Number of phases (3 continuous supports + 8 transition steps).
     pub const COUNT: usize = 11;
 

@@ -12,6 +12,7 @@ use super::tables::{
     Axes, ComGoal, Constraint, Gradient, GradientKind, OrientationTarget, PointTarget, Task,
     TaskTable,
 };
+use super::zmp_balance::SupportZmp;
 use crate::human::HumanJoint;
 use crate::model::{Axis, FrameId, Model, ModelData};
 use crate::robots::BipedProfile;
@@ -60,10 +61,17 @@ struct ResolvedTask {
 /// A constraint of a table, resolved against a model: its rows and where they are.
 #[derive(Debug, Clone)]
 struct ResolvedConstraint {
-    rows: CapsuleDistanceTask,
+    rows: ConstraintRows,
     level: usize,
     /// First row among the level's inequality rows.
     row: usize,
+}
+
+/// The rows of a constraint.
+#[derive(Debug, Clone)]
+enum ConstraintRows {
+    Distance(CapsuleDistanceTask),
+    Zmp(Box<SupportZmp>),
 }
 
 /// What the tasks of a phase aim at in one frame, in the model root's frame.
@@ -96,6 +104,10 @@ pub(super) struct FrameTargets<'a> {
     /// The share of [`PointTarget::Standing`]'s lowering asked for, in [0, 1]: below 1 at the
     /// start ([`super::shaping::StartRamp`]).
     pub(super) lowering_share: f64,
+    /// The joints' velocity over the frame before (per second, one per model variable): the
+    /// start of the frame's acceleration for a [`Constraint::Zmp`]; empty when the table has
+    /// none.
+    pub(super) joint_velocity: &'a [f64],
 }
 
 /// The gradient criteria of the imitator, shared by every phase.
@@ -208,7 +220,7 @@ impl PhaseSolver {
                 row += task.rows();
             }
         }
-        let constraints = resolve_constraints(table, profile, model)?;
+        let constraints = resolve_constraints(table, profile, model, &initial)?;
         let solver = Solver::with_settings(&table.shape(model.nv()), settings)?;
         let driver = PositionDriver::new(&solver, DriverSettings::default())?;
         let contact = (table.levels.first())
@@ -365,13 +377,18 @@ impl PhaseSolver {
     ) -> Result<(), ImitationError> {
         self.driver.set_settings(settings)?;
         self.frame_start.copy_from_slice(q);
+        let frame_dt = settings.dt * settings.max_iterations as f64;
+        for c in &mut self.constraints {
+            if let ConstraintRows::Zmp(zmp) = &mut c.rows {
+                zmp.begin_frame(data, q, targets.joint_velocity, frame_dt)?;
+            }
+        }
         // A hand placed on a support moves with the pelvis: then only the other leg settles.
         let legs_may_settle = targets.hand_contacts.iter().all(Option::is_none);
         let (table, resolved) = (&self.table, (&self.tasks[..], &self.constraints[..]));
         let mut tasks = PhaseTasks::new(model, data, resolved, table, targets, criteria)
             .moving(self.joints.as_deref());
         self.driver.run(&mut self.solver, &mut tasks, q, bounds)?;
-        let frame_dt = settings.dt * settings.max_iterations as f64;
         self.settle_contact(model, data, q, bounds, frame_dt, legs_may_settle)?;
         // A large frame's step leaves the contact second order in it, and a step the frame's
         // reach cut short leaves more: the G1's held foot was up to 22 µm off over its full
@@ -513,7 +530,10 @@ fn moves_apart(
     data: &ModelData,
     joints: &[bool],
 ) -> Result<bool, ImitationError> {
-    let Constraint::Distance { first, second, .. } = constraint;
+    let Constraint::Distance { first, second, .. } = constraint else {
+        // The whole body's ZMP moves with any joint.
+        return Ok(joints.iter().any(|&j| j));
+    };
     let body = |name: &str| -> Result<Vec<bool>, ImitationError> {
         let frame = (profile.self_collision.body(name)?).capsule(model, &profile.stand)?;
         turning(model, data, frame.frame)
@@ -528,21 +548,33 @@ fn resolve_constraints(
     table: &TaskTable,
     profile: &BipedProfile,
     model: &Model,
+    data: &ModelData,
 ) -> Result<Vec<ResolvedConstraint>, ImitationError> {
     let bodies = &profile.self_collision;
     let mut out = Vec::new();
     for (level, l) in table.levels.iter().enumerate() {
         let mut row = 0;
         for constraint in &l.constraints {
-            let Constraint::Distance {
-                first,
-                second,
-                margin,
-            } = constraint;
-            let [first, second] =
-                [first, second].map(|name| bodies.body(name)?.capsule(model, &profile.stand));
-            let rows =
-                CapsuleDistanceTask::new(model, &constraint.name(), first?, second?, *margin)?;
+            let rows = match constraint {
+                Constraint::Distance {
+                    first,
+                    second,
+                    margin,
+                } => {
+                    let [first, second] = [first, second]
+                        .map(|name| bodies.body(name)?.capsule(model, &profile.stand));
+                    let name = constraint.name();
+                    let task = CapsuleDistanceTask::new(model, &name, first?, second?, *margin)?;
+                    ConstraintRows::Distance(task)
+                }
+                Constraint::Zmp { .. } => {
+                    let [left, right] = (profile.hands.each_ref())
+                        .map(|hand| own_joints(model, data, hand, &profile.torso));
+                    let arms = (left?.iter().zip(right?)).map(|(l, r)| *l || r).collect();
+                    let zmp = SupportZmp::new(constraint, table, profile, model, arms)?;
+                    ConstraintRows::Zmp(Box::new(zmp.expect("a ZMP constraint")))
+                }
+            };
             out.push(ResolvedConstraint { rows, level, row });
             row += constraint.rows();
         }
@@ -654,6 +686,18 @@ impl TaskModel for PhaseTasks<'_> {
         }
     }
 
+    fn max_inequality_correction(&self, level: usize, row: usize) -> Option<f64> {
+        // A ZMP row bounds the frame's acceleration: its value if the joints stopped at once
+        // is no violation to recover from slowly (clipped, it let a swinging arm stop dead).
+        let zmp = |c: &ResolvedConstraint| match &c.rows {
+            ConstraintRows::Zmp(z) => {
+                c.level == level && (c.row..c.row + z.task.rows()).contains(&row)
+            }
+            ConstraintRows::Distance(_) => false,
+        };
+        self.constraints.iter().any(zmp).then_some(f64::INFINITY)
+    }
+
     fn evaluate(&mut self, q: &[f64], stack: &mut TaskStack) -> Result<(), ImitationError> {
         if !std::mem::take(&mut self.fresh) {
             self.model.forward_kinematics(self.data, q)?;
@@ -667,15 +711,23 @@ impl TaskModel for PhaseTasks<'_> {
         for c in self.constraints {
             let mut level = stack.level_mut(c.level);
             let (mut jacobian, lower, upper) = level.inequalities_mut();
-            let rows = c.row..c.row + c.rows.rows();
-            c.rows.write(
-                self.model,
-                self.data,
-                jacobian.as_mut().subrows_mut(c.row, c.rows.rows()),
-                &mut lower[rows.clone()],
-                &mut upper[rows],
-            )?;
-            keep_columns(jacobian.subrows_mut(c.row, c.rows.rows()), self.joints);
+            let count = match &c.rows {
+                ConstraintRows::Distance(d) => d.rows(),
+                ConstraintRows::Zmp(z) => z.task.rows(),
+            };
+            let (rows, (model, data)) = (c.row..c.row + count, (self.model, &*self.data));
+            let mut jacobian = jacobian.as_mut().subrows_mut(c.row, count);
+            let (lower, upper) = (&mut lower[rows.clone()], &mut upper[rows]);
+            match &c.rows {
+                ConstraintRows::Distance(d) => {
+                    d.write(model, data, jacobian.as_mut(), lower, upper)?
+                }
+                ConstraintRows::Zmp(z) => {
+                    z.task
+                        .write(model, data, q, jacobian.as_mut(), lower, upper)?
+                }
+            }
+            keep_columns(jacobian, self.joints);
         }
         stack.clear_gradient();
         for g in self.gradients {

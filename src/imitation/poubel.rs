@@ -48,6 +48,7 @@ use crate::solver::{JointBounds, JointLimitAvoidance, JointTracking, Settings, S
 use super::config::ImitatorConfig;
 use super::error::ImitationError;
 use super::output::{EFFECTORS, RobotFrame, effector_frames};
+use super::zmp_balance::JointVelocity;
 
 /// Poubel et al.'s imitator.
 pub(crate) struct PoubelImitator {
@@ -96,6 +97,8 @@ pub(crate) struct PoubelImitator {
     walk: Option<WalkFollower>,
     /// Whether the next support-phase frame takes its held targets afresh (after a walk).
     rehold: bool,
+    /// The joints' velocity over the last frame, for the tables' ZMP rows.
+    joint_velocity: JointVelocity,
 }
 
 impl std::fmt::Debug for PoubelImitator {
@@ -173,6 +176,9 @@ impl PoubelImitator {
         if hands.is_some() {
             tables.add_hand_supports(&profile);
         }
+        if config.zmp_balance {
+            tables.add_zmp_balance(&profile);
+        }
         // Position limits only matter to the limit-avoidance gradient and the start clamp.
         let (mut shared, position_bounds) = Shared::new(profile, &config)?;
         let (profile, q) = (&shared.profile, &shared.q);
@@ -236,6 +242,7 @@ impl PoubelImitator {
         };
         let tracking = JointTracking::new(q)?;
         let human_q = q.clone();
+        let joint_velocity = JointVelocity::new(q.len());
         shared.reserve_output(phases_sizes(&phases));
         Ok(Self {
             detector: SupportDetector::new(config.support)?,
@@ -280,6 +287,7 @@ impl PoubelImitator {
             hands,
             walk,
             rehold: false,
+            joint_velocity,
             shared,
         })
     }
@@ -325,6 +333,7 @@ impl PoubelImitator {
     pub(crate) fn step(&mut self, frame: &HumanFrame) -> Result<&RobotFrame, ImitationError> {
         let start = Instant::now();
         let dt = self.shared.begin_frame(frame.time)?;
+        self.joint_velocity.begin(&self.shared.q, dt);
         let human = self.detector.update(frame);
         let feet = [
             ground_pose(&self.shared.output.left_sole),
@@ -460,6 +469,7 @@ impl PoubelImitator {
             up: planned.up,
             com_height: planned.com_height,
             lowering_share: self.start.advance(dt),
+            joint_velocity: &[],
         };
         let criteria = Criteria {
             limits: &self.limits,
@@ -618,6 +628,7 @@ impl PoubelImitator {
             up: Vector3::z(),
             com_height: 0.0,
             lowering_share: self.start.advance(dt),
+            joint_velocity: self.joint_velocity.get(),
         };
         let criteria = Criteria {
             limits: &self.limits,

@@ -13,8 +13,8 @@ pub mod sway;
 pub mod tuning;
 
 pub use profile::{
-    BipedProfile, FootArea, FootFrames, HumanJointAngles, JointAnglesFactory, ProfileError,
-    RobotPoint, SolePlacement, outline_bounds,
+    ASSUMED_FLOOR_FRICTION, BipedProfile, FootArea, FootFrames, HumanJointAngles,
+    JointAnglesFactory, LIGHT_FOOT_SHARE, ProfileError, RobotPoint, SolePlacement, outline_bounds,
 };
 pub use self_collision::{BodyCapsule, FramePoint, SelfCollision};
 pub use tuning::{BipedSize, MotionTuning};

@@ -26,6 +26,14 @@ use super::tuning::MotionTuning;
 use crate::human::{HumanJoint, SegmentDirections, Side};
 use crate::model::{Model, ModelError, UrdfError};
 
+/// Sliding friction coefficient assumed of the floor where the profile cannot know it (a
+/// polished floor under a plastic sole; the judge's floors have 0.7 and 1.0).
+pub const ASSUMED_FLOOR_FRICTION: f64 = 0.5;
+
+/// Share of the weight on the lighter foot that still counts as loaded (the judge's
+/// "loaded foot" carries at least 20 %).
+pub const LIGHT_FOOT_SHARE: f64 = 0.2;
+
 /// A robot point that stands for a human joint: a named frame's origin, or the midpoint of two.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum RobotPoint {
@@ -416,6 +424,24 @@ impl BipedProfile {
     pub fn sole_centre(&self, side: Side) -> [f64; 2] {
         let [lo, hi] = outline_bounds(&self.foot(side).outline);
         [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])]
+    }
+
+    /// Largest vertical moment (N·m) a balance may ask of the floor on the standing soles
+    /// before a loaded foot turns: `μ · s · m g · r̄`, with `m` the model's mass, `r̄` the mean
+    /// distance of the contact area's corners from [`BipedProfile::sole_centre`] (the lever of
+    /// the friction at the corners, where a flat sole bears its load on an uneven floor),
+    /// `μ` = [`ASSUMED_FLOOR_FRICTION`] and `s` = [`LIGHT_FOOT_SHARE`] of the weight (a foot
+    /// that carries a fifth of the weight counts as loaded and must not turn either).
+    pub fn max_floor_yaw_moment(&self) -> f64 {
+        let mass = self.models[0].total_mass();
+        let radius = |side: Side| {
+            let [cx, cy] = self.sole_centre(side);
+            let outline = &self.foot(side).outline;
+            let sum: f64 = outline.iter().map(|[x, y]| (x - cx).hypot(y - cy)).sum();
+            sum / outline.len() as f64
+        };
+        let radius = radius(Side::Left).min(radius(Side::Right));
+        ASSUMED_FLOOR_FRICTION * LIGHT_FOOT_SHARE * mass * crate::tasks::GRAVITY * radius
     }
 
     /// The point of the contact area of `side` (sole frame, m) at `margin` from its inner edge

@@ -36,6 +36,16 @@ pub trait TaskModel {
         let _ = task;
         None
     }
+
+    /// Largest violation (task units) of inequality row `row` of level `level` one iteration
+    /// is asked to remove, when it differs from [`DriverSettings::max_task_error`]:
+    /// `f64::INFINITY` for a row that bounds a rate over the step rather than a position (its
+    /// value at the unchanged posture is not a state to recover from, e.g. a ZMP whose motion
+    /// stopping at once would throw it out). Default: none.
+    fn max_inequality_correction(&self, level: usize, row: usize) -> Option<f64> {
+        let _ = (level, row);
+        None
+    }
 }
 
 /// Settings of the position-level iteration.
@@ -272,7 +282,7 @@ impl PositionDriver {
             self.previous.copy_from_slice(errors);
             self.previous_violation = violation;
             self.set_velocities(model, solver.stack_mut());
-            self.set_bounds(solver.stack_mut());
+            self.set_bounds(model, solver.stack_mut());
             solver.solve(q, &self.step_bounds, s.dt)?;
             for (qi, v) in q.iter_mut().zip(solver.velocity()) {
                 *qi += v * s.dt;
@@ -334,12 +344,15 @@ impl PositionDriver {
 
     /// `K (l − c(q)) ≤ C q̇ ≤ K (u − c(q))`, a violated side (`l − c > 0` or `u − c < 0`) clipped
     /// to `max_task_error` first.
-    fn set_bounds(&self, stack: &mut TaskStack) {
-        let (gain, limit) = (self.settings.gain, self.settings.max_task_error);
+    fn set_bounds<M: TaskModel>(&self, model: &M, stack: &mut TaskStack) {
+        let gain = self.settings.gain;
         for level in 0..stack.level_count() {
             let mut l = stack.level_mut(level);
             let (_, lower, upper) = l.inequalities_mut();
-            for (lo, hi) in lower.iter_mut().zip(upper.iter_mut()) {
+            for (row, (lo, hi)) in lower.iter_mut().zip(upper.iter_mut()).enumerate() {
+                let limit = (model.max_inequality_correction(level, row))
+                    .filter(|l| *l > 0.0)
+                    .unwrap_or(self.settings.max_task_error);
                 *lo = gain * lo.min(limit);
                 *hi = gain * hi.max(-limit);
             }

@@ -29,6 +29,11 @@
 //! `n_iᵀ (J_c,xy + [−A_y; A_x] / (m g Δt²))` and `A_z / Δt²` (`A_O`'s rows; its own change
 //! with `q` left out, as the `Ȧ q̇` term).
 //!
+//! [`ZmpTask::seeing`] restricts `A_O` to some joints (the imitation's arms): the rows then
+//! hold the CoM's statics plus those joints' dynamics, for a robot whose CoM reference is
+//! shaped on its own and whose legs' frame-to-frame steps are not smooth enough to be read as
+//! accelerations at `1/Δt²`.
+//!
 //! Units: metres, seconds, newton-metres.
 
 use faer::MatMut;
@@ -55,15 +60,15 @@ pub struct ZmpTask {
     dt: f64,
     start: Vec<f64>,
     velocity: Vec<f64>,
-    /// Scratch: `(q − q₀)/Δt − v₋`.
-    acceleration: Vec<f64>,
+    /// The joints whose momentum the rows see (`None`: all).
+    seen: Option<Vec<bool>>,
 }
 
 impl ZmpTask {
     /// A task with room for `capacity` polygon vertices (≥ 4: its rows serve as scratch for the
     /// CoM and momentum Jacobians), holding `vertices` with `margin` (m, as
     /// [`ComPolygonTask::set_polygon`]) and the vertical moment bound `max_yaw_moment` (N·m,
-    /// > 0). The frame starts at rest at the zero posture with `Δt` = 0.01 s until
+    /// positive). The frame starts at rest at the zero posture with `Δt` = 0.01 s until
     /// [`ZmpTask::begin_frame`].
     ///
     /// # Errors
@@ -93,7 +98,7 @@ impl ZmpTask {
             dt: 0.01,
             start: vec![0.0; nv],
             velocity: vec![0.0; nv],
-            acceleration: vec![0.0; nv],
+            seen: None,
         })
     }
 
@@ -132,6 +137,18 @@ impl ZmpTask {
         Ok(())
     }
 
+    /// The same task seeing only the momentum of `joints` (one per variable; the CoM rows
+    /// still see every joint): the rows then bound what those joints' motion adds to the
+    /// statics, e.g. the arms' on a robot whose CoM reference is shaped on its own.
+    ///
+    /// # Errors
+    /// [`TaskError::Solver`] when `joints` does not have one entry per variable.
+    pub fn seeing(mut self, joints: Vec<bool>) -> Result<Self, TaskError> {
+        check_len("zmp joints seen", self.start.len(), joints.len())?;
+        self.seen = Some(joints);
+        Ok(self)
+    }
+
     /// Number of rows: the polygon's capacity and the vertical moment.
     pub fn rows(&self) -> usize {
         self.polygon.capacity() + 1
@@ -145,7 +162,7 @@ impl ZmpTask {
     /// [`ModelError`] for kinematics not computed, a model without mass, or sizes that do not
     /// match the model.
     pub fn write(
-        &mut self,
+        &self,
         model: &Model,
         data: &ModelData,
         q: &[f64],
@@ -162,16 +179,18 @@ impl ZmpTask {
         let c = model.com(data)?;
         model.com_jacobian_rows(data, 2, jacobian.as_mut().subrows_mut(0, 2))?;
         model.angular_momentum_jacobian(data, jacobian.as_mut().subrows_mut(2, 3))?;
-        let dt = self.dt;
-        for ((a, (&q, &q0)), &v) in (self.acceleration.iter_mut())
-            .zip(q.iter().zip(&self.start))
-            .zip(&self.velocity)
-        {
-            *a = ((q - q0) / dt - v) / dt;
+        if let Some(seen) = &self.seen {
+            for (k, _) in seen.iter().enumerate().filter(|(_, s)| !**s) {
+                for r in 2..5 {
+                    jacobian[(r, k)] = 0.0;
+                }
+            }
         }
+        let dt = self.dt;
+        // Ḣ = A_O q̈, with the frame's joint acceleration q̈ = ((q − q₀)/Δt − v₋)/Δt.
         let rate = |r: usize| -> f64 {
             (0..jacobian.ncols())
-                .map(|k| jacobian[(r, k)] * self.acceleration[k])
+                .map(|k| jacobian[(r, k)] * ((q[k] - self.start[k]) / dt - self.velocity[k]) / dt)
                 .sum()
         };
         let h_rate = [rate(2), rate(3), rate(4)];

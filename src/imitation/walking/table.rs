@@ -180,6 +180,7 @@ mod tests {
             up: Vector3::z(),
             com_height: 0.0,
             lowering_share: 1.0,
+            joint_velocity: &[],
         };
         let bounds = crate::tasks::joint_bounds(model).unwrap();
         let limits = JointLimitAvoidance::new(&bounds);
