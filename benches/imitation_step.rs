@@ -142,5 +142,24 @@ fn dynamic_walk(c: &mut Criterion) {
     bench_laps(c, name, &mut imitator, &frames);
 }
 
-criterion_group!(benches, bench, dynamic_walk);
+/// Poubel's method on the NAO with the ZMP balance (`ImitatorConfig::zmp_balance`) and hands
+/// at 1 m/s, on the stand on one leg (CMU 05_02): the cost of the "dynamics" level.
+fn zmp_balance(c: &mut Criterion) {
+    let frames = frames("cmu_05_02_stand_arm_gestures_turn_single_leg.bvh");
+    let config = ImitatorConfig {
+        zmp_balance: true,
+        max_tracking_speed: Some(1.0),
+        max_tracking_acceleration: Some(10.0),
+        ..ImitatorConfig::default()
+    };
+    let mut imitator = Imitator::new(nao::profile(), config).unwrap();
+    for f in &frames {
+        imitator.step(f).unwrap();
+    }
+    let name = "imitator_step/nao/poubel/zmp_balance_05_02";
+    print_tail(name, &mut imitator, &frames);
+    bench_laps(c, name, &mut imitator, &frames);
+}
+
+criterion_group!(benches, bench, dynamic_walk, zmp_balance);
 criterion_main!(benches);

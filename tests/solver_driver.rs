@@ -28,25 +28,29 @@ impl TaskModel for Pair {
     }
 }
 
-/// One Gauss–Newton step (K Δt = 1) from q = 0 with the default limit 0.05.
-fn one_step(limit: Option<f64>) -> [f64; 2] {
-    let shape = StackShape::new(2).with_level("x", &[("a", 1), ("b", 1)]);
-    let mut solver = Solver::new(&shape).unwrap();
+/// One Gauss–Newton step (K Δt = 1) of `model` on a stack of `shape` from `q`, the driver's
+/// default error limit 0.05, no joint bounds.
+fn one_iteration<M: TaskModel<Error = SolverError>>(
+    shape: &StackShape,
+    model: &mut M,
+    q: &mut [f64],
+) {
+    let mut solver = Solver::new(shape).unwrap();
     let settings = DriverSettings {
         max_iterations: 1,
         max_joint_step: f64::INFINITY,
         ..DriverSettings::default()
     };
     let mut driver = PositionDriver::new(&solver, settings).unwrap();
+    let bounds = JointBounds::unbounded(q.len());
+    driver.run(&mut solver, model, q, &bounds).unwrap();
+}
+
+/// One step of [`Pair`] from q = 0.
+fn one_step(limit: Option<f64>) -> [f64; 2] {
+    let shape = StackShape::new(2).with_level("x", &[("a", 1), ("b", 1)]);
     let mut q = [0.0, 0.0];
-    driver
-        .run(
-            &mut solver,
-            &mut Pair { limit },
-            &mut q,
-            &JointBounds::unbounded(2),
-        )
-        .unwrap();
+    one_iteration(&shape, &mut Pair { limit }, &mut q);
     q
 }
 
@@ -152,16 +156,8 @@ impl TaskModel for Floor {
 fn an_inequality_row_may_take_its_whole_room_in_one_step() {
     let shape = StackShape::new(1).with_mixed_level("floor", &[], &[("q >= 1", 1)]);
     let step = |limit| {
-        let mut solver = Solver::new(&shape).unwrap();
-        let settings = DriverSettings {
-            max_iterations: 1,
-            max_joint_step: f64::INFINITY,
-            ..DriverSettings::default()
-        };
-        let mut driver = PositionDriver::new(&solver, settings).unwrap();
         let mut q = [0.0];
-        let bounds = JointBounds::unbounded(1);
-        (driver.run(&mut solver, &mut Floor { limit }, &mut q, &bounds)).unwrap();
+        one_iteration(&shape, &mut Floor { limit }, &mut q);
         q[0]
     };
     // The driver's 0.05 by default (and for a limit that is not > 0); the whole violation

@@ -7,7 +7,7 @@ mod common;
 
 use faer::Mat;
 use nalgebra::Vector3;
-use taskstack::model::{Model, ModelData};
+use taskstack::model::{Model, ModelData, ModelError};
 use taskstack::robots::nao;
 use taskstack::solver::Solver;
 use taskstack::solver::driver::{DriverSettings, PositionDriver};
@@ -448,6 +448,9 @@ fn zmp_task_rejects_bad_input() {
         )
         .is_err()
     );
+    let (q, mut small) = (vec![0.0; n], Mat::zeros(4, n));
+    let written = task.write(&model, &data, &q, small.as_mut(), &mut lower, &mut upper);
+    assert!(matches!(written, Err(ModelError::OutputShape { .. })));
 }
 
 /// Seeing no joint's momentum, the ZMP rows are the CoM's: the room of an edge is its offset less

@@ -176,6 +176,15 @@ impl ZmpTask {
                 got: q.len(),
             });
         }
+        let rows = self.rows();
+        if jacobian.nrows() != rows || lower.len() != rows || upper.len() != rows {
+            return Err(ModelError::OutputShape {
+                expected_rows: rows,
+                expected_cols: self.start.len(),
+                rows: jacobian.nrows().min(lower.len()).min(upper.len()),
+                cols: jacobian.ncols(),
+            });
+        }
         let c = model.com(data)?;
         model.com_jacobian_rows(data, 2, jacobian.as_mut().subrows_mut(0, 2))?;
         model.angular_momentum_jacobian(data, jacobian.as_mut().subrows_mut(2, 3))?;
