@@ -567,12 +567,17 @@ fn resolve_constraints(
                     let task = CapsuleDistanceTask::new(model, &name, first?, second?, *margin)?;
                     ConstraintRows::Distance(task)
                 }
-                Constraint::Zmp { .. } => {
+                Constraint::Zmp {
+                    margin,
+                    max_yaw_moment,
+                    vertices,
+                } => {
                     let [left, right] = (profile.hands.each_ref())
                         .map(|hand| own_joints(model, data, hand, &profile.torso));
                     let arms = (left?.iter().zip(right?)).map(|(l, r)| *l || r).collect();
-                    let zmp = SupportZmp::new(constraint, table, profile, model, arms)?;
-                    ConstraintRows::Zmp(Box::new(zmp.expect("a ZMP constraint")))
+                    let bounds = [*margin, *max_yaw_moment];
+                    let zmp = SupportZmp::new(table, profile, model, arms, bounds, *vertices)?;
+                    ConstraintRows::Zmp(Box::new(zmp))
                 }
             };
             out.push(ResolvedConstraint { rows, level, row });

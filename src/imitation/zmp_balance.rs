@@ -1,8 +1,9 @@
-//! The support polygon of a phase for its [`Constraint::Zmp`] rows: the root sole's contact
-//! area, with the other sole's where the phase stands on both feet, as their convex hull in the
-//! root frame at the start of each frame.
+//! The support polygon of a phase for its ZMP rows
+//! ([`Constraint::Zmp`](super::tables::Constraint::Zmp)): the root sole's contact area, with
+//! the other sole's where the phase stands on both feet, as their convex hull in the root frame
+//! at the start of each frame.
 
-use super::tables::{Constraint, TaskTable};
+use super::tables::TaskTable;
 use crate::model::{FrameId, Model, ModelData};
 use crate::robots::BipedProfile;
 use crate::tasks::{TaskError, ZmpTask, convex_hull};
@@ -21,23 +22,17 @@ pub(super) struct SupportZmp {
 }
 
 impl SupportZmp {
-    /// The rows of `constraint` (a [`Constraint::Zmp`]) for `table`'s phase on `model`, seeing
-    /// the momentum of the joints `arms` (one per variable); `None` for another constraint.
+    /// The rows of a ZMP constraint of `margin` (m) and `max_yaw_moment` (N·m) with room for
+    /// `vertices` polygon corners, for `table`'s phase on `model`, seeing the momentum of the
+    /// joints `arms` (one per variable).
     pub(super) fn new(
-        constraint: &Constraint,
         table: &TaskTable,
         profile: &BipedProfile,
         model: &Model,
         arms: Vec<bool>,
-    ) -> Result<Option<Self>, TaskError> {
-        let Constraint::Zmp {
-            margin,
-            max_yaw_moment,
-            vertices,
-        } = *constraint
-        else {
-            return Ok(None);
-        };
+        [margin, max_yaw_moment]: [f64; 2],
+        vertices: usize,
+    ) -> Result<Self, TaskError> {
         let root = table.model_root;
         let standing = table.phase.standing_feet();
         let other = (standing[root.other().index()])
@@ -52,14 +47,14 @@ impl SupportZmp {
         convex_hull(&mut points, &mut hull);
         points.reserve(vertices);
         let task = ZmpTask::new(model, vertices, &hull, margin, max_yaw_moment)?.seeing(arms)?;
-        Ok(Some(Self {
+        Ok(Self {
             task,
             margin,
             root: outline,
             other,
             points,
             hull,
-        }))
+        })
     }
 
     /// Sets the polygon from the other sole's placement in `data` (the frame's start) and
@@ -87,7 +82,7 @@ impl SupportZmp {
 }
 
 /// The joints' velocity over the last frame (per second, one per model variable), from the
-/// postures at the start of consecutive frames: what a [`Constraint::Zmp`] needs to turn a
+/// postures at the start of consecutive frames: what the ZMP rows need to turn a
 /// frame's step into an acceleration. Zero before the second frame. Allocates nothing after
 /// [`JointVelocity::new`].
 #[derive(Debug, Clone)]
