@@ -679,6 +679,13 @@ fn zmp_balance_bounds_the_arms_moment_on_the_floor() {
         zmp_balance,
         ..ImitatorConfig::default()
     };
+    // Koenemann's method has no task tables to put the level in: refused, not ignored.
+    let koenemann = ImitatorConfig {
+        method: ImitationMethod::Koenemann(KoenemannConfig::default()),
+        ..fast(true)
+    };
+    let refused = Imitator::new(nao::profile(), koenemann).err();
+    assert!(refused.is_some_and(|e| e.to_string().contains("zmp_balance")));
     let bound = nao::profile().max_floor_yaw_moment();
     let (free, free_metrics) = arms_yaw_moment(name, fast(false));
     let (balanced, balanced_metrics) = arms_yaw_moment(name, fast(true));

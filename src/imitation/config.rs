@@ -128,7 +128,8 @@ pub struct ImitatorConfig {
     /// acceleration (from the model's masses and inertias) inside the support polygon and the
     /// arms' vertical moment on the feet below what friction holds. Default `false`. With
     /// hands at 1 m/s (`max_tracking_speed`, 10 m/s²) the judge's NAO passes 14 of 16 runs on
-    /// the bundled clips with it and 9 of 16 without (loaded feet turning 3.5–6.6°).
+    /// the bundled clips with it and 9 of 16 without (loaded feet turning 3.5–6.6°). Refused
+    /// with Koenemann's method (no task tables).
     pub zmp_balance: bool,
 }
 
@@ -258,6 +259,10 @@ impl ImitatorConfig {
                 return invalid("hand_supports", f64::NAN, reason);
             }
             hands.validate()?;
+        }
+        if self.zmp_balance && matches!(self.method, ImitationMethod::Koenemann(_)) {
+            let reason = "the ZMP balance needs Poubel et al.'s method (task tables)";
+            return invalid("zmp_balance", 1.0, reason);
         }
         if let Some(ahead) = &self.look_ahead {
             if matches!(self.method, ImitationMethod::Koenemann(_)) {
