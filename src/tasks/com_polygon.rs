@@ -24,6 +24,9 @@ pub struct ComPolygonTask {
     capacity: usize,
     /// Distance kept from every edge (m, ≥ 0).
     margin: f64,
+    /// Each row's edge (outward unit normal, offset `n_iᵀ v_i`), `None` for a spare row:
+    /// computed when the polygon is set, not per Jacobian column.
+    edges: Vec<Option<([f64; 2], f64)>>,
 }
 
 impl ComPolygonTask {
@@ -45,6 +48,7 @@ impl ComPolygonTask {
             vertices: Vec::with_capacity(capacity),
             capacity,
             margin: 0.0,
+            edges: vec![None; capacity],
         };
         task.set_polygon(vertices, margin)?;
         Ok(task)
@@ -81,20 +85,22 @@ impl ComPolygonTask {
         self.vertices.clear();
         self.vertices.extend_from_slice(vertices);
         self.margin = margin;
+        for (i, edge) in self.edges.iter_mut().enumerate() {
+            *edge = (i < k).then(|| {
+                let (a, b) = (vertices[i], vertices[(i + 1) % k]);
+                let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+                let length = dx.hypot(dy);
+                let n = [dy / length, -dx / length];
+                (n, n[0] * a[0] + n[1] * a[1])
+            });
+        }
         Ok(())
     }
 
-    /// Edge `i`'s outward unit normal `n_i` and offset `n_iᵀ v_i` (m), or `None` for a spare row.
-    pub(crate) fn edge_normal(&self, i: usize) -> Option<([f64; 2], f64)> {
-        let k = self.vertices.len();
-        if i >= k {
-            return None;
-        }
-        let (a, b) = (self.vertices[i], self.vertices[(i + 1) % k]);
-        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-        let length = dx.hypot(dy);
-        let n = [dy / length, -dx / length];
-        Some((n, n[0] * a[0] + n[1] * a[1]))
+    /// Each row's edge: its outward unit normal `n_i` and offset `n_iᵀ v_i` (m), or `None` for
+    /// a spare row.
+    pub(crate) fn edges(&self) -> &[Option<([f64; 2], f64)>] {
+        &self.edges
     }
 
     /// The most vertices the task holds (its rows).
@@ -136,16 +142,16 @@ impl InequalityTask for ComPolygonTask {
         model.com_jacobian_rows(data, 2, jacobian.as_mut().subrows_mut(0, 2))?;
         for col in 0..jacobian.ncols() {
             let (x, y) = (jacobian[(0, col)], jacobian[(1, col)]);
-            for i in 0..self.capacity {
-                jacobian[(i, col)] = match self.edge_normal(i) {
+            for (i, edge) in self.edges.iter().enumerate() {
+                jacobian[(i, col)] = match edge {
                     Some(([nx, ny], _)) => nx * x + ny * y,
                     None => 0.0,
                 };
             }
         }
-        for i in 0..self.capacity {
+        for (i, edge) in self.edges.iter().enumerate() {
             lower[i] = f64::NEG_INFINITY;
-            upper[i] = match self.edge_normal(i) {
+            upper[i] = match edge {
                 Some(([nx, ny], offset)) => offset - self.margin - (nx * c[0] + ny * c[1]),
                 None => f64::INFINITY,
             };

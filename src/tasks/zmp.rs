@@ -55,9 +55,6 @@ pub const GRAVITY: f64 = 9.81;
 #[derive(Debug, Clone, PartialEq)]
 pub struct ZmpTask {
     polygon: ComPolygonTask,
-    /// Each row's edge (outward normal, offset), `None` for a spare row: computed when the
-    /// polygon is set, not per Jacobian column.
-    edges: Vec<Option<([f64; 2], f64)>>,
     max_yaw_moment: f64,
     /// The frame's length (s), its start posture and the joints' velocity in the frame before.
     dt: f64,
@@ -95,23 +92,14 @@ impl ZmpTask {
             return Err(invalid("the vertical moment bound must be finite and > 0"));
         }
         let nv = model.nv();
-        let mut task = Self {
+        Ok(Self {
             polygon: ComPolygonTask::new(model, capacity, vertices, margin)?,
-            edges: vec![None; capacity],
             max_yaw_moment,
             dt: 0.01,
             start: vec![0.0; nv],
             velocity: vec![0.0; nv],
             seen: None,
-        };
-        task.set_edges();
-        Ok(task)
-    }
-
-    fn set_edges(&mut self) {
-        for (i, edge) in self.edges.iter_mut().enumerate() {
-            *edge = self.polygon.edge_normal(i);
-        }
+        })
     }
 
     /// Replaces the polygon (as [`ComPolygonTask::set_polygon`]). Does not allocate.
@@ -119,9 +107,7 @@ impl ZmpTask {
     /// # Errors
     /// As [`ComPolygonTask::set_polygon`].
     pub fn set_polygon(&mut self, vertices: &[[f64; 2]], margin: f64) -> Result<(), TaskError> {
-        self.polygon.set_polygon(vertices, margin)?;
-        self.set_edges();
-        Ok(())
+        self.polygon.set_polygon(vertices, margin)
     }
 
     /// Starts a frame of `dt` seconds (> 0) at posture `start`, the joints having moved at
@@ -225,7 +211,7 @@ impl ZmpTask {
             let x = jacobian[(0, col)] - jacobian[(3, col)] * scale;
             let y = jacobian[(1, col)] + jacobian[(2, col)] * scale;
             let yaw = jacobian[(4, col)] / (dt * dt);
-            for (i, edge) in self.edges.iter().enumerate() {
+            for (i, edge) in self.polygon.edges().iter().enumerate() {
                 jacobian[(i, col)] = match edge {
                     Some(([nx, ny], _)) => nx * x + ny * y,
                     None => 0.0,
@@ -234,7 +220,7 @@ impl ZmpTask {
             jacobian[(capacity, col)] = yaw;
         }
         let margin = self.polygon.margin();
-        for (i, edge) in self.edges.iter().enumerate() {
+        for (i, edge) in self.polygon.edges().iter().enumerate() {
             lower[i] = f64::NEG_INFINITY;
             upper[i] = match edge {
                 Some(([nx, ny], offset)) => offset - margin - (nx * zmp[0] + ny * zmp[1]),
