@@ -670,6 +670,7 @@ pub fn metrics_value(m: &ImitationMetrics, clip: &Path) -> Value {
         "frames_com_outside_support": m.frames_com_outside,
         "joint_limit_violations": m.joint_limit_violations,
         "velocity_limit_violations": m.velocity_limit_violations,
+        "joint_reversal_frames": m.joint_reversal_frames,
         "max_support_foot_slip_m": m.max_support_slip,
         "max_support_foot_turn_rad": m.max_support_turn,
         "max_held_foot_slip_m": m.max_held_foot_slip,

@@ -251,8 +251,9 @@ fn print_summary(
     );
     let _ = writeln!(
         text,
-        "limits: {} joint-position and {} joint-velocity violations (joint × frame)",
-        m.joint_limit_violations, m.velocity_limit_violations
+        "limits: {} joint-position and {} joint-velocity violations (joint × frame); {} frames \
+         with a joint turning back at speed",
+        m.joint_limit_violations, m.velocity_limit_violations, m.joint_reversal_frames
     );
     let _ = writeln!(
         text,

@@ -333,6 +333,12 @@ pub struct ImitationMetrics {
     pub joint_limit_violations: usize,
     /// Joint velocities above the allowed fraction of the rated velocity (joint × frame).
     pub velocity_limit_violations: usize,
+    /// Frames in which some joint turned back at speed: it moved at least half its allowed
+    /// velocity one way over the previous frame and at least half of it the other way over this
+    /// one. A human's joints do not reverse within a frame (1/120 s at these speeds); the
+    /// solver's solution does when it chatters (a near-singular level, an acceleration bound
+    /// met in full every frame), which a servo either filters or shakes with.
+    pub joint_reversal_frames: usize,
     /// Largest move of the support foot (the model root) from where its stance began (m); zero
     /// up to rounding, by construction of the model switches.
     pub max_support_slip: f64,
@@ -426,6 +432,10 @@ pub struct MetricsRecorder {
     outside: usize,
     joint_violations: usize,
     velocity_violations: usize,
+    /// Each joint's step over the last frame, as a fraction of its allowed step (velocity
+    /// bound × the frame's time); empty before the second frame.
+    last_step: Vec<f64>,
+    reversal_frames: usize,
     /// Where each foot's current stance began (right, left), `None` while it does not stand.
     anchors: [Option<IsometryMatrix3<f64>>; 2],
     slip: f64,
@@ -519,6 +529,8 @@ impl MetricsRecorder {
             outside: 0,
             joint_violations: 0,
             velocity_violations: 0,
+            last_step: Vec::new(),
+            reversal_frames: 0,
             anchors: [None; 2],
             slip: 0.0,
             turn: 0.0,
@@ -657,15 +669,27 @@ impl MetricsRecorder {
                 self.joint_violations += 1;
             }
         }
-        if !self.last_q.is_empty() {
-            let dt = frame.time - self.last_time;
-            for (i, (&q, &p)) in frame.q.iter().zip(&self.last_q).enumerate() {
-                let allowed = bounds.velocity()[i] * dt;
-                if (q - p).abs() > allowed * (1.0 + 1e-9) + 1e-12 {
-                    self.velocity_violations += 1;
-                }
-            }
+        if self.last_q.is_empty() {
+            return;
         }
+        let dt = frame.time - self.last_time;
+        let first_step = self.last_step.is_empty();
+        self.last_step.resize(frame.q.len(), 0.0);
+        let mut reversed = false;
+        for (i, (&q, &p)) in frame.q.iter().zip(&self.last_q).enumerate() {
+            let allowed = bounds.velocity()[i] * dt;
+            if (q - p).abs() > allowed * (1.0 + 1e-9) + 1e-12 {
+                self.velocity_violations += 1;
+            }
+            let step = if allowed > 0.0 {
+                (q - p) / allowed
+            } else {
+                0.0
+            };
+            let last = std::mem::replace(&mut self.last_step[i], step);
+            reversed |= !first_step && step.abs() >= 0.5 && last.abs() >= 0.5 && step * last < 0.0;
+        }
+        self.reversal_frames += usize::from(reversed);
     }
 
     /// Slip of the `standing` feet: how far each moved since its stance began.
@@ -753,6 +777,7 @@ impl MetricsRecorder {
             frames_com_outside: self.outside,
             joint_limit_violations: self.joint_violations,
             velocity_limit_violations: self.velocity_violations,
+            joint_reversal_frames: self.reversal_frames,
             max_support_slip: self.slip,
             max_support_turn: self.turn,
             max_held_foot_slip: self.held_slip,
