@@ -513,6 +513,27 @@ fn koenemann_keeps_the_invariants_on_every_clip() {
     }
 }
 
+/// Koenemann et al.'s arms on CMU 02_10, where the human folds the right arm tighter than the
+/// NAO's elbow bends: the hand target is kept beyond the folded arm's reach, so the arm's IK
+/// does not press the elbow into its limit frame after frame while the wrist turns back and
+/// forth at its velocity bound (145 frames of 2 400 had a joint reversing at speed, 135 of
+/// them the right wrist's yaw; `ImitationMetrics::joint_reversal_frames`).
+#[test]
+fn koenemann_arms_do_not_chatter_on_a_tightly_folded_arm() {
+    let config = ImitatorConfig {
+        method: ImitationMethod::Koenemann(KoenemannConfig::default()),
+        ..ImitatorConfig::default()
+    };
+    let name = "cmu_02_10_wash_self_standing_arm_gestures.bvh";
+    let (m, _) = run_with(name, config, KOENEMANN_FOOT_TOLERANCE);
+    assert!(
+        m.joint_reversal_frames * 200 <= m.frames,
+        "{} of {} frames with a joint turning back at speed",
+        m.joint_reversal_frames,
+        m.frames
+    );
+}
+
 /// The clip `name` opened, and the NAO's imitator for it at default settings.
 fn nao_on(name: &str) -> (Clip, Imitator) {
     let clip = Clip::open(clip_path(name)).unwrap();

@@ -194,6 +194,11 @@ impl Arm {
         Some(())
     }
 
+    /// The nearest the hand gets to the shoulder point (m): the elbow at its most bent.
+    pub(super) fn nearest(&self) -> f64 {
+        self.span[0]
+    }
+
     /// The elbow, when the arm has one.
     pub(super) fn elbow(&self) -> Option<Elbow> {
         self.elbow

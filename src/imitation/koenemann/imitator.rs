@@ -18,6 +18,7 @@ use crate::imitation::imitator::{Shared, effector_ids, human_stance};
 use crate::imitation::metrics::CONTACT_HEIGHT;
 use crate::imitation::output::RobotFrame;
 use crate::imitation::phase::{Landing, SupportPhase, TakeOff};
+use crate::imitation::reach::Arm;
 use crate::imitation::scaler::reference_points;
 use crate::imitation::shaping::{HandRates, HandSpeed, MotionLimits, SwingHeight};
 use crate::imitation::support::{HumanSupport, SupportDetector};
@@ -42,6 +43,9 @@ const LEG_STALL_FRACTION: f64 = 0.01;
 /// of 200 on most frames of CMU 02_10 (6.2 ms a frame), ending on one with the held sole 1.1 mm
 /// off.
 const LEG_PATIENCE: usize = 10;
+/// How far beyond the folded arm's reach a hand target is kept (m): at the reach itself the
+/// elbow ends a hair past its limit and the IK still pressed it.
+const FOLD_CLEARANCE: f64 = 0.005;
 
 /// Frames of one model.
 #[derive(Debug)]
@@ -58,6 +62,9 @@ struct Frames {
 struct Body {
     /// Shoulders and hips in the torso frame (m), `[left, right]`.
     shoulders: [Vector3<f64>; 2],
+    /// The nearest each hand gets to its shoulder, the elbow at its most bent (m; 0 for an arm
+    /// the profile does not map), `[left, right]`.
+    folded: [f64; 2],
     hips: [Vector3<f64>; 2],
     limbs: Limbs,
     /// Sole centres in the sole frames.
@@ -171,8 +178,11 @@ impl Body {
                 .translation
                 .vector
         };
+        let folded =
+            Side::BOTH.map(|side| Arm::of(profile, model, side).map_or(0.0, |a| a.nearest()));
         Ok(Body {
             shoulders,
+            folded,
             hips,
             limbs: Limbs {
                 arms: length(&shoulders, &elbows, &hands),
@@ -487,7 +497,8 @@ impl KoenemannImitator {
         let radius = 0.5 * (self.body.hips[0] - self.body.hips[1]).norm();
         let targets = [0, 1].map(|k| {
             let moved = step_toward(previous[k], wanted[k], speeds[k] * dt);
-            outside_torso(moved, radius, &self.body)
+            let unfolded = beyond_fold(moved, k, &self.body);
+            outside_torso(unfolded, radius, &self.body)
         });
         self.hands = Some(targets);
         let root = self.shared.root.index();
@@ -908,6 +919,21 @@ fn step_toward(from: Vector3<f64>, to: Vector3<f64>, reach: f64) -> Vector3<f64>
     match distance <= reach {
         true => to,
         false => from + step * (reach / distance),
+    }
+}
+
+/// `p` (torso frame, m) pushed along the line from arm `k`'s shoulder until it lies
+/// [`FOLD_CLEARANCE`] beyond the nearest its hand gets (the elbow at its most bent). A target
+/// the folded arm cannot reach had the arm's IK press the elbow into its limit frame after
+/// frame, and the free joints of the wrist turned back and forth at their velocity bound
+/// (NAO, CMU 02_10: 145 frames with a joint reversal, 135 of them the right wrist's yaw; 8
+/// with the target pushed out).
+fn beyond_fold(p: Vector3<f64>, k: usize, body: &Body) -> Vector3<f64> {
+    let arm = p - body.shoulders[k];
+    let nearest = body.folded[k] + FOLD_CLEARANCE;
+    match arm.try_normalize(1e-9) {
+        Some(direction) if arm.norm() < nearest => body.shoulders[k] + direction * nearest,
+        _ => p,
     }
 }
 
