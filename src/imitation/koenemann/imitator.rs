@@ -926,7 +926,7 @@ fn step_toward(from: Vector3<f64>, to: Vector3<f64>, reach: f64) -> Vector3<f64>
 /// [`FOLD_CLEARANCE`] beyond the nearest its hand gets (the elbow at its most bent). A target
 /// the folded arm cannot reach had the arm's IK press the elbow into its limit frame after
 /// frame, and the free joints of the wrist turned back and forth at their velocity bound
-/// (NAO, CMU 02_10: 145 frames with a joint reversal, 135 of them the right wrist's yaw; 8
+/// (NAO, CMU 02_10: 145 frames with a joint reversal, 135 of them the right wrist's yaw; 2
 /// with the target pushed out).
 fn beyond_fold(p: Vector3<f64>, k: usize, body: &Body) -> Vector3<f64> {
     let arm = p - body.shoulders[k];
