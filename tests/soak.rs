@@ -342,6 +342,20 @@ fn zmp_balance_step_does_not_allocate_after_warm_up() {
     assert_no_allocation_after_warm_up(Imitator::new(nao::profile(), config).unwrap(), &SHORT);
 }
 
+/// Nor does damping toward the last step ([`ImitatorConfig::damping_momentum`]): the step
+/// reference and the solver's reference coordinates are sized in `new`.
+#[test]
+fn damping_momentum_step_does_not_allocate_after_warm_up() {
+    let mut config = ImitatorConfig {
+        zmp_balance: true,
+        damping_momentum: 0.8,
+        ..ImitatorConfig::default()
+    };
+    config.solver.max_damping = 0.1;
+    config.solver.damping_threshold = 0.1;
+    assert_no_allocation_after_warm_up(Imitator::new(nao::profile(), config).unwrap(), &SHORT);
+}
+
 /// Nor does Koenemann et al.'s method (its IK problems, goals and bounds are built in `new`).
 #[test]
 fn koenemann_step_does_not_allocate_after_warm_up() {

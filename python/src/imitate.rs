@@ -41,6 +41,8 @@ pub(crate) struct Settings {
     dynamic_walk: bool,
     walking_arms: bool,
     zmp_balance: bool,
+    damping: Option<f64>,
+    damping_momentum: f64,
     velocity_fraction: f64,
     upper_body_fraction: Option<f64>,
     task_speed: Option<f64>,
@@ -62,6 +64,8 @@ impl Settings {
             dynamic_walk: false,
             walking_arms: false,
             zmp_balance: false,
+            damping: None,
+            damping_momentum: 0.0,
             velocity_fraction: 0.1,
             upper_body_fraction: None,
             task_speed: None,
@@ -83,6 +87,8 @@ impl Settings {
                 "dynamic_walk" => s.dynamic_walk = value.extract()?,
                 "walking_arms" => s.walking_arms = value.extract()?,
                 "zmp_balance" => s.zmp_balance = value.extract()?,
+                "damping" => s.damping = value.extract()?,
+                "damping_momentum" => s.damping_momentum = value.extract()?,
                 "velocity_fraction" => s.velocity_fraction = value.extract()?,
                 "upper_body_fraction" => s.upper_body_fraction = value.extract()?,
                 "task_speed" => s.task_speed = value.extract()?,
@@ -188,6 +194,17 @@ impl Settings {
         config.footsteps.dynamic = self.dynamic_walk;
         config.footsteps.walking_arms = self.walking_arms;
         config.zmp_balance = self.zmp_balance;
+        if !(0.0..=1.0).contains(&self.damping_momentum) {
+            return Err(value_error(format!(
+                "damping_momentum = {}: must be in [0, 1]",
+                self.damping_momentum
+            )));
+        }
+        config.damping_momentum = self.damping_momentum;
+        if let Some(mu) = positive("damping", self.damping)? {
+            config.solver.damping_threshold = mu;
+            config.solver.max_damping = mu;
+        }
         Ok(config)
     }
 }

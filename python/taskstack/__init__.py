@@ -91,6 +91,8 @@ def imitate_clip(
     dynamic_walk: bool = False,
     walking_arms: bool = False,
     zmp_balance: bool = False,
+    damping: Optional[float] = None,
+    damping_momentum: float = 0.0,
     offline: bool = False,
     velocity_fraction: float = 0.1,
     upper_body_fraction: Optional[float] = None,
@@ -120,6 +122,10 @@ def imitate_clip(
             ``--zmp-balance``): the ZMP of the CoM and the arms' acceleration stays in the
             support polygon and their vertical moment below what friction holds, so faster
             hands (``tracking_speed``) do not tip the robot or turn a loaded foot.
+        damping: the solver's damping of near-singular levels (the CLI's ``--damping``;
+            default 0.02).
+        damping_momentum: share in [0, 1] of the last frame's joint step a damped level
+            keeps instead of coming to rest (the CLI's ``--damping-momentum``; default 0).
         offline: read the whole clip first and time weight shifts ahead of the human.
         velocity_fraction: share of the rated joint velocity the legs may use, in (0, 1].
         upper_body_fraction: the same for arms, head and torso (default: the robot's).
@@ -148,6 +154,8 @@ def imitate_clip(
         dynamic_walk=dynamic_walk,
         walking_arms=walking_arms,
         zmp_balance=zmp_balance,
+        damping=damping,
+        damping_momentum=damping_momentum,
         offline=offline,
         velocity_fraction=velocity_fraction,
         upper_body_fraction=upper_body_fraction,

@@ -78,6 +78,12 @@ def cli_joints(clip: Path, out: Path, *args: str):
             ["--hold", "0", "--zmp-balance", "--tracking-speed", "1.0"],
             {"hold": 0, "zmp_balance": True, "tracking_speed": 1.0},
         ),
+        (
+            KINECT,
+            "nao",
+            ["--hold", "0", "--damping", "0.1", "--damping-momentum", "0.8"],
+            {"hold": 0, "damping": 0.1, "damping_momentum": 0.8},
+        ),
     ],
 )
 def test_imitate_clip_gives_the_cli_joint_angles(tmp, clip, robot, args, kwargs):
@@ -157,6 +163,11 @@ def test_bad_input_raises_python_exceptions_with_the_rust_message(tmp):
         taskstack.imitate_clip(KINECT, velocity_fraction=0.0)
     with pytest.raises(ValueError, match="dynamic_walk"):
         taskstack.imitate_clip(KINECT, walking_arms=True)
+    for bad in [-0.1, 1.5, math.nan]:
+        with pytest.raises(ValueError, match="damping_momentum"):
+            taskstack.imitate_clip(KINECT, damping_momentum=bad)
+    with pytest.raises(ValueError, match="damping"):
+        taskstack.imitate_clip(KINECT, damping=0.0)
     with pytest.raises(FileNotFoundError, match="missing_profile.toml"):
         taskstack.imitate_clip(KINECT, robot=str(tmp / "missing_profile.toml"))
     with pytest.raises(TypeError, match="velocity_fractoin"):

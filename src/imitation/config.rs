@@ -131,6 +131,17 @@ pub struct ImitatorConfig {
     /// the bundled clips with it and 9 of 16 without (loaded feet turning 3.5–6.6°). Refused
     /// with Koenemann's method (no task tables).
     pub zmp_balance: bool,
+    /// The share (0–1) of the last frame's joint step that a damped level keeps (Poubel et
+    /// al.'s method, its support phases). A level whose smallest singular value falls below
+    /// [`Settings::damping_threshold`] (an elbow near straight, a wrist turn that hardly moves
+    /// the hand point) is damped, and its poorly conditioned directions are damped toward this
+    /// share of the last step ([`crate::solver::driver::PositionDriver::set_step_reference`]) instead
+    /// of toward rest: such a direction then keeps moving the way it moved rather than
+    /// reversing at speed from frame to frame, while the well-conditioned directions are
+    /// solved exactly either way. A level holding inequality rows at their bounds is damped
+    /// toward rest whatever this says. Default 0 (toward rest, the textbook damping). Pair it
+    /// with a larger damping ([`Settings::max_damping`]): see the CHANGELOG for measurements.
+    pub damping_momentum: f64,
 }
 
 impl Default for ImitatorConfig {
@@ -157,6 +168,7 @@ impl Default for ImitatorConfig {
             hand_supports: None,
             look_ahead: None,
             zmp_balance: false,
+            damping_momentum: 0.0,
         }
     }
 }
@@ -259,6 +271,17 @@ impl ImitatorConfig {
                 return invalid("hand_supports", f64::NAN, reason);
             }
             hands.validate()?;
+        }
+        if !(0.0..=1.0).contains(&self.damping_momentum) {
+            return invalid(
+                "damping_momentum",
+                self.damping_momentum,
+                "must be in [0, 1]",
+            );
+        }
+        if self.damping_momentum > 0.0 && matches!(self.method, ImitationMethod::Koenemann(_)) {
+            let reason = "the damping momentum needs Poubel et al.'s method (its task levels)";
+            return invalid("damping_momentum", self.damping_momentum, reason);
         }
         if self.zmp_balance && matches!(self.method, ImitationMethod::Koenemann(_)) {
             let reason = "the ZMP balance needs Poubel et al.'s method (task tables)";

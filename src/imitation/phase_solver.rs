@@ -18,8 +18,8 @@ use crate::model::{Axis, FrameId, Model, ModelData};
 use crate::robots::BipedProfile;
 use crate::solver::driver::{DriverReport, DriverSettings, PositionDriver, TaskModel};
 use crate::solver::{
-    JointBounds, JointLimitAvoidance, JointTracking, Settings, SolveReport, Solver, StackShape,
-    TaskStack,
+    JointBounds, JointLimitAvoidance, JointTracking, Settings, SolveReport, Solver, SolverError,
+    StackShape, TaskStack,
 };
 use crate::tasks::{
     CapsuleDistanceTask, FramePoint, InequalityTask, com_rows, orientation_rows, point_rows,
@@ -149,6 +149,10 @@ pub(super) struct PhaseSolver {
     other_sole: FrameId,
     /// The joints the solve may move ([`PhaseSolver::restricted`]); `None`: all.
     joints: Option<Vec<bool>>,
+    /// [`ImitatorConfig::damping_momentum`](super::ImitatorConfig::damping_momentum), and the
+    /// frame's step reference it gives (rad).
+    damping_momentum: f64,
+    momentum_step: Vec<f64>,
 }
 
 /// The tracked axes of `axes` in row order, padded with z.
@@ -253,6 +257,8 @@ impl PhaseSolver {
             other_ankle: model.frame_id(&other.ankle)?,
             other_sole: model.frame_id(&other.sole)?,
             joints: None,
+            damping_momentum: 0.0,
+            momentum_step: vec![0.0; model.nv()],
         })
     }
 
@@ -284,6 +290,13 @@ impl PhaseSolver {
         let mut solver = Self::new(&table, profile, initial_q, settings)?;
         solver.joints = Some(joints);
         Ok(solver)
+    }
+
+    /// Damped levels keep `share` of the last frame's step ([`PhaseSolver::run`]'s step
+    /// reference, [`ImitatorConfig::damping_momentum`](super::ImitatorConfig::damping_momentum)).
+    pub(super) fn with_damping_momentum(mut self, share: f64) -> Self {
+        self.damping_momentum = share;
+        self
     }
 
     /// Number of tasks (entries of the driver's task errors).
@@ -378,6 +391,7 @@ impl PhaseSolver {
         self.driver.set_settings(settings)?;
         self.frame_start.copy_from_slice(q);
         let frame_dt = settings.dt * settings.max_iterations as f64;
+        self.set_step_reference(targets.joint_velocity, frame_dt)?;
         for c in &mut self.constraints {
             if let ConstraintRows::Zmp(zmp) = &mut c.rows {
                 zmp.begin_frame(data, q, targets.joint_velocity, frame_dt)?;
@@ -402,6 +416,18 @@ impl PhaseSolver {
             self.settle_contact(model, data, q, bounds, frame_dt, legs_may_settle)?;
         }
         Ok(())
+    }
+
+    /// The driver's step reference: `damping_momentum` of the last frame's joint velocity over
+    /// this frame's `frame_dt` (s); none when the share is 0 or the velocity is not known.
+    fn set_step_reference(&mut self, velocity: &[f64], frame_dt: f64) -> Result<(), SolverError> {
+        if self.damping_momentum == 0.0 || velocity.len() != self.momentum_step.len() {
+            return self.driver.set_step_reference(None);
+        }
+        for (s, v) in self.momentum_step.iter_mut().zip(velocity) {
+            *s = self.damping_momentum * v * frame_dt;
+        }
+        self.driver.set_step_reference(Some(&self.momentum_step))
     }
 
     /// Writes the contact level's rows at the posture in `data` (its forward kinematics

@@ -118,6 +118,7 @@ fn phase_solvers(
     profile: &BipedProfile,
     q: &[f64],
     solver: Settings,
+    momentum: f64,
 ) -> Result<Vec<PhaseSolver>, ImitationError> {
     SupportPhase::ALL
         .iter()
@@ -135,7 +136,7 @@ fn phase_solvers(
                 warm_start: true,
                 ..solver
             };
-            PhaseSolver::new(table, profile, q, settings)
+            Ok(PhaseSolver::new(table, profile, q, settings)?.with_damping_momentum(momentum))
         })
         .collect()
 }
@@ -192,7 +193,7 @@ impl PoubelImitator {
             .zip(q)
             .map(|(&l, &v)| l.then_some(v))
             .collect();
-        let phases = phase_solvers(&tables, profile, q, config.solver)?;
+        let phases = phase_solvers(&tables, profile, q, config.solver, config.damping_momentum)?;
         let angles = profile.joint_angles.map(|build| build(model)).transpose()?;
         let effectors = effector_ids(profile)?;
         let tuning = profile.tuning;

@@ -164,6 +164,11 @@ pub struct PositionDriver {
     best_violation: f64,
     /// The caller's bounds with the per-iteration step limit as a velocity cap.
     step_bounds: JointBounds,
+    /// The step of the whole run that damped levels are damped toward
+    /// ([`PositionDriver::set_step_reference`]), and `q` at the run's start.
+    step_reference: Vec<f64>,
+    use_step_reference: bool,
+    run_start: Vec<f64>,
     report: DriverReport,
 }
 
@@ -187,6 +192,9 @@ impl PositionDriver {
             best_errors: vec![0.0; tasks],
             best_violation: 0.0,
             step_bounds: JointBounds::unbounded(solver.stack().dof()),
+            step_reference: vec![0.0; solver.stack().dof()],
+            use_step_reference: false,
+            run_start: vec![0.0; solver.stack().dof()],
             report: DriverReport {
                 iterations: 0,
                 stop: StopReason::Converged,
@@ -209,6 +217,24 @@ impl PositionDriver {
     pub fn set_settings(&mut self, settings: DriverSettings) -> Result<(), SolverError> {
         settings.validate()?;
         self.settings = settings;
+        Ok(())
+    }
+
+    /// The step `δq` (rad or m, one per joint) the next runs are expected to take as a whole,
+    /// e.g. the last frame's: each iteration's damped levels are then damped toward what is
+    /// left of it, `(δq_ref − (q − q_start)) / Δt`, instead of toward rest (see
+    /// [`TaskStack::damping_reference_mut`]). `None` (the default): toward rest.
+    /// Errors: a wrong length or a non-finite entry.
+    pub fn set_step_reference(&mut self, step: Option<&[f64]>) -> Result<(), SolverError> {
+        match step {
+            Some(step) => {
+                check_len("step reference", self.step_reference.len(), step.len())?;
+                check_finite_slice("step reference", step)?;
+                self.step_reference.copy_from_slice(step);
+                self.use_step_reference = true;
+            }
+            None => self.use_step_reference = false,
+        }
         Ok(())
     }
 
@@ -240,6 +266,7 @@ impl PositionDriver {
         let s = self.settings;
         let mut iterations = 0;
         let mut since_best = 0;
+        self.run_start.copy_from_slice(q);
         let stop = loop {
             model.evaluate(q, solver.stack_mut())?;
             // Before measuring: a NaN task error must not pass the tolerance test as converged.
@@ -283,6 +310,7 @@ impl PositionDriver {
             self.previous_violation = violation;
             self.set_velocities(model, solver.stack_mut());
             self.set_bounds(model, solver.stack_mut());
+            self.set_damping_reference(q, solver.stack_mut());
             solver.solve(q, &self.step_bounds, s.dt)?;
             for (qi, v) in q.iter_mut().zip(solver.velocity()) {
                 *qi += v * s.dt;
@@ -356,6 +384,21 @@ impl PositionDriver {
                 *lo = gain * lo.min(limit);
                 *hi = gain * hi.max(-limit);
             }
+        }
+    }
+
+    /// What is left of the step reference after the iterations so far, per `Δt`; zero without
+    /// one.
+    fn set_damping_reference(&self, q: &[f64], stack: &mut TaskStack) {
+        let reference = stack.damping_reference_mut();
+        if !self.use_step_reference {
+            reference.fill(0.0);
+            return;
+        }
+        let dt = self.settings.dt;
+        let parts = (self.step_reference.iter()).zip(q.iter().zip(&self.run_start));
+        for (r, (step, (qi, q0))) in reference.iter_mut().zip(parts) {
+            *r = (step - (qi - q0)) / dt;
         }
     }
 

@@ -19,7 +19,14 @@
 //!   (`Z_{j−1}ᵀ J_jᵀ`), to the gradient (`Z_Nᵀ g`), and once, back, to assemble `q̇`.
 //! * Damping: when the smallest kept pivot `σ` of a level is below
 //!   [`Settings::damping_threshold`] `ε`, `μ² = μ_max² (1 − (σ/ε)²)` (Nakamura–Hanafusa style,
-//!   continuous in `σ`); otherwise `μ = 0` and the level is solved exactly.
+//!   continuous in `σ`); otherwise `μ = 0` and the level is solved exactly. A damped level is
+//!   damped toward the stack's damping reference `q̇_ref`
+//!   ([`TaskStack::damping_reference_mut`](super::TaskStack::damping_reference_mut), zero by
+//!   default): `w_j = argmin ‖R_jᵀ w − Πᵀ b_j‖² + μ_j² ‖w − U_jᵀ q̇_ref‖²`, `U_j` the level's
+//!   range basis, so that its poorly conditioned directions keep the reference's motion rather
+//!   than come to rest (over the level's range this is `(JᵀJ + μ²I)⁻¹(Jᵀẋ + μ² P q̇_ref)`). A
+//!   level holding inequality rows at a bound is damped toward rest: a bound never gives way
+//!   to the reference.
 //!
 //! Lower levels act only in `Z_j`, so they cannot disturb a higher level: its residual is the same
 //! with or without them (strict priority), up to rounding and the truncated directions whose
@@ -92,7 +99,8 @@ pub struct Settings {
     /// A level whose smallest kept singular value estimate `σ` is below this is damped. Default
     /// `2e-2`. Set to 0 to disable damping (pure truncation).
     pub damping_threshold: f64,
-    /// Largest damping factor `μ_max`, reached as `σ → 0`. Default `2e-2`.
+    /// Largest damping factor `μ_max`, reached as `σ → 0`. Default `2e-2`. A damped level is
+    /// damped toward the stack's damping reference (zero by default, see the module docs).
     pub max_damping: f64,
     /// A level is reported feasible when `‖J_j q̇ − ẋ_j‖ ≤ feasibility_tolerance · (1 + ‖ẋ_j‖)`.
     /// Default `1e-8`.
@@ -311,6 +319,13 @@ pub struct Solver {
     /// Right-hand side `b_j` per row, then `w_j` per level (at the level's start).
     rhs: Vec<f64>,
     coeff: Vec<f64>,
+    /// Per level (at the level's start): the damping reference's coordinates `U_jᵀ q̇_ref`
+    /// along its range basis, the `w` a damped level is damped toward.
+    reference_coeff: Vec<f64>,
+    /// Whether this pass has a nonzero damping reference.
+    damp_toward_reference: bool,
+    /// The damping reference in reduced coordinates, rotated level by level (length n).
+    reference_coords: Vec<f64>,
     /// Damped least-squares scratch: `(2 m_max) × m_max` and `2 m_max`.
     ls_matrix: Vec<f64>,
     ls_rhs: Vec<f64>,
@@ -375,6 +390,9 @@ impl Solver {
             perm: vec![0; capacity],
             rhs: vec![0.0; capacity],
             coeff: vec![0.0; capacity],
+            reference_coeff: vec![0.0; capacity],
+            damp_toward_reference: false,
+            reference_coords: vec![0.0; n],
             ls_matrix: vec![0.0; 2 * m_max * m_max],
             ls_rhs: vec![0.0; 2 * m_max],
             coords: vec![0.0; n],
@@ -640,6 +658,12 @@ impl Solver {
         self.free.clear();
         self.free.extend((0..n).filter(|&i| !self.clamped[i]));
         let mut dim = self.free.len();
+        let reference = self.stack.damping_reference();
+        self.damp_toward_reference = reference.iter().any(|&v| v != 0.0);
+        for (c, &i) in self.reference_coords.iter_mut().zip(&self.free) {
+            *c = reference[i];
+        }
+        let mut offset = 0;
         for j in 0..self.stack.level_count() {
             let rows = self.project_level_rows(j, dim);
             let (rank, damping) = self.factor_level(j, dim, rows);
@@ -649,10 +673,31 @@ impl Solver {
                 rows,
                 damping,
             };
+            if self.damp_toward_reference {
+                self.project_reference(j, offset);
+            }
             self.solve_level(j);
             dim -= rank;
+            offset += rank;
         }
         self.assemble_velocity();
+    }
+
+    /// Level j's range coordinates of the damping reference, `U_jᵀ q̇_ref`, into
+    /// `reference_coeff`: `reference_coords[offset..]` holds `Z_{j−1}ᵀ q̇_ref` on entry and
+    /// level j's reflectors are applied to it, as [`apply_chain`] does.
+    fn project_reference(&mut self, j: usize, offset: usize) {
+        let (n, start, f) = (self.stack.dof(), self.seg_start[j], self.factors[j]);
+        let factor = &self.qr[n * start..];
+        let cur = &mut self.reference_coords[offset..offset + f.dim];
+        for l in 0..f.rank {
+            apply_reflector(
+                &factor[l * f.dim + l..(l + 1) * f.dim],
+                self.tau[start + l],
+                &mut cur[l..],
+            );
+        }
+        self.reference_coeff[start..start + f.rank].copy_from_slice(&cur[..f.rank]);
     }
 
     /// The last prioritized pass again for the current scales and fixed velocities, on its
@@ -795,7 +840,8 @@ impl Solver {
             if rank == rows && damping == 0.0 {
                 solve_upper_transposed(a, dim, rank, c);
             } else {
-                // min ‖[Rᵀ; μ I] w − [c; 0]‖ by a QR of the stacked matrix.
+                // min ‖[Rᵀ; μ I] w − [c; μ w_ref]‖ by a QR of the stacked matrix, w_ref the
+                // damping reference's coordinates (0 without one), scaled with the level.
                 let aug_rows = rows + if damping > 0.0 { rank } else { 0 };
                 let m = &mut self.ls_matrix[..aug_rows * rank];
                 m.fill(0.0);
@@ -809,6 +855,15 @@ impl Solver {
                     }
                 }
                 c[rows..aug_rows].fill(0.0);
+                // A level holding inequality rows at their bounds is damped toward rest: a
+                // bound must not give way to the last step's momentum.
+                let equalities = self.stack.level_start(j + 1) - self.stack.level_start(j);
+                if damping > 0.0 && self.damp_toward_reference && rows == equalities {
+                    let reference = &self.reference_coeff[start..start + rank];
+                    for (ck, &r) in c[rows..aug_rows].iter_mut().zip(reference) {
+                        *ck = damping * self.scales[j] * r;
+                    }
+                }
                 qr_with_rhs(m, aug_rows, rank, &mut c[..aug_rows]);
                 solve_upper(m, aug_rows, rank, c);
             }

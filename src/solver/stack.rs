@@ -188,6 +188,7 @@ pub struct TaskStack {
     lower: Vec<f64>,
     upper: Vec<f64>,
     gradient: Vec<f64>,
+    damping_reference: Vec<f64>,
 }
 
 /// `[0, c₀, c₀ + c₁, …]`: the first index of each block of `counts` rows, and the total.
@@ -216,6 +217,7 @@ impl TaskStack {
             lower: vec![f64::NEG_INFINITY; inequalities],
             upper: vec![f64::INFINITY; inequalities],
             gradient: vec![0.0; shape.dof],
+            damping_reference: vec![0.0; shape.dof],
         })
     }
 
@@ -374,6 +376,20 @@ impl TaskStack {
         self.gradient.fill(0.0);
     }
 
+    /// The velocity a damped level is damped toward (length `n`, joint velocity units; zero
+    /// by default): see [`Settings::max_damping`](super::Settings::max_damping).
+    pub fn damping_reference(&self) -> &[f64] {
+        &self.damping_reference
+    }
+
+    /// Mutable access to the damping reference, e.g. the previous solve's velocity: a damped
+    /// (near-singular) level then keeps moving as it did in its poorly conditioned
+    /// directions instead of being pulled toward rest, which turns a level's frame-to-frame
+    /// reversals into smooth motion without slowing its well-conditioned directions.
+    pub fn damping_reference_mut(&mut self) -> &mut [f64] {
+        &mut self.damping_reference
+    }
+
     /// Adds `κ ∇f(q)` of an optimization task (eq. 3) to the combined gradient term. A negative
     /// `kappa` descends `f` (the paper: κ = −0.10 for joint limits, −0.02 for joint tracking).
     pub fn add_gradient(
@@ -428,6 +444,7 @@ impl TaskStack {
             && all_finite(&self.target)
             && columns_finite(&self.inequality_jacobian_t)
             && all_finite(&self.gradient)
+            && all_finite(&self.damping_reference)
         {
             return self.check_inequality_bounds();
         }
@@ -466,7 +483,8 @@ impl TaskStack {
             }
         }
         self.check_inequalities()?;
-        check_finite_slice("gradient term", &self.gradient)
+        check_finite_slice("gradient term", &self.gradient)?;
+        check_finite_slice("damping reference", &self.damping_reference)
     }
 
     /// Finite inequality Jacobians, then [`TaskStack::check_inequality_bounds`].
