@@ -544,15 +544,14 @@ fn koenemann_arms_do_not_chatter_on_a_tightly_folded_arm() {
 fn damping_toward_the_last_step_stops_the_chatter_and_keeps_the_hands() {
     let name = "cmu_05_02_stand_arm_gestures_turn_single_leg.bvh";
     let run = |momentum: f64| {
-        let mut config = ImitatorConfig {
+        let config = ImitatorConfig {
             zmp_balance: true,
             max_tracking_speed: Some(1.0),
             max_tracking_acceleration: Some(10.0),
             damping_momentum: momentum,
+            damping: Some(0.1),
             ..ImitatorConfig::default()
         };
-        config.solver.damping_threshold = 0.1;
-        config.solver.max_damping = 0.1;
         let (m, _) = run_with(name, config, HELD_FOOT_TOLERANCE);
         let hands: Vec<f64> = (m.effectors_clip.iter())
             .filter(|e| e.name.ends_with("hand"))
@@ -573,6 +572,19 @@ fn damping_toward_the_last_step_stops_the_chatter_and_keeps_the_hands() {
         };
         let refused = Imitator::new(nao::profile(), config).err();
         assert!(refused.is_some_and(|e| e.to_string().contains("damping_momentum")));
+    }
+    for (method, damping) in [
+        (ImitationMethod::Poubel, 0.0),
+        (ImitationMethod::Poubel, f64::INFINITY),
+        (ImitationMethod::Koenemann(KoenemannConfig::default()), 0.05),
+    ] {
+        let config = ImitatorConfig {
+            method,
+            damping: Some(damping),
+            ..ImitatorConfig::default()
+        };
+        let refused = Imitator::new(nao::profile(), config).err();
+        assert!(refused.is_some_and(|e| e.to_string().contains("damping")));
     }
     let (at_rest, _) = run(0.0);
     let (moving, m) = run(0.8);

@@ -96,6 +96,7 @@ fn the_scaling_rules_keep_the_invariants_they_state() {
         b.tracking_acceleration / to.arm_length,
         a.tracking_acceleration / from.arm_length
     );
+    assert_relative_eq!(b.damping / to.arm_length, a.damping / from.arm_length);
     // Faster motors: the same joint speeds, never a larger fraction.
     assert!(b.upper_body_velocity_fraction <= a.upper_body_velocity_fraction);
     // A robot of the same size keeps its values.
@@ -110,6 +111,8 @@ fn the_rules_give_the_g1_what_was_tuned_on_it_independently() {
     // not): the rules land within 10 % of both.
     let g1 = g1::profile().size().unwrap();
     let rules = nao::TUNING.scaled(&nao::SIZE, &g1);
+    // The G1's damping is the rules' value, rounded to 1 mm/rad.
+    assert!((rules.damping - g1::TUNING.damping).abs() < 5e-4);
     let unshaped = MotionTuning {
         stance_tracking_speed: 0.15,
         ..nao::TUNING

@@ -346,13 +346,12 @@ fn zmp_balance_step_does_not_allocate_after_warm_up() {
 /// reference and the solver's reference coordinates are sized in `new`.
 #[test]
 fn damping_momentum_step_does_not_allocate_after_warm_up() {
-    let mut config = ImitatorConfig {
+    let config = ImitatorConfig {
         zmp_balance: true,
         damping_momentum: 0.8,
+        damping: Some(0.1),
         ..ImitatorConfig::default()
     };
-    config.solver.max_damping = 0.1;
-    config.solver.damping_threshold = 0.1;
     assert_no_allocation_after_warm_up(Imitator::new(nao::profile(), config).unwrap(), &SHORT);
 }
 

@@ -55,7 +55,7 @@ pub(crate) struct ImitationOptions {
     pub(crate) zmp_balance: bool,
     /// Poubel's method: the solver's damping of near-singular levels (μ in task units per
     /// rad, above 0): a level whose smallest singular value is below MU is damped, up to MU.
-    /// Default 0.02. Larger damping stops arms chattering near a singular pose (an elbow near
+    /// Default: the robot profile's (NAO 0.02, G1 0.039). Larger damping stops arms chattering near a singular pose (an elbow near
     /// straight) at the cost of hand tracking; see --damping-momentum.
     #[arg(long, value_name = "MU", value_parser = positive, allow_negative_numbers = true)]
     pub(crate) damping: Option<f64>,
@@ -228,10 +228,7 @@ impl ImitationOptions {
         config.footsteps.walking_arms = self.walking_arms;
         config.zmp_balance = self.zmp_balance;
         config.damping_momentum = self.damping_momentum;
-        if let Some(mu) = self.damping {
-            config.solver.damping_threshold = mu;
-            config.solver.max_damping = mu;
-        }
+        config.damping = self.damping;
         config
     }
 }

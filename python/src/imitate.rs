@@ -201,10 +201,7 @@ impl Settings {
             )));
         }
         config.damping_momentum = self.damping_momentum;
-        if let Some(mu) = positive("damping", self.damping)? {
-            config.solver.damping_threshold = mu;
-            config.solver.max_damping = mu;
-        }
+        config.damping = positive("damping", self.damping)?;
         Ok(config)
     }
 }

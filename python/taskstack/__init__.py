@@ -123,7 +123,7 @@ def imitate_clip(
             support polygon and their vertical moment below what friction holds, so faster
             hands (``tracking_speed``) do not tip the robot or turn a loaded foot.
         damping: the solver's damping of near-singular levels (the CLI's ``--damping``;
-            default 0.02).
+            default: the robot's, NAO 0.02, G1 0.039).
         damping_momentum: share in [0, 1] of the last frame's joint step a damped level
             keeps instead of coming to rest (the CLI's ``--damping-momentum``; default 0).
         offline: read the whole clip first and time weight shifts ahead of the human.

@@ -110,8 +110,16 @@ pub struct ImitatorConfig {
     /// solve cut short leaves the higher levels part of their motion: on CMU 07_04 with
     /// `--walk` the robot, its lifts cut frame after frame, walked 0.07 of 0.88 m (0.55 m
     /// unbounded), and with 6 a loaded foot turned 2.6° on CMU 09_12. Hence no budget by
-    /// default.
+    /// default. Its [`Settings::damping_threshold`] and [`Settings::max_damping`] are replaced
+    /// by [`ImitatorConfig::damping`].
     pub solver: Settings,
+    /// The solver's damping of near-singular levels (Poubel et al.'s method; task units per
+    /// rad, m/rad for the hands, > 0): the damping threshold and the largest damping of
+    /// `solver`. `None` (default): the profile's
+    /// [`MotionTuning::damping`](crate::robots::MotionTuning::damping) (NAO 0.02, G1 0.039:
+    /// it scales with the arm). Refused with Koenemann's method (its own
+    /// [`KoenemannConfig::damping`]).
+    pub damping: Option<f64>,
     /// Initial posture (model variable order, rad); `None` (default): the profile's
     /// [`BipedProfile::stand`](crate::robots::BipedProfile::stand).
     pub initial_q: Option<Vec<f64>>,
@@ -169,12 +177,23 @@ impl Default for ImitatorConfig {
             look_ahead: None,
             zmp_balance: false,
             damping_momentum: 0.0,
+            damping: None,
         }
     }
 }
 
 impl ImitatorConfig {
     /// [`ImitatorConfig::motion`], or the default with the CoM bounds of `tuning`.
+    /// `solver` with the damping of [`ImitatorConfig::damping`], or `tuning`'s.
+    pub(super) fn solver_for(&self, tuning: &MotionTuning) -> Settings {
+        let damping = self.damping.unwrap_or(tuning.damping);
+        Settings {
+            damping_threshold: damping,
+            max_damping: damping,
+            ..self.solver
+        }
+    }
+
     pub(super) fn motion_for(&self, tuning: &MotionTuning) -> MotionLimits {
         self.motion
             .unwrap_or_else(|| MotionLimits::with_com_of(tuning))
@@ -271,6 +290,15 @@ impl ImitatorConfig {
                 return invalid("hand_supports", f64::NAN, reason);
             }
             hands.validate()?;
+        }
+        if let Some(damping) = self.damping {
+            if !(damping.is_finite() && damping > 0.0) {
+                return invalid("damping", damping, "must be finite and > 0");
+            }
+            if matches!(self.method, ImitationMethod::Koenemann(_)) {
+                let reason = "Koenemann et al.'s method has its own damping (KoenemannConfig)";
+                return invalid("damping", damping, reason);
+            }
         }
         if !(0.0..=1.0).contains(&self.damping_momentum) {
             return invalid(

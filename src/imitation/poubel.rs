@@ -193,7 +193,8 @@ impl PoubelImitator {
             .zip(q)
             .map(|(&l, &v)| l.then_some(v))
             .collect();
-        let phases = phase_solvers(&tables, profile, q, config.solver, config.damping_momentum)?;
+        let solver = config.solver_for(&profile.tuning);
+        let phases = phase_solvers(&tables, profile, q, solver, config.damping_momentum)?;
         let angles = profile.joint_angles.map(|build| build(model)).transpose()?;
         let effectors = effector_ids(profile)?;
         let tuning = profile.tuning;
@@ -231,12 +232,7 @@ impl PoubelImitator {
                 };
                 let footsteps = &config.footsteps;
                 Some(WalkFollower::new(
-                    profile,
-                    q,
-                    config.solver,
-                    area,
-                    footsteps,
-                    bounds,
+                    profile, q, solver, area, footsteps, bounds,
                 )?)
             }
             false => None,

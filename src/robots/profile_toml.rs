@@ -59,6 +59,7 @@
 //! com_acceleration = 0.3             # m/s²
 //! offset_rate = 1.5                  # 1/s, Koenemann's CoM offset between the feet
 //! offset_acceleration = 6.0          # 1/s²
+//! damping = 0.02                     # m/rad, the solver's damping of near-singular levels
 //! ```
 //!
 //! The soles become links named `left_sole` and `right_sole` (added to the URDF text before it
@@ -115,6 +116,7 @@ struct Tuning {
     com_acceleration: Option<f64>,
     offset_rate: Option<f64>,
     offset_acceleration: Option<f64>,
+    damping: Option<f64>,
 }
 
 #[derive(Deserialize)]
@@ -352,6 +354,7 @@ fn tuning(file: Option<Tuning>, scaled: MotionTuning) -> MotionTuning {
         com_acceleration: t.com_acceleration.unwrap_or(scaled.com_acceleration),
         offset_rate: t.offset_rate.unwrap_or(scaled.offset_rate),
         offset_acceleration: t.offset_acceleration.unwrap_or(scaled.offset_acceleration),
+        damping: t.damping.unwrap_or(scaled.damping),
     }
 }
 

@@ -340,6 +340,7 @@ pub const TUNING: MotionTuning = MotionTuning {
     com_acceleration: 0.3,
     offset_rate: 1.5,
     offset_acceleration: 6.0,
+    damping: 0.02,
 };
 
 /// The NAO's sizes ([`BipedProfile::size`] of its profile, rounded to 0.1 mm and 0.01 rad/s; a test
