@@ -559,32 +559,28 @@ fn damping_toward_the_last_step_stops_the_chatter_and_keeps_the_hands() {
             .collect();
         (hands.iter().sum::<f64>() / hands.len() as f64, m)
     };
-    // Out of [0, 1], or with Koenemann's method (no task levels): refused, not ignored.
-    for (method, momentum) in [
-        (ImitationMethod::Poubel, 1.5),
-        (ImitationMethod::Poubel, f64::NAN),
-        (ImitationMethod::Koenemann(KoenemannConfig::default()), 0.5),
+    // Out of range, or with Koenemann's method (no task levels, its own damping): refused by
+    // name, not ignored.
+    let koenemann = || ImitationMethod::Koenemann(KoenemannConfig::default());
+    for (method, momentum, damping, name) in [
+        (ImitationMethod::Poubel, 1.5, None, "damping_momentum"),
+        (ImitationMethod::Poubel, f64::NAN, None, "damping_momentum"),
+        (koenemann(), 0.5, None, "damping_momentum"),
+        (ImitationMethod::Poubel, 0.0, Some(0.0), "damping"),
+        (ImitationMethod::Poubel, 0.0, Some(f64::INFINITY), "damping"),
+        (koenemann(), 0.0, Some(0.05), "damping"),
     ] {
         let config = ImitatorConfig {
             method,
             damping_momentum: momentum,
+            damping,
             ..ImitatorConfig::default()
         };
         let refused = Imitator::new(nao::profile(), config).err();
-        assert!(refused.is_some_and(|e| e.to_string().contains("damping_momentum")));
-    }
-    for (method, damping) in [
-        (ImitationMethod::Poubel, 0.0),
-        (ImitationMethod::Poubel, f64::INFINITY),
-        (ImitationMethod::Koenemann(KoenemannConfig::default()), 0.05),
-    ] {
-        let config = ImitatorConfig {
-            method,
-            damping: Some(damping),
-            ..ImitatorConfig::default()
-        };
-        let refused = Imitator::new(nao::profile(), config).err();
-        assert!(refused.is_some_and(|e| e.to_string().contains("damping")));
+        assert!(
+            refused.is_some_and(|e| e.to_string().contains(name)),
+            "{name}"
+        );
     }
     let (at_rest, _) = run(0.0);
     let (moving, m) = run(0.8);

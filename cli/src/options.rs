@@ -284,8 +284,7 @@ pub(crate) fn non_negative(text: &str) -> Result<f64, String> {
     }
 }
 
-fn fraction(text: &str) -> Result<f64, String> {
-    let value = positive(text)?;
+fn at_most_one(value: f64) -> Result<f64, String> {
     if value <= 1.0 {
         Ok(value)
     } else {
@@ -293,13 +292,14 @@ fn fraction(text: &str) -> Result<f64, String> {
     }
 }
 
+/// A share of a rated velocity: in (0, 1].
+fn fraction(text: &str) -> Result<f64, String> {
+    positive(text).and_then(at_most_one)
+}
+
+/// A share that may be none: in [0, 1].
 fn share(text: &str) -> Result<f64, String> {
-    let value = non_negative(text)?;
-    if value <= 1.0 {
-        Ok(value)
-    } else {
-        Err(format!("{value} is not ≤ 1"))
-    }
+    non_negative(text).and_then(at_most_one)
 }
 
 fn hold(text: &str) -> Result<Hold, String> {
