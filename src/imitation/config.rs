@@ -141,14 +141,14 @@ pub struct ImitatorConfig {
     pub zmp_balance: bool,
     /// The share (0–1) of the last frame's joint step that a damped level keeps (Poubel et
     /// al.'s method, its support phases). A level whose smallest singular value falls below
-    /// [`Settings::damping_threshold`] (an elbow near straight, a wrist turn that hardly moves
+    /// the damping ([`ImitatorConfig::damping`]; an elbow near straight, a wrist turn that hardly moves
     /// the hand point) is damped, and its poorly conditioned directions are damped toward this
     /// share of the last step ([`crate::solver::driver::PositionDriver::set_step_reference`]) instead
     /// of toward rest: such a direction then keeps moving the way it moved rather than
     /// reversing at speed from frame to frame, while the well-conditioned directions are
     /// solved exactly either way. A level holding inequality rows at their bounds is damped
     /// toward rest whatever this says. Default 0 (toward rest, the textbook damping). Pair it
-    /// with a larger damping ([`Settings::max_damping`]): see the CHANGELOG for measurements.
+    /// with a larger damping ([`ImitatorConfig::damping`]): see the CHANGELOG for measurements.
     pub damping_momentum: f64,
 }
 
@@ -183,7 +183,6 @@ impl Default for ImitatorConfig {
 }
 
 impl ImitatorConfig {
-    /// [`ImitatorConfig::motion`], or the default with the CoM bounds of `tuning`.
     /// `solver` with the damping of [`ImitatorConfig::damping`], or `tuning`'s.
     pub(super) fn solver_for(&self, tuning: &MotionTuning) -> Settings {
         let damping = self.damping.unwrap_or(tuning.damping);
@@ -194,6 +193,7 @@ impl ImitatorConfig {
         }
     }
 
+    /// [`ImitatorConfig::motion`], or the default with the CoM bounds of `tuning`.
     pub(super) fn motion_for(&self, tuning: &MotionTuning) -> MotionLimits {
         self.motion
             .unwrap_or_else(|| MotionLimits::with_com_of(tuning))

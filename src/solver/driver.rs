@@ -223,7 +223,8 @@ impl PositionDriver {
     /// The step `δq` (rad or m, one per joint) the next runs are expected to take as a whole,
     /// e.g. the last frame's: each iteration's damped levels are then damped toward what is
     /// left of it, `(δq_ref − (q − q_start)) / Δt`, instead of toward rest (see
-    /// [`TaskStack::damping_reference_mut`]). `None` (the default): toward rest.
+    /// [`TaskStack::damping_reference_mut`]). `None` (the default): toward rest. Either way
+    /// [`PositionDriver::run`] writes the stack's damping reference before every solve.
     /// Errors: a wrong length or a non-finite entry.
     pub fn set_step_reference(&mut self, step: Option<&[f64]>) -> Result<(), SolverError> {
         match step {

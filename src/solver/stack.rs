@@ -382,10 +382,13 @@ impl TaskStack {
         &self.damping_reference
     }
 
-    /// Mutable access to the damping reference, e.g. the previous solve's velocity: a damped
-    /// (near-singular) level then keeps moving as it did in its poorly conditioned
-    /// directions instead of being pulled toward rest, which turns a level's frame-to-frame
-    /// reversals into smooth motion without slowing its well-conditioned directions.
+    /// Mutable access to the damping reference, e.g. a share of the previous solve's
+    /// velocity: a damped (near-singular) level then keeps moving as it did in its poorly
+    /// conditioned directions instead of being pulled toward rest, which can turn a level's
+    /// frame-to-frame reversals into smooth motion without slowing its well-conditioned
+    /// directions. Nothing brakes those directions but the damping itself, so a reference of
+    /// the whole last velocity can drift (the imitation keeps a share of it). The weighted DLS
+    /// method ignores it (it damps toward the gradient term).
     pub fn damping_reference_mut(&mut self) -> &mut [f64] {
         &mut self.damping_reference
     }
