@@ -55,8 +55,9 @@ pub(crate) struct ImitationOptions {
     pub(crate) zmp_balance: bool,
     /// Poubel's method: the solver's damping of near-singular levels (μ in task units per
     /// rad, above 0): a level whose smallest singular value is below MU is damped, up to MU.
-    /// Default: the robot profile's (NAO 0.02, G1 0.039). Larger damping stops arms chattering near a singular pose (an elbow near
-    /// straight) at the cost of hand tracking; see --damping-momentum.
+    /// Default: the robot profile's (NAO 0.02, G1 0.039). Larger damping stops arms
+    /// chattering near a singular pose (an elbow near straight) at the cost of hand tracking;
+    /// see --damping-momentum.
     #[arg(long, value_name = "MU", value_parser = positive, allow_negative_numbers = true)]
     pub(crate) damping: Option<f64>,
     /// Poubel's method: share (0–1) of the last frame's joint step that a damped level keeps
