@@ -276,18 +276,27 @@ fn apply_chain(
     let mut offset = 0;
     for (j, f) in factors.iter().enumerate() {
         let start = seg_start[j];
-        let factor = &qr[n * start..];
-        let cur = &mut coords[offset..offset + f.dim];
-        for l in 0..f.rank {
-            apply_reflector(
-                &factor[l * f.dim + l..(l + 1) * f.dim],
-                tau[start + l],
-                &mut cur[l..],
-            );
-        }
+        apply_level(
+            &qr[n * start..],
+            &tau[start..],
+            f,
+            &mut coords[offset..offset + f.dim],
+        );
         offset += f.rank;
     }
     offset
+}
+
+/// Applies the reflectors of one level `f` (its factor and `tau` from the level's start) to
+/// `cur` (its `r_{j−1}` coordinates): afterwards `cur[..k_j]` is `Q_j[:, ..k_j]ᵀ cur`.
+fn apply_level(factor: &[f64], tau: &[f64], f: &LevelFactor, cur: &mut [f64]) {
+    for l in 0..f.rank {
+        apply_reflector(
+            &factor[l * f.dim + l..(l + 1) * f.dim],
+            tau[l],
+            &mut cur[l..],
+        );
+    }
 }
 
 /// A prioritized task-stack solver: the stack, its workspace, and the last result.
@@ -685,18 +694,11 @@ impl Solver {
 
     /// Level j's range coordinates of the damping reference, `U_jᵀ q̇_ref`, into
     /// `reference_coeff`: `reference_coords[offset..]` holds `Z_{j−1}ᵀ q̇_ref` on entry and
-    /// level j's reflectors are applied to it, as [`apply_chain`] does.
+    /// level j's reflectors are applied to it ([`apply_level`]).
     fn project_reference(&mut self, j: usize, offset: usize) {
         let (n, start, f) = (self.stack.dof(), self.seg_start[j], self.factors[j]);
-        let factor = &self.qr[n * start..];
         let cur = &mut self.reference_coords[offset..offset + f.dim];
-        for l in 0..f.rank {
-            apply_reflector(
-                &factor[l * f.dim + l..(l + 1) * f.dim],
-                self.tau[start + l],
-                &mut cur[l..],
-            );
-        }
+        apply_level(&self.qr[n * start..], &self.tau[start..], &f, cur);
         self.reference_coeff[start..start + f.rank].copy_from_slice(&cur[..f.rank]);
     }
 
