@@ -225,25 +225,63 @@ fn a_closed_lift_gate_holds_the_weight_on_the_stance_foot() {
     let step = TakeOff::ComToFoot;
     // The shift runs and ends as usual, but the foot stays down while the gate is closed.
     assert_eq!(
-        m.update_gated(H::Right, false, &FAR),
+        m.update_gated(H::Right, false, &FAR, 0.01),
         P::DoubleToRight(step)
     );
     for _ in 0..3 {
         assert_eq!(
-            m.update_gated(H::Right, false, &COM_OK),
+            m.update_gated(H::Right, false, &COM_OK, 0.01),
             P::DoubleToRight(step)
         );
     }
     // Opened: the lift starts at once.
     let lift = P::DoubleToRight(TakeOff::LiftFoot);
-    assert_eq!(m.update_gated(H::Right, true, &COM_OK), lift);
+    assert_eq!(m.update_gated(H::Right, true, &COM_OK, 0.01), lift);
     // The gate only holds a take-off: a lifted foot, a landing and a recentring go on.
-    assert_eq!(m.update_gated(H::Right, false, &LIFTED), P::Right);
+    assert_eq!(m.update_gated(H::Right, false, &LIFTED, 0.01), P::Right);
     let lower = P::RightToDouble(Landing::LowerFoot);
-    assert_eq!(m.update_gated(H::Double, false, &LIFTED), lower);
+    assert_eq!(m.update_gated(H::Double, false, &LIFTED, 0.01), lower);
     let middle = P::RightToDouble(Landing::ComToMiddle);
-    assert_eq!(m.update_gated(H::Double, false, &DOWN), middle);
-    assert_eq!(m.update_gated(H::Double, false, &COM_OK), P::Double);
+    assert_eq!(m.update_gated(H::Double, false, &DOWN, 0.01), middle);
+    assert_eq!(m.update_gated(H::Double, false, &COM_OK, 0.01), P::Double);
+}
+
+#[test]
+fn a_foot_lifts_once_the_weight_shift_has_held_for_the_settle_time() {
+    // 0.05 s at 0.01 s a frame: the frame that reaches the goal counts, so the fifth frame on
+    // the goal ends the shift; a frame off the goal starts the count again.
+    let mut m = PhaseMachine::new(PhaseConfig {
+        settle_time: Some(0.05),
+        ..config()
+    })
+    .unwrap();
+    let shift = P::DoubleToRight(TakeOff::ComToFoot);
+    assert_eq!(m.update_gated(H::Right, true, &FAR, 0.01), shift);
+    for _ in 0..3 {
+        assert_eq!(m.update_gated(H::Right, true, &COM_OK, 0.01), shift);
+    }
+    assert_eq!(m.update_gated(H::Right, true, &FAR, 0.01), shift);
+    for _ in 0..4 {
+        assert_eq!(m.update_gated(H::Right, true, &COM_OK, 0.01), shift);
+    }
+    let lift = P::DoubleToRight(TakeOff::LiftFoot);
+    assert_eq!(m.update_gated(H::Right, true, &COM_OK, 0.01), lift);
+    // The landing does not wait: the weight moves back once the foot is down.
+    assert_eq!(m.update_gated(H::Right, true, &LIFTED, 0.01), P::Right);
+    let lower = P::RightToDouble(Landing::LowerFoot);
+    assert_eq!(m.update_gated(H::Double, true, &LIFTED, 0.01), lower);
+    let middle = P::RightToDouble(Landing::ComToMiddle);
+    assert_eq!(m.update_gated(H::Double, true, &DOWN, 0.01), middle);
+    // A second shift counts from zero, and `update` (a step of any length) ends it at once.
+    assert_eq!(m.update_gated(H::Double, true, &COM_OK, 0.01), P::Double);
+    assert_eq!(
+        m.update_gated(H::Left, true, &FAR, 0.01),
+        P::DoubleToLeft(TakeOff::ComToFoot)
+    );
+    assert_eq!(
+        m.update(H::Left, &COM_OK),
+        P::DoubleToLeft(TakeOff::LiftFoot)
+    );
 }
 
 #[test]
@@ -363,6 +401,20 @@ fn bad_config_is_rejected_naming_the_field() {
                 ..PhaseConfig::default()
             },
             "posture_tolerance",
+        ),
+        (
+            PhaseConfig {
+                settle_time: Some(-0.1),
+                ..PhaseConfig::default()
+            },
+            "settle_time",
+        ),
+        (
+            PhaseConfig {
+                settle_time: Some(f64::NAN),
+                ..PhaseConfig::default()
+            },
+            "settle_time",
         ),
         // ρ = 4 mm ≤ 2 × 2 mm: a foot could be "lifted" and "on the ground" at once.
         (

@@ -203,6 +203,15 @@ fn profile_errors_name_the_field() {
     assert_eq!(profile.tuning.torso_lowering, 0.03);
     let err = load(&tuned(-0.01));
     assert!(err.to_string().contains("tuning.torso_lowering"), "{err}");
+    let on_one_foot =
+        |lowering: f64| format!("{toml}\n[tuning]\nsingle_support_lowering = {lowering}\n");
+    let profile = BipedProfile::from_toml_str(&on_one_foot(0.02), &urdf).unwrap();
+    assert_eq!(profile.tuning.single_support_lowering, 0.02);
+    let err = load(&on_one_foot(-0.02));
+    assert!(
+        err.to_string().contains("tuning.single_support_lowering"),
+        "{err}"
+    );
 
     // The servos' stiffness, a key before the first table.
     let servos = |saturation: f64| format!("servo_saturation = {saturation}\n{toml}");

@@ -139,10 +139,13 @@ fn the_g1_commands_its_servo_targets_through_the_shaper() {
         env!("CARGO_MANIFEST_DIR")
     );
     let mut clip = Clip::open(path).unwrap();
-    let config = ImitatorConfig {
+    // Both wait the shaper's length before a lift (the shaped robot's default), so that only
+    // the shaping differs.
+    let mut config = ImitatorConfig {
         support: SupportConfig::for_capture(clip.capture()),
         ..ImitatorConfig::default()
     };
+    config.phase.settle_time = Some(period);
     let mut shaped = Imitator::new(profile, config.clone()).unwrap();
     let mut plain = Imitator::new(unshaped, config.clone()).unwrap();
     let n = shaped.variable_names().count();
@@ -162,5 +165,43 @@ fn the_g1_commands_its_servo_targets_through_the_shaper() {
     assert!(
         largest_lag > 0.01,
         "the shaper moved nothing: {largest_lag}"
+    );
+}
+
+/// The robot time (s) of the first frame whose phase has a foot in the air.
+fn first_lift(profile: &BipedProfile, settle_time: Option<f64>) -> f64 {
+    let path = format!(
+        "{}/tests/data/mocap/cmu_05_12_slow_dance_tendu_arms_high.bvh",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let mut clip = Clip::open(path).unwrap();
+    let mut config = ImitatorConfig {
+        support: SupportConfig::for_capture(clip.capture()),
+        ..ImitatorConfig::default()
+    };
+    config.phase.settle_time = settle_time;
+    let mut imitator = Imitator::new(profile.clone(), config).unwrap();
+    let mut frame = HumanFrame::new(0.0);
+    while clip.read_frame(&mut frame).unwrap() {
+        let out = imitator.step(&frame).unwrap();
+        if out.phase.airborne_foot().is_some() {
+            return out.time;
+        }
+    }
+    panic!("the robot never lifted a foot");
+}
+
+#[test]
+fn the_g1_lifts_a_foot_a_sway_period_after_its_weight_is_over_the_other() {
+    // Until the first lift both runs are the same frame for frame; the default (the profile's
+    // sway period) holds the finished weight shift for the shaper's length before the lift,
+    // to within a frame (the clip's frame times are rounded).
+    let profile = g1::profile();
+    let period = profile.sway_period.unwrap();
+    let waited = first_lift(&profile, None) - first_lift(&profile, Some(0.0));
+    let dt = ImitatorConfig::default().nominal_dt;
+    assert!(
+        (waited - period).abs() <= dt,
+        "waited {waited} s for a sway period of {period} s"
     );
 }

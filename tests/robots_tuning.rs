@@ -84,6 +84,15 @@ fn the_scaling_rules_keep_the_invariants_they_state() {
         b.torso_lowering / to.hip_height,
         a.torso_lowering / from.hip_height
     );
+    // The NAO rises on one foot (0): a robot that does not keeps the same fraction of the leg.
+    let low = MotionTuning {
+        single_support_lowering: 0.01,
+        ..a
+    };
+    assert_relative_eq!(
+        low.scaled(&from, &to).single_support_lowering / to.hip_height,
+        0.01 / from.hip_height
+    );
     assert_relative_eq!(
         b.tracking_speed / to.arm_length,
         a.tracking_speed / from.arm_length

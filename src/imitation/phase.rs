@@ -28,6 +28,15 @@
 //! condition is not met is repeated at the next update. A NaN measurement never meets a
 //! condition, so it never ends a step.
 //!
+//! The weight shift onto the support foot ("CoM to RFoot") ends only once its condition has held
+//! for [`PhaseConfig::settle_time`] (0 unless the robot's servo commands are shaped): a robot
+//! whose commands reach it through the sway shaper ([`crate::robots::sway`]) follows the plan up
+//! to the shaper's length later, so the plan's CoM must have been over the support foot that long
+//! before the foot lifts. A plan held still for the shaper's length is exactly what the shaped
+//! command has reached, so this wait is not a guess. A landing does not wait: the weight moving
+//! back while the shaped foot still comes down loads it as soon as it touches (with the same wait
+//! after the landing, the G1 bounced off its landing foot on CMU 131_01 and rolled off the other).
+//!
 //! # Transition graph
 //!
 //! The input is the human's support `h`; [`HumanSupport::Airborne`] is replaced by the last
@@ -335,11 +344,19 @@ pub struct PhaseConfig {
     /// then the stance hip's roll servo holds the upper body out to the side (on a small robot
     /// beyond its torque limit when the servos are weak). Default 0.03 rad.
     pub posture_tolerance: f64,
+    /// How long (s) the end of a weight shift onto the support foot must have held before the
+    /// foot lifts (module docs). `None` (default): the profile's sway period
+    /// ([`BipedProfile::sway_period`](crate::robots::BipedProfile::sway_period)), the length
+    /// of the shaper its servo commands are played through, or 0 when they are not shaped (the
+    /// NAO). Measured on the G1 (CMU 07_04): without the wait its right foot left the floor
+    /// while the shaped command still held its CoM 21 mm inside the plan's, on the edge of the
+    /// left sole, and it rolled off that foot.
+    pub settle_time: Option<f64>,
 }
 
 impl Default for PhaseConfig {
     /// The paper's λ = 15 mm and ρ = 30 mm, with a 5 mm CoM and a 1 µm foot height tolerance,
-    /// the profile's support margin and a 0.03 rad posture tolerance.
+    /// the profile's support margin and settle time and a 0.03 rad posture tolerance.
     fn default() -> Self {
         Self {
             com_tolerance: 0.005,
@@ -348,13 +365,15 @@ impl Default for PhaseConfig {
             foot_height_tolerance: 0.000001,
             support_margin: None,
             posture_tolerance: 0.03,
+            settle_time: None,
         }
     }
 }
 
 impl PhaseConfig {
-    /// Checks every field: tolerances finite and > 0, λ finite and ≥ 0, ρ finite and more than
-    /// twice the foot height tolerance (so a lifted foot is never also "on the ground").
+    /// Checks every field: tolerances finite and > 0, λ, the support margin and the settle time
+    /// finite and ≥ 0, ρ finite and more than twice the foot height tolerance (so a lifted foot
+    /// is never also "on the ground").
     pub fn validate(&self) -> Result<(), PhaseError> {
         let positive = |v: f64| v.is_finite() && v > 0.0;
         if !positive(self.com_tolerance) {
@@ -377,6 +396,9 @@ impl PhaseConfig {
                 "support_margin",
                 "must be finite and ≥ 0",
             ));
+        }
+        if (self.settle_time).is_some_and(|t| !(t.is_finite() && t >= 0.0)) {
+            return Err(PhaseError::Config("settle_time", "must be finite and ≥ 0"));
         }
         if !positive(self.foot_height_tolerance) {
             return Err(PhaseError::Config(
@@ -494,6 +516,8 @@ pub struct PhaseMachine {
     config: PhaseConfig,
     phase: SupportPhase,
     human: HumanSupport,
+    /// How long (s) the weight shift's end condition has held without a break.
+    held: f64,
 }
 
 impl PhaseMachine {
@@ -504,6 +528,7 @@ impl PhaseMachine {
             config,
             phase: SupportPhase::Double,
             human: HumanSupport::Double,
+            held: 0.0,
         })
     }
 
@@ -524,25 +549,38 @@ impl PhaseMachine {
 
     /// Advances by one time step: `human` is the human's support in the new frame, `measured`
     /// what the robot achieved at the last solve (in the current phase). Returns the new phase.
+    /// The step is taken as long enough for any [`PhaseConfig::settle_time`].
     pub fn update(&mut self, human: HumanSupport, measured: &Measurements) -> SupportPhase {
-        self.update_gated(human, true, measured)
+        self.update_gated(human, true, measured, f64::INFINITY)
     }
 
-    /// [`PhaseMachine::update`], with the swing foot allowed to leave the ground only if `lift`:
-    /// otherwise a finished "CoM to foot" step waits with the weight on the support foot (the
-    /// robot shifts its weight ahead of a human lift-off it knows is coming,
-    /// [`super::look_ahead`]).
+    /// [`PhaseMachine::update`] after `dt` seconds, with the swing foot allowed to leave the
+    /// ground only if `lift`: otherwise a finished "CoM to foot" step waits with the weight on
+    /// the support foot (the robot shifts its weight ahead of a human lift-off it knows is
+    /// coming, [`super::look_ahead`]). A weight shift ends once its condition has held for
+    /// [`PhaseConfig::settle_time`] (counting this `dt`).
     pub fn update_gated(
         &mut self,
         human: HumanSupport,
         lift: bool,
         measured: &Measurements,
+        dt: f64,
     ) -> SupportPhase {
         if human != HumanSupport::Airborne {
             self.human = human;
         }
-        let done = Done::new(measured, &self.config, lift);
-        self.phase = next_phase(self.phase, self.human, &done);
+        let mut done = Done::new(measured, &self.config, lift);
+        if let SupportPhase::DoubleToRight(TakeOff::ComToFoot)
+        | SupportPhase::DoubleToLeft(TakeOff::ComToFoot) = self.phase
+        {
+            self.held = if done.com { self.held + dt } else { 0.0 };
+            done.com &= self.held >= self.config.settle_time.unwrap_or(0.0);
+        }
+        let next = next_phase(self.phase, self.human, &done);
+        if next != self.phase {
+            self.held = 0.0;
+        }
+        self.phase = next;
         self.phase
     }
 }

@@ -31,7 +31,9 @@ use super::footsteps::{FootstepPlanner, GroundPose, StepRequest};
 use super::hand_support::{HandSupports, HandView, hand_point};
 use super::imitator::{Shared, effector_ids, ground_pose, human_stance, velocity_bounds};
 use super::metrics::CONTACT_HEIGHT;
-use super::phase::{Measurements, PhaseMachine, Settling, SupportKind, SupportPhase, TakeOff};
+use super::phase::{
+    Measurements, PhaseConfig, PhaseMachine, Settling, SupportKind, SupportPhase, TakeOff,
+};
 use super::phase_solver::{Criteria, FrameTargets, PhaseSolver};
 use super::reach::Arm;
 use super::scaler::{RobotSkeleton, ScaleConfig, Scaler};
@@ -198,6 +200,7 @@ impl PoubelImitator {
         let angles = profile.joint_angles.map(|build| build(model)).transpose()?;
         let effectors = effector_ids(profile)?;
         let tuning = profile.tuning;
+        let sway_period = profile.sway_period;
         let motion = config.motion_for(&tuning);
         let area = config.step_envelope.unwrap_or(profile.step_envelope);
         let scale = ScaleConfig {
@@ -245,7 +248,10 @@ impl PoubelImitator {
             detector: SupportDetector::new(config.support)?,
             scaler,
             angles,
-            machine: PhaseMachine::new(config.phase)?,
+            machine: PhaseMachine::new(PhaseConfig {
+                settle_time: (config.phase.settle_time).or(sway_period),
+                ..config.phase
+            })?,
             limits: JointLimitAvoidance::new(&position_bounds),
             tracking,
             stance,
@@ -362,7 +368,8 @@ impl PoubelImitator {
         wanted: StepRequest,
         dt: f64,
     ) -> Result<(), ImitationError> {
-        let phase = (self.machine).update_gated(wanted.support, wanted.lift, &self.measurements);
+        let phase =
+            (self.machine).update_gated(wanted.support, wanted.lift, &self.measurements, dt);
         let changed = phase != self.phase || self.shared.previous_time.is_none() || self.rehold;
         self.rehold = false;
         self.shared

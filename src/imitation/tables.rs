@@ -512,17 +512,18 @@ fn foot_frames(profile: &BipedProfile, foot: Side) -> [&str; 3] {
 
 /// How far below standing the executable tables carry the torso in `phase` (m): the profile's
 /// [`MotionTuning::torso_lowering`](crate::robots::MotionTuning::torso_lowering) while the free
-/// leg has to reach the ground (both feet down, and while a foot is lowered), none while a foot
-/// is lifted or up. Then the stance knee bears the whole weight, and the straighter it is the
-/// less torque it needs: lowered, the NAO's stance knee bent to 1.2 rad, and on the judge's weak
-/// model it spent ten times as long at its torque limit (CMU 05_02: 0.31 % against 0.02 %) and
-/// buckled on every walk.
+/// leg has to reach the ground (both feet down, and while a foot is lowered), its
+/// [`MotionTuning::single_support_lowering`](crate::robots::MotionTuning::single_support_lowering)
+/// while a foot is lifted or up. Then the stance knee bears the whole weight, and the straighter
+/// it is the less torque it needs: lowered, the NAO's stance knee bent to 1.2 rad, and on the
+/// judge's weak model it spent ten times as long at its torque limit (CMU 05_02: 0.31 % against
+/// 0.02 %) and buckled on every walk, so the NAO rises on one foot.
 fn torso_lowering(phase: SupportPhase, profile: &BipedProfile) -> f64 {
     match phase {
         SupportPhase::Right
         | SupportPhase::Left
         | SupportPhase::DoubleToRight(TakeOff::LiftFoot)
-        | SupportPhase::DoubleToLeft(TakeOff::LiftFoot) => 0.0,
+        | SupportPhase::DoubleToLeft(TakeOff::LiftFoot) => profile.tuning.single_support_lowering,
         _ => profile.tuning.torso_lowering,
     }
 }

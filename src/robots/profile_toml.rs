@@ -53,6 +53,7 @@
 //! tracking_acceleration = 2.0        # m/s², the hands' change of speed
 //! upper_body_velocity_fraction = 0.5
 //! torso_lowering = 0.02              # m, the torso below its standing height
+//! single_support_lowering = 0.0      # m, the same while a foot is lifted or up
 //! torso_lean = 0.25                  # rad, over the stance foot
 //! support_margin = 0.015             # m, CoM goal from the sole's inner edge
 //! com_speed = 0.05                   # m/s, the CoM reference
@@ -110,6 +111,7 @@ struct Tuning {
     tracking_acceleration: Option<f64>,
     upper_body_velocity_fraction: Option<f64>,
     torso_lowering: Option<f64>,
+    single_support_lowering: Option<f64>,
     torso_lean: Option<f64>,
     support_margin: Option<f64>,
     com_speed: Option<f64>,
@@ -348,6 +350,8 @@ fn tuning(file: Option<Tuning>, scaled: MotionTuning) -> MotionTuning {
         upper_body_velocity_fraction: (t.upper_body_velocity_fraction)
             .unwrap_or(scaled.upper_body_velocity_fraction),
         torso_lowering: t.torso_lowering.unwrap_or(scaled.torso_lowering),
+        single_support_lowering: (t.single_support_lowering)
+            .unwrap_or(scaled.single_support_lowering),
         torso_lean: t.torso_lean.unwrap_or(scaled.torso_lean),
         support_margin: t.support_margin.unwrap_or(scaled.support_margin),
         com_speed: t.com_speed.unwrap_or(scaled.com_speed),

@@ -19,7 +19,7 @@
 //! | `offset_acceleration` | `× w h / (w' h')` | the CoM acceleration it gives, as `com_acceleration` |
 //! | `torso_lean` | `× atan(w'/h') / atan(w/h)` | the same multiple of the angle under which the stance hip is seen from the CoM |
 //! | `support_margin` | `× s'/s` | the same fraction of the sole's width |
-//! | `torso_lowering` | `× l'/l` | the same fraction of the leg |
+//! | `torso_lowering`, `single_support_lowering` | `× l'/l` | the same fraction of the leg |
 //! | `tracking_speed`, `stance_tracking_speed` | `× a'/a` | the hands cover the same fraction of the arm per second |
 //! | `tracking_acceleration` | `× a'/a` | the hands' speed changes by the same fraction of the arm per second, per second |
 //! | `upper_body_velocity_fraction` | `× ω/ω'`, at most its value | the same joint speeds (rad/s) on faster motors |
@@ -58,6 +58,13 @@ pub struct MotionTuning {
     /// starting in its standing posture is lowered along a ramp of `√(6 d / com_acceleration)`
     /// seconds (`imitation::shaping::StartRamp`).
     pub torso_lowering: f64,
+    /// How far below its standing height the executable task tables keep the torso while a
+    /// foot is lifted or up (m, ≥ 0; at most `torso_lowering` makes sense). A straighter stance
+    /// knee needs less torque, so a robot whose knees are weak for its weight rises on one foot
+    /// (the NAO: 0); one that rises by its whole lowering as it lifts a foot moves its CoM
+    /// up and down by that much within a step, and a robot on stiff servos sways from it (the
+    /// G1 stays lowered, [`crate::robots::g1::TUNING`]).
+    pub single_support_lowering: f64,
     /// Sideways lean of the torso over the foot the robot stands or is about to stand on in the
     /// executable tables (rad, ≥ 0). With an upright pelvis the stance hip ends up outside the
     /// CoM and its roll servo holds the whole upper body out to the side; leaning brings the
@@ -111,6 +118,7 @@ impl MotionTuning {
         ];
         let non_negative = [
             ("torso_lowering", self.torso_lowering),
+            ("single_support_lowering", self.single_support_lowering),
             ("torso_lean", self.torso_lean),
             ("support_margin", self.support_margin),
         ];
@@ -144,6 +152,7 @@ impl MotionTuning {
                 / to.upper_body_speed)
                 .min(self.upper_body_velocity_fraction),
             torso_lowering: self.torso_lowering * to.hip_height / from.hip_height,
+            single_support_lowering: self.single_support_lowering * to.hip_height / from.hip_height,
             torso_lean: self.torso_lean * stance_angle(to) / stance_angle(from),
             support_margin: self.support_margin * to.sole_width / from.sole_width,
             com_speed: self.com_speed * froude,
