@@ -134,18 +134,9 @@ fn the_g1_commands_its_servo_targets_through_the_shaper() {
         sway_period: None,
         ..profile.clone()
     };
-    let path = format!(
-        "{}/tests/data/mocap/cmu_05_12_slow_dance_tendu_arms_high.bvh",
-        env!("CARGO_MANIFEST_DIR")
-    );
-    let mut clip = Clip::open(path).unwrap();
     // Both wait the shaper's length before a lift (the shaped robot's default), so that only
     // the shaping differs.
-    let mut config = ImitatorConfig {
-        support: SupportConfig::for_capture(clip.capture()),
-        ..ImitatorConfig::default()
-    };
-    config.phase.settle_time = Some(period);
+    let (mut clip, config) = slow_dance(Some(period));
     let mut shaped = Imitator::new(profile, config.clone()).unwrap();
     let mut plain = Imitator::new(unshaped, config.clone()).unwrap();
     let n = shaped.variable_names().count();
@@ -168,18 +159,25 @@ fn the_g1_commands_its_servo_targets_through_the_shaper() {
     );
 }
 
-/// The robot time (s) of the first frame whose phase has a foot in the air.
-fn first_lift(profile: &BipedProfile, settle_time: Option<f64>) -> f64 {
+/// CMU 05_12 (a slow dance with single supports) and the default settings for it, with the
+/// weight shift's `settle_time`.
+fn slow_dance(settle_time: Option<f64>) -> (Clip, ImitatorConfig) {
     let path = format!(
         "{}/tests/data/mocap/cmu_05_12_slow_dance_tendu_arms_high.bvh",
         env!("CARGO_MANIFEST_DIR")
     );
-    let mut clip = Clip::open(path).unwrap();
+    let clip = Clip::open(path).unwrap();
     let mut config = ImitatorConfig {
         support: SupportConfig::for_capture(clip.capture()),
         ..ImitatorConfig::default()
     };
     config.phase.settle_time = settle_time;
+    (clip, config)
+}
+
+/// The robot time (s) of the first frame whose phase has a foot in the air.
+fn first_lift(profile: &BipedProfile, settle_time: Option<f64>) -> f64 {
+    let (mut clip, config) = slow_dance(settle_time);
     let mut imitator = Imitator::new(profile.clone(), config).unwrap();
     let mut frame = HumanFrame::new(0.0);
     while clip.read_frame(&mut frame).unwrap() {
