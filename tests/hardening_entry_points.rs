@@ -400,7 +400,7 @@ fn koenemann_config_out_of_range_is_refused_by_name() {
 fn imitator_config_out_of_range_is_refused_by_name() {
     type Set = fn(&mut ImitatorConfig, f64);
     let fields: [(&str, Set); 10] = [
-        ("velocity_fraction", |c, v| c.velocity_fraction = v),
+        ("velocity_fraction", |c, v| c.velocity_fraction = Some(v)),
         ("nominal_dt", |c, v| c.nominal_dt = v),
         ("max_task_speed", |c, v| c.max_task_speed = Some(v)),
         ("max_tracking_speed", |c, v| c.max_tracking_speed = Some(v)),

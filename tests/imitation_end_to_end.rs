@@ -390,7 +390,7 @@ fn other_clips_keep_the_invariants() {
 #[test]
 fn a_walk_at_full_speed_keeps_the_invariants() {
     let config = ImitatorConfig {
-        velocity_fraction: 1.0,
+        velocity_fraction: Some(1.0),
         upper_body_velocity_fraction: Some(1.0),
         max_task_speed: Some(1.0),
         iterations_per_frame: 2,

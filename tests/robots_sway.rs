@@ -2,8 +2,11 @@
 //! period still. Checked on an oscillator integrated here (`ẍ = ω² (u − x) − 2ζω ẋ`, the sway
 //! mode driven by the command `u`), not against the shaper's own weights.
 
-use taskstack::human::HumanFrame;
+use nalgebra::Vector3;
+use taskstack::human::{HumanFrame, HumanJoint};
+use taskstack::imitation::config::ImitationMethod;
 use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
+use taskstack::imitation::koenemann::KoenemannConfig;
 use taskstack::imitation::support::SupportConfig;
 use taskstack::io::clip::Clip;
 use taskstack::robots::sway::{SWAY_DAMPING, SwayError, SwayShaper};
@@ -200,6 +203,53 @@ fn the_g1_lifts_a_foot_a_sway_period_after_its_weight_is_over_the_other() {
     let dt = ImitatorConfig::default().nominal_dt;
     assert!(
         (waited - period).abs() <= dt,
+        "waited {waited} s for a sway period of {period} s"
+    );
+}
+
+/// The robot time (s) of the first frame with a foot in the air, Koenemann's method on the G1
+/// with the weight shift's `settle_time`, for a human who stands still on both feet for 1 s
+/// (the first frame of CMU 05_02) and then holds the right foot 15 cm up for 5 s.
+fn first_koenemann_lift(settle_time: Option<f64>) -> f64 {
+    let path = format!(
+        "{}/tests/data/mocap/cmu_05_02_stand_arm_gestures_turn_single_leg.bvh",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let mut clip = Clip::open(path).unwrap();
+    let config = ImitatorConfig {
+        support: SupportConfig::for_capture(clip.capture()),
+        method: ImitationMethod::Koenemann(KoenemannConfig {
+            settle_time,
+            ..KoenemannConfig::default()
+        }),
+        ..ImitatorConfig::default()
+    };
+    let mut standing = HumanFrame::new(0.0);
+    assert!(clip.read_frame(&mut standing).unwrap());
+    let mut imitator = Imitator::new(g1::profile(), config).unwrap();
+    for k in 0..720 {
+        let mut frame = standing;
+        frame.time = k as f64 * DT;
+        if frame.time >= 1.0 {
+            for joint in [HumanJoint::RAnkle, HumanJoint::RToe] {
+                let lifted = frame.get(joint).map(|p| p + Vector3::z() * 0.15);
+                frame.set(joint, lifted);
+            }
+        }
+        let out = imitator.step(&frame).unwrap();
+        if out.phase.airborne_foot().is_some() {
+            return out.time;
+        }
+    }
+    panic!("the robot never lifted a foot");
+}
+
+#[test]
+fn the_g1_on_koenemanns_method_also_waits_a_sway_period_before_a_lift() {
+    let period = g1::profile().sway_period.unwrap();
+    let waited = first_koenemann_lift(None) - first_koenemann_lift(Some(0.0));
+    assert!(
+        (waited - period).abs() <= DT,
         "waited {waited} s for a sway period of {period} s"
     );
 }

@@ -28,6 +28,7 @@ fn the_nao_sizes_match_its_dimensions_and_the_stored_constant() {
         (size.sole_width, stored.sole_width, 5e-5),
         (size.arm_length, stored.arm_length, 5e-5),
         (size.upper_body_speed, stored.upper_body_speed, 5e-3),
+        (size.leg_speed, stored.leg_speed, 5e-3),
     ] {
         assert_relative_eq!(got, kept, epsilon = tolerance);
     }
@@ -108,6 +109,13 @@ fn the_scaling_rules_keep_the_invariants_they_state() {
     assert_relative_eq!(b.damping / to.arm_length, a.damping / from.arm_length);
     // Faster motors: the same joint speeds, never a larger fraction.
     assert!(b.upper_body_velocity_fraction <= a.upper_body_velocity_fraction);
+    // The legs: joint speeds (fraction × rated) in the ratio √(h/h') of a motion of the same
+    // shape at the same Froude number.
+    assert_relative_eq!(
+        b.leg_velocity_fraction * to.leg_speed / (a.leg_velocity_fraction * from.leg_speed),
+        (from.com_height / to.com_height).sqrt(),
+        max_relative = 1e-12
+    );
     // A robot of the same size keeps its values.
     assert_eq!(a.scaled(&from, &from), a);
 }
@@ -120,8 +128,15 @@ fn the_rules_give_the_g1_what_was_tuned_on_it_independently() {
     // not): the rules land within 10 % of both.
     let g1 = g1::profile().size().unwrap();
     let rules = nao::TUNING.scaled(&nao::SIZE, &g1);
-    // The G1's damping is the rules' value, rounded to 1 mm/rad.
+    // The G1's damping is the rules' value, rounded to 1 mm/rad; its legs' fraction in
+    // Koenemann's method too, rounded to 0.001 (by hand: 0.1 × 5.38 / 27.33 rad/s of the
+    // NAO's and the G1's mean leg ratings, × √(0.2725 / 0.6902 m) = 0.0124).
     assert!((rules.damping - g1::TUNING.damping).abs() < 5e-4);
+    assert!((rules.leg_velocity_fraction - g1::TUNING.leg_velocity_fraction).abs() < 5e-4);
+    assert!(
+        (g1::TUNING.leg_velocity_fraction - 0.1 * 5.38 / 27.33 * (0.2725f64 / 0.6902).sqrt()).abs()
+            < 5e-4
+    );
     let unshaped = MotionTuning {
         stance_tracking_speed: 0.15,
         ..nao::TUNING

@@ -76,10 +76,11 @@ pub(crate) struct ImitationOptions {
     #[arg(long, value_name = "auto|SECONDS", default_value = "auto", value_parser = hold,
           allow_negative_numbers = true)]
     pub(crate) hold: Hold,
-    /// Share of each joint's rated velocity the legs may use (0 < F ≤ 1; Poubel et al. use 0.1).
-    #[arg(long, value_name = "F", default_value_t = 0.1, value_parser = fraction,
-          allow_negative_numbers = true)]
-    pub(crate) velocity_fraction: f64,
+    /// Share of each joint's rated velocity the legs may use (0 < F ≤ 1). Default: 0.1 with
+    /// Poubel et al.'s method (the paper's), the robot profile's with Koenemann et al.'s,
+    /// whose legs copy the human's (NAO 0.1, G1 0.012).
+    #[arg(long, value_name = "F", value_parser = fraction, allow_negative_numbers = true)]
+    pub(crate) velocity_fraction: Option<f64>,
     /// Share of the rated velocity the arms, head and torso may use (0 < F ≤ 1). Default: the
     /// robot profile's (NAO 0.5, G1 0.1).
     #[arg(long, value_name = "F", value_parser = fraction, allow_negative_numbers = true)]

@@ -43,7 +43,7 @@ pub(crate) struct Settings {
     zmp_balance: bool,
     damping: Option<f64>,
     damping_momentum: f64,
-    velocity_fraction: f64,
+    velocity_fraction: Option<f64>,
     upper_body_fraction: Option<f64>,
     task_speed: Option<f64>,
     tracking_speed: Option<f64>,
@@ -66,7 +66,7 @@ impl Settings {
             zmp_balance: false,
             damping: None,
             damping_momentum: 0.0,
-            velocity_fraction: 0.1,
+            velocity_fraction: None,
             upper_body_fraction: None,
             task_speed: None,
             tracking_speed: None,
@@ -176,7 +176,9 @@ impl Settings {
         }
         let mut config = ImitatorConfig {
             method,
-            velocity_fraction: fraction("velocity_fraction", self.velocity_fraction)?,
+            velocity_fraction: (self.velocity_fraction)
+                .map(|f| fraction("velocity_fraction", f))
+                .transpose()?,
             upper_body_velocity_fraction: (self.upper_body_fraction)
                 .map(|f| fraction("upper_body_fraction", f))
                 .transpose()?,

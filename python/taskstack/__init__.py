@@ -94,7 +94,7 @@ def imitate_clip(
     damping: Optional[float] = None,
     damping_momentum: float = 0.0,
     offline: bool = False,
-    velocity_fraction: float = 0.1,
+    velocity_fraction: Optional[float] = None,
     upper_body_fraction: Optional[float] = None,
     task_speed: Optional[float] = None,
     tracking_speed: Optional[float] = None,
@@ -127,7 +127,9 @@ def imitate_clip(
         damping_momentum: share in [0, 1] of the last frame's joint step a damped level
             keeps instead of coming to rest (the CLI's ``--damping-momentum``; default 0).
         offline: read the whole clip first and time weight shifts ahead of the human.
-        velocity_fraction: share of the rated joint velocity the legs may use, in (0, 1].
+        velocity_fraction: share of the rated joint velocity the legs may use, in (0, 1]
+            (default: 0.1 with Poubel's method, the robot's with Koenemann's: NAO 0.1,
+            G1 0.012).
         upper_body_fraction: the same for arms, head and torso (default: the robot's).
         task_speed: fastest CoM and foot target speed (m/s; default: the robot's).
         tracking_speed: fastest hand target speed (m/s; default: the robot's).

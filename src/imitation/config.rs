@@ -46,10 +46,14 @@ pub struct ImitatorConfig {
     /// with the feet held fully while they stand, the CoM at the middle of the contact area and
     /// an upright torso.
     pub tables: Option<TaskTables>,
-    /// Fraction of each leg joint's rated velocity the robot may use (paper: 0.1): the joints
-    /// on the chain between the two soles, which carry the robot and close a loop in double
-    /// support.
-    pub velocity_fraction: f64,
+    /// Fraction of each leg joint's rated velocity the robot may use: the joints on the chain
+    /// between the two soles, which carry the robot and close a loop in double support.
+    /// `None` (default): [`PAPER_VELOCITY_FRACTION`] in Poubel et al.'s method, whose tasks
+    /// bound the legs by the CoM's and the feet's speeds; the profile's
+    /// [`MotionTuning::leg_velocity_fraction`] in Koenemann et al.'s, whose legs copy the
+    /// human's and are slowed by this bound alone (the G1's legs at 10 % of its fast motors
+    /// bobbed its 35 kg up and down at the human's pace and fell on 8 of 16 judge runs).
+    pub velocity_fraction: Option<f64>,
     /// Fraction of the rated velocity of every joint off the sole-to-sole chain (arms, head);
     /// `None` (default): the profile's [`MotionTuning::upper_body_velocity_fraction`](crate::robots::MotionTuning::upper_body_velocity_fraction) (0.5 for
     /// the NAO: the arms follow the human closely while the legs keep the paper's 10 %; the
@@ -161,7 +165,7 @@ impl Default for ImitatorConfig {
             min_segment: 1e-9,
             tables: None,
             phase: PhaseConfig::default(),
-            velocity_fraction: 0.1,
+            velocity_fraction: None,
             upper_body_velocity_fraction: None,
             walking_velocity_fraction: 1.0,
             motion: None,
@@ -182,7 +186,19 @@ impl Default for ImitatorConfig {
     }
 }
 
+/// Poubel et al.'s fraction of each leg joint's rated velocity (§IV: 10 %).
+pub const PAPER_VELOCITY_FRACTION: f64 = 0.1;
+
 impl ImitatorConfig {
+    /// [`ImitatorConfig::velocity_fraction`], or the method's default for a robot of `tuning`.
+    pub(super) fn velocity_fraction_for(&self, tuning: &MotionTuning) -> f64 {
+        match (self.velocity_fraction, &self.method) {
+            (Some(fraction), _) => fraction,
+            (None, ImitationMethod::Koenemann(_)) => tuning.leg_velocity_fraction,
+            (None, _) => PAPER_VELOCITY_FRACTION,
+        }
+    }
+
     /// `solver` with the damping of [`ImitatorConfig::damping`], or `tuning`'s.
     pub(super) fn solver_for(&self, tuning: &MotionTuning) -> Settings {
         let damping = self.damping.unwrap_or(tuning.damping);
@@ -229,7 +245,7 @@ impl ImitatorConfig {
         let positive = [
             (
                 "velocity_fraction",
-                Some(self.velocity_fraction),
+                self.velocity_fraction,
                 "must be finite and > 0",
             ),
             (

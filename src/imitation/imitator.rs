@@ -186,11 +186,12 @@ impl Shared {
         let legs = profile.sole_chain_variables(&q)?;
         let upper_body = (config.upper_body_velocity_fraction)
             .unwrap_or(profile.tuning.upper_body_velocity_fraction);
+        let velocity_fraction = config.velocity_fraction_for(&profile.tuning);
         let bounds = velocity_bounds(
             model,
             &position_bounds,
             &legs,
-            config.velocity_fraction,
+            velocity_fraction,
             upper_body,
         )?;
         let mut data = profile.models.each_ref().map(Model::new_data);
@@ -213,7 +214,7 @@ impl Shared {
             world_t_root: IsometryMatrix3::identity(),
             bounds,
             legs,
-            velocity_fraction: config.velocity_fraction,
+            velocity_fraction,
             nominal_dt: config.nominal_dt,
             previous_time: None,
             paused: 0.0,

@@ -153,6 +153,13 @@ pub const STAND: [f64; 29] = [
 /// step, and the judge's G1 rocked on its stance foot (hold 60, every bundled clip, both models,
 /// with the weight shift's wait of [`SWAY_PERIOD`]: 11 of 16 runs pass rising, 15 lowered).
 ///
+/// Koenemann's legs move at the rules' 1.2 % of their rated speed (0.1 × 5.38 / 27.33 rad/s,
+/// the NAO's and the G1's mean leg ratings, × √(0.27 / 0.69 m), their CoM heights): the same
+/// joint speeds at the same Froude number. At the NAO's 10 % the G1's legs copied the human's
+/// knee bends and pelvis turns at up to 2.6 rad/s (hip yaw, CMU 02_10) and 8 of 16 judge runs
+/// fell (hold 60, every bundled clip, both models); at the rules' value 3 (with the weight
+/// shift's wait of [`SWAY_PERIOD`] before a lift, `KoenemannConfig::settle_time`).
+///
 /// The solver's damping is the rules' 0.039 m/rad (the NAO's 0.02 × the arm lengths' ratio,
 /// 0.375 / 0.191 m): at the NAO's value the G1's arms and waist reversed at speed on 285 of
 /// 3 099 frames of CMU 09_12 (hold 0), at this one on 2, the hands as near.
@@ -162,6 +169,7 @@ pub const TUNING: MotionTuning = MotionTuning {
     stance_tracking_speed: 0.3,
     tracking_acceleration: 100.0,
     upper_body_velocity_fraction: 0.1,
+    leg_velocity_fraction: 0.012,
     torso_lowering: 0.05,
     single_support_lowering: 0.05,
     torso_lean: 0.25,

@@ -52,6 +52,7 @@
 //! stance_tracking_speed = 0.3        # m/s, the hands on one foot and while the weight shifts
 //! tracking_acceleration = 2.0        # m/s², the hands' change of speed
 //! upper_body_velocity_fraction = 0.5
+//! leg_velocity_fraction = 0.1        # Koenemann's legs, of their rated speed
 //! torso_lowering = 0.02              # m, the torso below its standing height
 //! single_support_lowering = 0.0      # m, the same while a foot is lifted or up
 //! torso_lean = 0.25                  # rad, over the stance foot
@@ -110,6 +111,7 @@ struct Tuning {
     stance_tracking_speed: Option<f64>,
     tracking_acceleration: Option<f64>,
     upper_body_velocity_fraction: Option<f64>,
+    leg_velocity_fraction: Option<f64>,
     torso_lowering: Option<f64>,
     single_support_lowering: Option<f64>,
     torso_lean: Option<f64>,
@@ -349,6 +351,7 @@ fn tuning(file: Option<Tuning>, scaled: MotionTuning) -> MotionTuning {
         tracking_acceleration: (t.tracking_acceleration).unwrap_or(scaled.tracking_acceleration),
         upper_body_velocity_fraction: (t.upper_body_velocity_fraction)
             .unwrap_or(scaled.upper_body_velocity_fraction),
+        leg_velocity_fraction: (t.leg_velocity_fraction).unwrap_or(scaled.leg_velocity_fraction),
         torso_lowering: t.torso_lowering.unwrap_or(scaled.torso_lowering),
         single_support_lowering: (t.single_support_lowering)
             .unwrap_or(scaled.single_support_lowering),

@@ -56,7 +56,8 @@ impl BipedProfile {
             hip_height: 0.5 * (left_hip.z + right_hip.z),
             sole_width: 0.5 * (widths[0] + widths[1]),
             arm_length: (hand - shoulder).norm(),
-            upper_body_speed: upper_body_speed(profile)?,
+            upper_body_speed: mean_speed(profile, false)?,
+            leg_speed: mean_speed(profile, true)?,
         };
         checked(size)
     }
@@ -71,6 +72,7 @@ fn checked(size: BipedSize) -> Result<BipedSize, ProfileError> {
         ("sole_width", size.sole_width),
         ("arm_length", size.arm_length),
         ("upper_body_speed", size.upper_body_speed),
+        ("leg_speed", size.leg_speed),
     ];
     match sizes
         .into_iter()
@@ -84,9 +86,9 @@ fn checked(size: BipedSize) -> Result<BipedSize, ProfileError> {
     }
 }
 
-/// Mean rated speed (rad/s) of the variables off the sole-to-sole chain, or of all of them
-/// when every variable is on it.
-fn upper_body_speed(profile: &BipedProfile) -> Result<f64, ProfileError> {
+/// Mean rated speed (rad/s) of the variables on the sole-to-sole chain (`legs`) or off it, or
+/// of all of them when none is on that side.
+fn mean_speed(profile: &BipedProfile, legs: bool) -> Result<f64, ProfileError> {
     let chain = profile.sole_chain_variables(&profile.stand)?;
     let variables = profile.model(Side::Left).variables();
     let mean = |pick: &dyn Fn(usize) -> bool| {
@@ -96,7 +98,7 @@ fn upper_body_speed(profile: &BipedProfile) -> Result<f64, ProfileError> {
             .collect();
         (!speeds.is_empty()).then(|| speeds.iter().sum::<f64>() / speeds.len() as f64)
     };
-    Ok(mean(&|i| !chain[i])
+    Ok(mean(&|i| chain[i] == legs)
         .or_else(|| mean(&|_| true))
         .unwrap_or(0.0))
 }

@@ -9,7 +9,7 @@
 //! them scaled by the length that decides each one, with the sizes of [`BipedSize`] read off
 //! its profile in the standing posture (`h` the CoM height, `w` half the hip spacing, `l` the
 //! hip height, `s` the sole's contact width, `a` the arm length, `ω` the upper body's mean
-//! rated joint speed; primes for the new robot):
+//! rated joint speed, `ω_l` the legs'; primes for the new robot):
 //!
 //! | value | rule | why |
 //! |---|---|---|
@@ -23,6 +23,7 @@
 //! | `tracking_speed`, `stance_tracking_speed` | `× a'/a` | the hands cover the same fraction of the arm per second |
 //! | `tracking_acceleration` | `× a'/a` | the hands' speed changes by the same fraction of the arm per second, per second |
 //! | `upper_body_velocity_fraction` | `× ω/ω'`, at most its value | the same joint speeds (rad/s) on faster motors |
+//! | `leg_velocity_fraction` | `× (ω_l/ω_l') √(h/h')`, at most its value | the same Froude number: a leg motion of the same shape takes `√(h'/h)` times as long, so its joints turn `√(h/h')` times as fast |
 //! | `damping` | `× a'/a` | a hand's Jacobian (m/rad) scales with the arm: the same near-singular poses damped |
 //!
 //! The rules keep geometric and dynamic similarity; what they cannot see (servo stiffness, the
@@ -51,6 +52,11 @@ pub struct MotionTuning {
     /// Fraction of the rated velocity of every joint off the sole-to-sole chain (arms, head);
     /// the legs keep the imitator's `velocity_fraction`.
     pub upper_body_velocity_fraction: f64,
+    /// Fraction of the rated velocity of the legs' joints (the sole-to-sole chain) in
+    /// Koenemann et al.'s method, whose legs copy the human's at the human's speed: this bound
+    /// is all that slows them (`ImitatorConfig::velocity_fraction` overrides it). Poubel et
+    /// al.'s tasks bound the legs by the CoM's and the feet's speeds, and keep the paper's 10 %.
+    pub leg_velocity_fraction: f64,
     /// How far below its standing height the executable task tables keep the torso (m, ≥ 0).
     /// Shifting the hips over one foot with the torso upright lengthens the far leg: at the
     /// standing height the free leg ends up straight, a singular posture it cannot lift from
@@ -110,6 +116,7 @@ impl MotionTuning {
                 "upper_body_velocity_fraction",
                 self.upper_body_velocity_fraction,
             ),
+            ("leg_velocity_fraction", self.leg_velocity_fraction),
             ("com_speed", self.com_speed),
             ("com_acceleration", self.com_acceleration),
             ("offset_rate", self.offset_rate),
@@ -151,6 +158,10 @@ impl MotionTuning {
                 * from.upper_body_speed
                 / to.upper_body_speed)
                 .min(self.upper_body_velocity_fraction),
+            leg_velocity_fraction: (self.leg_velocity_fraction * from.leg_speed
+                / to.leg_speed
+                / froude)
+                .min(self.leg_velocity_fraction),
             torso_lowering: self.torso_lowering * to.hip_height / from.hip_height,
             single_support_lowering: self.single_support_lowering * to.hip_height / from.hip_height,
             torso_lean: self.torso_lean * stance_angle(to) / stance_angle(from),
@@ -184,4 +195,6 @@ pub struct BipedSize {
     /// Mean rated speed of the joints off the sole-to-sole chain (rad/s); the legs' where the
     /// robot has no such joints.
     pub upper_body_speed: f64,
+    /// Mean rated speed of the joints on the sole-to-sole chain, the legs (rad/s).
+    pub leg_speed: f64,
 }

@@ -111,6 +111,11 @@ pub(crate) struct KoenemannImitator {
     step_envelope: FootArea,
     q_start: Vec<f64>,
     mode: SupportMode,
+    /// How long the offset must stay at the support foot before the other lifts (s).
+    settle_time: f64,
+    /// How long the robot has been in double support with the human on one foot and its
+    /// offset at that foot (s).
+    settled_for: f64,
     /// The foot coming down after single support, until it is on the floor.
     landing: Option<Side>,
     /// Commanded offset `o'`, its rate (1/s) and the offset achieved at the last frame.
@@ -367,6 +372,8 @@ impl KoenemannImitator {
             frame_bounds: position_bounds.clone(),
             position_bounds,
             mode: SupportMode::Double,
+            settle_time: (method.settle_time).or(profile.sway_period).unwrap_or(0.0),
+            settled_for: 0.0,
             landing: None,
             command: 0.5,
             command_rate: 0.0,
@@ -426,7 +433,7 @@ impl KoenemannImitator {
         dt: f64,
     ) -> Result<(), ImitationError> {
         let tolerance = self.config.offset_tolerance;
-        let next = self.mode.next(human, self.measured, tolerance);
+        let next = self.settled(self.mode.next(human, self.measured, tolerance), dt);
         if let (SupportMode::Left | SupportMode::Right, SupportMode::Double) = (self.mode, next) {
             let support = if self.mode == SupportMode::Left {
                 Side::Left
@@ -463,6 +470,21 @@ impl KoenemannImitator {
             self.swing_target = None;
         }
         Ok(())
+    }
+
+    /// `next`, except that double support holds until the offset has stayed at the support
+    /// foot for the settle time (the shaped command catching up with the plan).
+    fn settled(&mut self, next: SupportMode, dt: f64) -> SupportMode {
+        if self.mode != SupportMode::Double || next == SupportMode::Double {
+            self.settled_for = 0.0;
+            return next;
+        }
+        self.settled_for += dt;
+        if self.settled_for >= self.settle_time {
+            next
+        } else {
+            SupportMode::Double
+        }
     }
 
     /// Height of `side`'s sole origin above the root sole (m).

@@ -98,6 +98,15 @@ pub struct KoenemannConfig {
     /// Kinect ges01 6.4 → 2.9, CMU 02_10 3.3 → 2.0), and the physics judge passes every run it
     /// passed. In [0, 1].
     pub arm_posture_gain: f64,
+    /// How long the offset must have stayed at the support foot's end (within
+    /// [`KoenemannConfig::offset_tolerance`]) before the other foot lifts (s). `None` (default):
+    /// the profile's sway period
+    /// ([`BipedProfile::sway_period`](crate::robots::BipedProfile::sway_period)), 0 for a robot
+    /// whose commands are not shaped. A robot whose commands reach it through the sway shaper
+    /// follows the plan's weight shift up to one period late; lifting the moment the plan's
+    /// offset arrives lifts the foot while the robot's weight is still half on it (the same
+    /// wait as Poubel's [`PhaseConfig::settle_time`](crate::imitation::phase::PhaseConfig::settle_time)).
+    pub settle_time: Option<f64>,
 }
 
 impl Default for KoenemannConfig {
@@ -112,6 +121,7 @@ impl Default for KoenemannConfig {
             max_leg_iterations: 4,
             tolerance: 1e-3,
             arm_posture_gain: 0.01,
+            settle_time: None,
         }
     }
 }
@@ -135,6 +145,9 @@ impl KoenemannConfig {
             .find(|(_, v)| !(v.is_finite() && *v > 0.0))
         {
             return Some((name, v, "must be finite and > 0"));
+        }
+        if let Some(t) = self.settle_time.filter(|t| !(t.is_finite() && *t >= 0.0)) {
+            return Some(("koenemann.settle_time", t, "must be finite and >= 0"));
         }
         if !(0.0..=1.0).contains(&self.arm_posture_gain) {
             return Some((

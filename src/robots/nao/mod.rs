@@ -333,6 +333,7 @@ pub const TUNING: MotionTuning = MotionTuning {
     stance_tracking_speed: 0.3,
     tracking_acceleration: 2.0,
     upper_body_velocity_fraction: 0.5,
+    leg_velocity_fraction: 0.1,
     torso_lowering: 0.02,
     single_support_lowering: 0.0,
     torso_lean: 0.25,
@@ -353,6 +354,7 @@ pub const SIZE: BipedSize = BipedSize {
     sole_width: 0.053,
     arm_length: 0.1907,
     upper_body_speed: 10.55,
+    leg_speed: 5.38,
 };
 
 /// The NAO's biped profile over the given models rooted at the left and right soles (the
