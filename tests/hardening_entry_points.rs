@@ -345,7 +345,7 @@ fn koenemann_config_out_of_range_is_refused_by_name() {
     use taskstack::imitation::config::ImitationMethod;
     use taskstack::imitation::koenemann::KoenemannConfig;
     type Set = fn(&mut KoenemannConfig, f64);
-    let fields: [(&str, Set, &[f64]); 4] = [
+    let fields: [(&str, Set, &[f64]); 5] = [
         (
             "koenemann.damping",
             |k, v| k.damping = v,
@@ -365,6 +365,11 @@ fn koenemann_config_out_of_range_is_refused_by_name() {
             "koenemann.arm_posture_gain",
             |k, v| k.arm_posture_gain = v,
             &[f64::NAN, -0.01, 1.5],
+        ),
+        (
+            "koenemann.settle_time",
+            |k, v| k.settle_time = Some(v),
+            &[f64::NAN, f64::INFINITY, -0.1],
         ),
     ];
     for (name, set, values) in fields {
