@@ -40,7 +40,11 @@
 //! offset's acceleration is bounded; the feet keep their stance in double support by default
 //! ([`FootRetargeting::ShiftBothFeet`]; the paper's one-foot rule slides a loaded foot);
 //! a foot coming down after single support lands flat at the touchdown speed of
-//! [`MotionLimits`](super::shaping::MotionLimits) before the offset leaves its end; the
+//! [`MotionLimits`](super::shaping::MotionLimits) before the offset leaves its end; on a
+//! robot whose commands are shaped, a foot lifts only once the offset has stayed at the other
+//! foot for [`KoenemannConfig::settle_time`]; the legs' share of their rated speed is the
+//! profile's ([`MotionTuning::leg_velocity_fraction`](crate::robots::MotionTuning::leg_velocity_fraction)),
+//! the paper's robot's 10 % carried to the robot's size; the
 //! human's CoM is estimated from the skeleton ([`crate::human::centre_of_mass`]) where the
 //! paper had the Xsens suit's.
 
