@@ -178,18 +178,24 @@ fn slow_dance(settle_time: Option<f64>) -> (Clip, ImitatorConfig) {
     (clip, config)
 }
 
-/// The robot time (s) of the first frame whose phase has a foot in the air.
-fn first_lift(profile: &BipedProfile, settle_time: Option<f64>) -> f64 {
-    let (mut clip, config) = slow_dance(settle_time);
-    let mut imitator = Imitator::new(profile.clone(), config).unwrap();
-    let mut frame = HumanFrame::new(0.0);
-    while clip.read_frame(&mut frame).unwrap() {
+/// The robot time (s) of the first of `frames` whose phase has a foot in the air.
+fn first_airborne(imitator: &mut Imitator, frames: impl Iterator<Item = HumanFrame>) -> f64 {
+    for frame in frames {
         let out = imitator.step(&frame).unwrap();
         if out.phase.airborne_foot().is_some() {
             return out.time;
         }
     }
     panic!("the robot never lifted a foot");
+}
+
+/// The robot time (s) of the slow dance's first frame with a foot in the air.
+fn first_lift(profile: &BipedProfile, settle_time: Option<f64>) -> f64 {
+    let (mut clip, config) = slow_dance(settle_time);
+    let mut imitator = Imitator::new(profile.clone(), config).unwrap();
+    let mut frame = HumanFrame::new(0.0);
+    let frames = std::iter::from_fn(|| clip.read_frame(&mut frame).unwrap().then_some(frame));
+    first_airborne(&mut imitator, frames)
 }
 
 #[test]
@@ -227,7 +233,7 @@ fn first_koenemann_lift(settle_time: Option<f64>) -> f64 {
     let mut standing = HumanFrame::new(0.0);
     assert!(clip.read_frame(&mut standing).unwrap());
     let mut imitator = Imitator::new(g1::profile(), config).unwrap();
-    for k in 0..720 {
+    let frames = (0..720).map(|k| {
         let mut frame = standing;
         frame.time = k as f64 * DT;
         if frame.time >= 1.0 {
@@ -236,12 +242,9 @@ fn first_koenemann_lift(settle_time: Option<f64>) -> f64 {
                 frame.set(joint, lifted);
             }
         }
-        let out = imitator.step(&frame).unwrap();
-        if out.phase.airborne_foot().is_some() {
-            return out.time;
-        }
-    }
-    panic!("the robot never lifted a foot");
+        frame
+    });
+    first_airborne(&mut imitator, frames)
 }
 
 #[test]
