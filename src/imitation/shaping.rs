@@ -17,15 +17,10 @@
 //!
 //! [`SwingHeight`] moves the swing foot's height above the ground toward its goal (ρ while a
 //! foot is lifted, 0 while it is lowered) at `foot_speed`, and slower near the ground: the
-//! speed is `min(foot_speed, max(touchdown_speed, h / landing_time))`, so the foot comes down
-//! in an exponential approach ending at `touchdown_speed`, and leaves the ground the same way
-//! backwards. A servo that sags a few millimetres puts the foot on the floor early; at that
-//! speed it arrives gently instead of bumping the robot onto the other foot's edge. A foot
-//! that still carries some weight when it lifts (the legs share the load in double support
-//! however far the CoM has gone over the other foot) hands it over to the stance foot as
-//! slowly: lifted at `foot_speed` at once, the G1's foot dropped its last 20–30 N within a few
-//! hundredths of a second, a step of 7 N·m at the stance ankle that tipped the robot onto its
-//! stance sole's inner edge (judge, CMU 131_01).
+//! descent speed is `min(foot_speed, max(touchdown_speed, h / landing_time))`, so the foot comes
+//! down in an exponential approach ending at `touchdown_speed`. A servo that sags a few
+//! millimetres puts the foot on the floor early; at that speed it arrives gently instead of
+//! bumping the robot onto the other foot's edge.
 //!
 //! # Hand speed
 //!
@@ -72,10 +67,10 @@ pub struct MotionLimits {
     pub com_acceleration: f64,
     /// Largest speed of the swing foot's height (m/s). Default 0.05.
     pub foot_speed: f64,
-    /// Speed at which a foot reaches and leaves the ground (m/s). Default 0.005.
+    /// Speed at which a foot reaches the ground (m/s). Default 0.005.
     pub touchdown_speed: f64,
-    /// Time constant of the foot's slow-down near the ground and of its speed-up after it
-    /// leaves it (s). Default 0.1: the last and the first 5 mm take about 0.33 s.
+    /// Time constant of the foot's slow-down near the ground (s). Default 0.1: the last
+    /// 5 mm take about 0.4 s.
     pub landing_time: f64,
 }
 
@@ -312,8 +307,13 @@ impl SwingHeight {
             return;
         }
         let goal = goal.max(0.0);
-        let speed =
-            (limits.foot_speed).min(limits.touchdown_speed.max(self.0 / limits.landing_time));
+        let speed = if goal < self.0 {
+            limits
+                .foot_speed
+                .min(limits.touchdown_speed.max(self.0 / limits.landing_time))
+        } else {
+            limits.foot_speed
+        };
         let step = speed * dt;
         self.0 = if (goal - self.0).abs() <= step {
             goal
@@ -491,16 +491,11 @@ mod tests {
         // 30 → 5 mm at up to 50 mm/s then h/τ: about τ·ln(30/5) + 0.4 s ≈ 0.6 s in all; well
         // under 2 s.
         assert!(t > 0.4 && t < 2.0, "{t}");
-        // Lifting mirrors it: off the ground at the touchdown speed, 0.5 mm at 5 mm/s (0.1 s),
-        // then h/τ up to 5 mm (τ ln 10 = 0.23 s), then 25 mm at 50 mm/s (0.5 s): 0.83 s.
+        // Lifting goes at foot speed: 30 mm in 0.6 s.
         let mut h = SwingHeight::at(0.0);
-        h.advance(0.03, dt, &limits);
-        assert!((h.height() - limits.touchdown_speed * dt).abs() < 1e-12);
-        let mut t = dt;
-        while h.height() < 0.03 {
+        for _ in 0..600 {
             h.advance(0.03, dt, &limits);
-            t += dt;
         }
-        assert!((t - 0.83).abs() < 0.01, "{t}");
+        assert!((h.height() - 0.03).abs() < 1e-9);
     }
 }
