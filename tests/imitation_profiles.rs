@@ -212,6 +212,14 @@ fn profile_errors_name_the_field() {
         err.to_string().contains("tuning.single_support_lowering"),
         "{err}"
     );
+    // The lift-off (a flag, kept by the scaling: the NAO's quick lift without the key).
+    let lift = |soft: &str| format!("{toml}\n[tuning]\nsoft_liftoff = {soft}\n");
+    let profile = BipedProfile::from_toml_str(&lift("true"), &urdf).unwrap();
+    assert!(profile.tuning.soft_liftoff);
+    let untuned = BipedProfile::from_toml_str(&toml, &urdf).unwrap();
+    assert!(!untuned.tuning.soft_liftoff);
+    let err = load(&lift("1.5"));
+    assert!(err.to_string().contains("soft_liftoff"), "{err}");
 
     // The servos' stiffness, a key before the first table.
     let servos = |saturation: f64| format!("servo_saturation = {saturation}\n{toml}");

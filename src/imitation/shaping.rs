@@ -20,7 +20,12 @@
 //! descent speed is `min(foot_speed, max(touchdown_speed, h / landing_time))`, so the foot comes
 //! down in an exponential approach ending at `touchdown_speed`. A servo that sags a few
 //! millimetres puts the foot on the floor early; at that speed it arrives gently instead of
-//! bumping the robot onto the other foot's edge.
+//! bumping the robot onto the other foot's edge. With `soft_liftoff` a lifted foot leaves the
+//! ground the same way backwards: a foot that still carries some weight when it lifts (the
+//! legs share the load in double support however far the CoM has gone over the other foot)
+//! hands it over to the stance foot as slowly. Lifted at `foot_speed` at once, the G1's foot
+//! dropped its last 20–30 N within a few hundredths of a second, a step of 7 N·m at the stance
+//! ankle that tipped the robot onto its stance sole's inner edge (judge, CMU 131_01).
 //!
 //! # Hand speed
 //!
@@ -70,8 +75,13 @@ pub struct MotionLimits {
     /// Speed at which a foot reaches the ground (m/s). Default 0.005.
     pub touchdown_speed: f64,
     /// Time constant of the foot's slow-down near the ground (s). Default 0.1: the last
-    /// 5 mm take about 0.4 s.
+    /// 5 mm take about 0.33 s.
     pub landing_time: f64,
+    /// Whether a lifted foot also leaves the ground that way, slowly for its first
+    /// millimetres (see the module docs). Default `false`: it lifts at `foot_speed` at once
+    /// (the imitator's default: the profile's
+    /// [`MotionTuning::soft_liftoff`](crate::robots::MotionTuning::soft_liftoff)).
+    pub soft_liftoff: bool,
 }
 
 impl Default for MotionLimits {
@@ -84,6 +94,7 @@ impl Default for MotionLimits {
             foot_speed: 0.05,
             touchdown_speed: 0.005,
             landing_time: 0.1,
+            soft_liftoff: false,
         }
     }
 }
@@ -94,6 +105,7 @@ impl MotionLimits {
         Self {
             com_speed: tuning.com_speed,
             com_acceleration: tuning.com_acceleration,
+            soft_liftoff: tuning.soft_liftoff,
             ..Self::default()
         }
     }
@@ -307,7 +319,7 @@ impl SwingHeight {
             return;
         }
         let goal = goal.max(0.0);
-        let speed = if goal < self.0 {
+        let speed = if goal < self.0 || limits.soft_liftoff {
             limits
                 .foot_speed
                 .min(limits.touchdown_speed.max(self.0 / limits.landing_time))
@@ -497,5 +509,21 @@ mod tests {
             h.advance(0.03, dt, &limits);
         }
         assert!((h.height() - 0.03).abs() < 1e-9);
+        // A soft lift-off mirrors the landing: off the ground at the touchdown speed, 0.5 mm
+        // at 5 mm/s (0.1 s), then h/τ up to 5 mm (τ ln 10 = 0.23 s), then 25 mm at 50 mm/s
+        // (0.5 s): 0.83 s.
+        let soft = MotionLimits {
+            soft_liftoff: true,
+            ..limits
+        };
+        let mut h = SwingHeight::at(0.0);
+        h.advance(0.03, dt, &soft);
+        assert!((h.height() - soft.touchdown_speed * dt).abs() < 1e-12);
+        let mut t = dt;
+        while h.height() < 0.03 {
+            h.advance(0.03, dt, &soft);
+            t += dt;
+        }
+        assert!((t - 0.83).abs() < 0.01, "{t}");
     }
 }

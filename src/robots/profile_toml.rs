@@ -53,6 +53,7 @@
 //! tracking_acceleration = 2.0        # m/s², the hands' change of speed
 //! upper_body_velocity_fraction = 0.5
 //! leg_velocity_fraction = 0.1        # Koenemann's legs, of their rated speed
+//! soft_liftoff = false               # a lifted foot leaves the ground as slowly as it lands
 //! torso_lowering = 0.02              # m, the torso below its standing height
 //! single_support_lowering = 0.0      # m, the same while a foot is lifted or up
 //! torso_lean = 0.25                  # rad, over the stance foot
@@ -112,6 +113,7 @@ struct Tuning {
     tracking_acceleration: Option<f64>,
     upper_body_velocity_fraction: Option<f64>,
     leg_velocity_fraction: Option<f64>,
+    soft_liftoff: Option<bool>,
     torso_lowering: Option<f64>,
     single_support_lowering: Option<f64>,
     torso_lean: Option<f64>,
@@ -352,6 +354,7 @@ fn tuning(file: Option<Tuning>, scaled: MotionTuning) -> MotionTuning {
         upper_body_velocity_fraction: (t.upper_body_velocity_fraction)
             .unwrap_or(scaled.upper_body_velocity_fraction),
         leg_velocity_fraction: (t.leg_velocity_fraction).unwrap_or(scaled.leg_velocity_fraction),
+        soft_liftoff: t.soft_liftoff.unwrap_or(scaled.soft_liftoff),
         torso_lowering: t.torso_lowering.unwrap_or(scaled.torso_lowering),
         single_support_lowering: (t.single_support_lowering)
             .unwrap_or(scaled.single_support_lowering),

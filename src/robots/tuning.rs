@@ -57,6 +57,10 @@ pub struct MotionTuning {
     /// is all that slows them (`ImitatorConfig::velocity_fraction` overrides it). Poubel et
     /// al.'s tasks bound the legs by the CoM's and the feet's speeds, and keep the paper's 10 %.
     pub leg_velocity_fraction: f64,
+    /// Whether a lifted foot leaves the ground as slowly as it lands, handing the load it
+    /// still carries to the stance foot gradually
+    /// (`imitation::shaping::MotionLimits::soft_liftoff`). Not a size: the scaling keeps it.
+    pub soft_liftoff: bool,
     /// How far below its standing height the executable task tables keep the torso (m, ≥ 0).
     /// Shifting the hips over one foot with the torso upright lengthens the far leg: at the
     /// standing height the free leg ends up straight, a singular posture it cannot lift from
@@ -158,6 +162,7 @@ impl MotionTuning {
                 * from.upper_body_speed
                 / to.upper_body_speed)
                 .min(self.upper_body_velocity_fraction),
+            soft_liftoff: self.soft_liftoff,
             leg_velocity_fraction: (self.leg_velocity_fraction * from.leg_speed
                 / to.leg_speed
                 / froude)

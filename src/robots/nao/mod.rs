@@ -334,6 +334,7 @@ pub const TUNING: MotionTuning = MotionTuning {
     tracking_acceleration: 2.0,
     upper_body_velocity_fraction: 0.5,
     leg_velocity_fraction: 0.1,
+    soft_liftoff: false,
     torso_lowering: 0.02,
     single_support_lowering: 0.0,
     torso_lean: 0.25,
