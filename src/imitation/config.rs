@@ -51,8 +51,8 @@ pub struct ImitatorConfig {
     /// `None` (default): [`PAPER_VELOCITY_FRACTION`] in Poubel et al.'s method, whose tasks
     /// bound the legs by the CoM's and the feet's speeds; the profile's
     /// [`MotionTuning::leg_velocity_fraction`] in Koenemann et al.'s, whose legs copy the
-    /// human's and are slowed by this bound alone (the G1's legs at 10 % of its fast motors
-    /// bobbed its 35 kg up and down at the human's pace and fell on 8 of 16 judge runs).
+    /// human's and are slowed by this bound alone (at 10 % of the G1's fast motors its legs
+    /// turned at up to 2.6 rad/s and it fell on 8 of 16 judge runs).
     pub velocity_fraction: Option<f64>,
     /// Fraction of the rated velocity of every joint off the sole-to-sole chain (arms, head);
     /// `None` (default): the profile's [`MotionTuning::upper_body_velocity_fraction`](crate::robots::MotionTuning::upper_body_velocity_fraction) (0.5 for
