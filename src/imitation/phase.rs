@@ -490,6 +490,33 @@ impl Default for Settling {
     }
 }
 
+/// How long a condition has held without a break (s), against a wait (s): the settle time of
+/// a weight shift, in either method.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct HoldTimer {
+    wait: f64,
+    held: f64,
+}
+
+impl HoldTimer {
+    /// Nothing held yet, against `wait` seconds.
+    pub(crate) fn new(wait: f64) -> Self {
+        Self { wait, held: 0.0 }
+    }
+
+    /// Counts `dt` while `holds`, restarting at a break; whether the condition holds and has
+    /// held for the wait.
+    pub(crate) fn hold(&mut self, holds: bool, dt: f64) -> bool {
+        self.held = if holds { self.held + dt } else { 0.0 };
+        holds && self.held >= self.wait
+    }
+
+    /// Starts the count again.
+    pub(crate) fn restart(&mut self) {
+        self.held = 0.0;
+    }
+}
+
 /// The support phase state machine (see the module docs for the graph).
 ///
 /// ```
@@ -516,8 +543,8 @@ pub struct PhaseMachine {
     config: PhaseConfig,
     phase: SupportPhase,
     human: HumanSupport,
-    /// How long (s) the weight shift's end condition has held without a break.
-    held: f64,
+    /// How long the weight shift's end condition has held, against the settle time.
+    settle: HoldTimer,
 }
 
 impl PhaseMachine {
@@ -528,7 +555,7 @@ impl PhaseMachine {
             config,
             phase: SupportPhase::Double,
             human: HumanSupport::Double,
-            held: 0.0,
+            settle: HoldTimer::new(config.settle_time.unwrap_or(0.0)),
         })
     }
 
@@ -573,12 +600,11 @@ impl PhaseMachine {
         if let SupportPhase::DoubleToRight(TakeOff::ComToFoot)
         | SupportPhase::DoubleToLeft(TakeOff::ComToFoot) = self.phase
         {
-            self.held = if done.com { self.held + dt } else { 0.0 };
-            done.com &= self.held >= self.config.settle_time.unwrap_or(0.0);
+            done.com = self.settle.hold(done.com, dt);
         }
         let next = next_phase(self.phase, self.human, &done);
         if next != self.phase {
-            self.held = 0.0;
+            self.settle.restart();
         }
         self.phase = next;
         self.phase

@@ -17,7 +17,7 @@ use crate::imitation::error::ImitationError;
 use crate::imitation::imitator::{Shared, effector_ids, human_stance};
 use crate::imitation::metrics::CONTACT_HEIGHT;
 use crate::imitation::output::RobotFrame;
-use crate::imitation::phase::{Landing, SupportPhase, TakeOff};
+use crate::imitation::phase::{HoldTimer, Landing, SupportPhase, TakeOff};
 use crate::imitation::reach::Arm;
 use crate::imitation::scaler::reference_points;
 use crate::imitation::shaping::{HandRates, HandSpeed, MotionLimits, SwingHeight};
@@ -111,11 +111,9 @@ pub(crate) struct KoenemannImitator {
     step_envelope: FootArea,
     q_start: Vec<f64>,
     mode: SupportMode,
-    /// How long the offset must stay at the support foot before the other lifts (s).
-    settle_time: f64,
     /// How long the robot has been in double support with the human on one foot and its
-    /// offset at that foot (s).
-    settled_for: f64,
+    /// offset at that foot, against the settle time.
+    lift_wait: HoldTimer,
     /// The foot coming down after single support, until it is on the floor.
     landing: Option<Side>,
     /// Commanded offset `o'`, its rate (1/s) and the offset achieved at the last frame.
@@ -372,8 +370,7 @@ impl KoenemannImitator {
             frame_bounds: position_bounds.clone(),
             position_bounds,
             mode: SupportMode::Double,
-            settle_time: (method.settle_time).or(profile.sway_period).unwrap_or(0.0),
-            settled_for: 0.0,
+            lift_wait: HoldTimer::new((method.settle_time).or(profile.sway_period).unwrap_or(0.0)),
             landing: None,
             command: 0.5,
             command_rate: 0.0,
@@ -476,14 +473,12 @@ impl KoenemannImitator {
     /// foot for the settle time (the shaped command catching up with the plan).
     fn settled(&mut self, next: SupportMode, dt: f64) -> SupportMode {
         if self.mode != SupportMode::Double || next == SupportMode::Double {
-            self.settled_for = 0.0;
+            self.lift_wait.restart();
             return next;
         }
-        self.settled_for += dt;
-        if self.settled_for >= self.settle_time {
-            next
-        } else {
-            SupportMode::Double
+        match self.lift_wait.hold(true, dt) {
+            true => next,
+            false => SupportMode::Double,
         }
     }
 
