@@ -345,7 +345,7 @@ fn koenemann_config_out_of_range_is_refused_by_name() {
     use taskstack::imitation::config::ImitationMethod;
     use taskstack::imitation::koenemann::KoenemannConfig;
     type Set = fn(&mut KoenemannConfig, f64);
-    let fields: [(&str, Set, &[f64]); 5] = [
+    let fields: [(&str, Set, &[f64]); 6] = [
         (
             "koenemann.damping",
             |k, v| k.damping = v,
@@ -369,6 +369,11 @@ fn koenemann_config_out_of_range_is_refused_by_name() {
         (
             "koenemann.settle_time",
             |k, v| k.settle_time = Some(v),
+            &[f64::NAN, f64::INFINITY, -0.1],
+        ),
+        (
+            "koenemann.leg_ramp_time",
+            |k, v| k.leg_ramp_time = Some(v),
             &[f64::NAN, f64::INFINITY, -0.1],
         ),
     ];

@@ -220,6 +220,13 @@ fn profile_errors_name_the_field() {
     assert!(!untuned.tuning.soft_liftoff);
     let err = load(&lift("1.5"));
     assert!(err.to_string().contains("soft_liftoff"), "{err}");
+    // Where Koenemann's offset ends (a flag too: the NAO's sole centres without the key).
+    let ends = |flag: &str| format!("{toml}\n[tuning]\noffset_to_stance_point = {flag}\n");
+    let profile = BipedProfile::from_toml_str(&ends("true"), &urdf).unwrap();
+    assert!(profile.tuning.offset_to_stance_point);
+    assert!(!untuned.tuning.offset_to_stance_point);
+    let err = load(&ends("\"yes\""));
+    assert!(err.to_string().contains("offset_to_stance_point"), "{err}");
 
     // The servos' stiffness, a key before the first table.
     let servos = |saturation: f64| format!("servo_saturation = {saturation}\n{toml}");

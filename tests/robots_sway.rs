@@ -213,10 +213,9 @@ fn the_g1_lifts_a_foot_a_sway_period_after_its_weight_is_over_the_other() {
     );
 }
 
-/// The robot time (s) of the first frame with a foot in the air, Koenemann's method on the G1
-/// with the weight shift's `settle_time`, for a human who stands still on both feet for 1 s
-/// (the first frame of CMU 05_02) and then holds the right foot 15 cm up for 5 s.
-fn first_koenemann_lift(settle_time: Option<f64>) -> f64 {
+/// Koenemann's method on the G1 with `method`, and a human who stands still on both feet for
+/// 1 s (the first frame of CMU 05_02) and then holds the right foot 15 cm up for 5 s.
+fn koenemann_lifting_right_foot(method: KoenemannConfig) -> (Imitator, Vec<HumanFrame>) {
     let path = format!(
         "{}/tests/data/mocap/cmu_05_02_stand_arm_gestures_turn_single_leg.bvh",
         env!("CARGO_MANIFEST_DIR")
@@ -224,15 +223,11 @@ fn first_koenemann_lift(settle_time: Option<f64>) -> f64 {
     let mut clip = Clip::open(path).unwrap();
     let config = ImitatorConfig {
         support: SupportConfig::for_capture(clip.capture()),
-        method: ImitationMethod::Koenemann(KoenemannConfig {
-            settle_time,
-            ..KoenemannConfig::default()
-        }),
+        method: ImitationMethod::Koenemann(method),
         ..ImitatorConfig::default()
     };
     let mut standing = HumanFrame::new(0.0);
     assert!(clip.read_frame(&mut standing).unwrap());
-    let mut imitator = Imitator::new(g1::profile(), config).unwrap();
     let frames = (0..720).map(|k| {
         let mut frame = standing;
         frame.time = k as f64 * DT;
@@ -244,7 +239,18 @@ fn first_koenemann_lift(settle_time: Option<f64>) -> f64 {
         }
         frame
     });
-    first_airborne(&mut imitator, frames)
+    let imitator = Imitator::new(g1::profile(), config).unwrap();
+    (imitator, frames.collect())
+}
+
+/// The robot time (s) of the first frame with a foot in the air in
+/// [`koenemann_lifting_right_foot`], with the weight shift's `settle_time`.
+fn first_koenemann_lift(settle_time: Option<f64>) -> f64 {
+    let (mut imitator, frames) = koenemann_lifting_right_foot(KoenemannConfig {
+        settle_time,
+        ..KoenemannConfig::default()
+    });
+    first_airborne(&mut imitator, frames.into_iter())
 }
 
 #[test]
@@ -254,5 +260,59 @@ fn the_g1_on_koenemanns_method_also_waits_a_sway_period_before_a_lift() {
     assert!(
         (waited - period).abs() <= DT,
         "waited {waited} s for a sway period of {period} s"
+    );
+}
+
+/// The largest leg-joint acceleration (as a share of the ramp's `v_max / T`, `T` the G1's sway
+/// period) and CoM acceleration (m/s², horizontal, during the weight shift from 1 to 3 s) of
+/// [`koenemann_lifting_right_foot`] with the legs' `leg_ramp_time`, by second differences of
+/// the output (the CoM in the root frame, over frames with one root).
+fn koenemann_leg_and_com_accelerations(leg_ramp_time: Option<f64>) -> (f64, f64) {
+    let (mut imitator, frames) = koenemann_lifting_right_foot(KoenemannConfig {
+        leg_ramp_time,
+        ..KoenemannConfig::default()
+    });
+    let profile = g1::profile();
+    let legs = profile.sole_chain_variables(&profile.stand).unwrap();
+    let period = profile.sway_period.unwrap();
+    let ramp: Vec<f64> = (imitator.bounds().velocity().iter())
+        .map(|v| v / period)
+        .collect();
+    let outputs: Vec<_> = frames
+        .iter()
+        .map(|frame| imitator.step(frame).unwrap().clone())
+        .collect();
+    let (mut legs_share, mut com) = (0.0_f64, 0.0_f64);
+    for w in outputs.windows(3) {
+        for i in (0..legs.len()).filter(|&i| legs[i]) {
+            let a = (w[2].q[i] - 2.0 * w[1].q[i] + w[0].q[i]) / (DT * DT);
+            legs_share = legs_share.max(a.abs() / ramp[i]);
+        }
+        let shifting = w[0].time >= 1.0 && w[2].time <= 3.0;
+        if shifting && w[0].root == w[2].root {
+            let a = (w[2].com - 2.0 * w[1].com + w[0].com) / (DT * DT);
+            com = com.max(a.xy().norm());
+        }
+    }
+    (legs_share, com)
+}
+
+#[test]
+fn the_g1_on_koenemanns_method_ramps_its_legs_over_a_sway_period() {
+    // Ramped (the default: the profile's sway period), each leg joint changes its speed by at
+    // most v_max / T per second, and the held sole's correction in double support adds what
+    // the legs' common line left (up to about twice that); unramped (0), the legs start and
+    // stop at their velocity limit within a frame, a hundred times the ramp's rate. The CoM
+    // they carry accelerates less as it shifts onto the left foot (0.31 against 0.55 m/s²).
+    let (ramped_legs, ramped_com) = koenemann_leg_and_com_accelerations(None);
+    let (abrupt_legs, abrupt_com) = koenemann_leg_and_com_accelerations(Some(0.0));
+    assert!(ramped_legs < 3.0, "ramped legs at {ramped_legs} × the ramp");
+    assert!(
+        abrupt_legs > 30.0,
+        "unramped legs at {abrupt_legs} × the ramp"
+    );
+    assert!(
+        ramped_com < 0.7 * abrupt_com,
+        "CoM {ramped_com} m/s² ramped, {abrupt_com} unramped"
     );
 }

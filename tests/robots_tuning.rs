@@ -53,6 +53,19 @@ fn the_scaling_rules_keep_the_invariants_they_state() {
             max_relative = 1e-12
         );
     }
+    // Flags are not sizes: the scaling keeps them, whichever way they are set.
+    for flag in [false, true] {
+        let flagged = MotionTuning {
+            soft_liftoff: flag,
+            offset_to_stance_point: flag,
+            ..a
+        };
+        let scaled = flagged.scaled(&from, &to);
+        assert_eq!(
+            (scaled.soft_liftoff, scaled.offset_to_stance_point),
+            (flag, flag)
+        );
+    }
     // Koenemann's offset (a fraction of the stance): the CoM speed it gives Froude-scaled, the
     // CoM acceleration it gives keeping a·h.
     let (cv, dv) = (

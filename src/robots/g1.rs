@@ -159,6 +159,12 @@ pub const STAND: [f64; 29] = [
 /// knee bends and pelvis turns at up to 2.6 rad/s (hip yaw, CMU 02_10) and 8 of 16 judge runs
 /// fell (hold 60, every bundled clip, both models); at the rules' value 3 (with the weight
 /// shift's wait of [`SWAY_PERIOD`] before a lift, `KoenemannConfig::settle_time`).
+/// Koenemann's offset ends at the stance points (`offset_to_stance_point`), where Poubel's
+/// method puts the CoM on one foot: with the CoM parked over a sole's centre the weak model
+/// rolled outward over it (the uncompensated half of its servos' sag), and with the legs
+/// also ramped over a sway period (`KoenemannConfig::leg_ramp_time`) every bundled clip
+/// passes the judge on both models (hold 60; the stance points alone 11 of 16, the ramp alone
+/// 13; with margins of 10 or 20 mm, or every leg joint ramped at 0.15 or 0.6 rad/s², 15 or 16).
 ///
 /// A lifted foot leaves the ground as slowly as it lands (`soft_liftoff`): lifted at once, the
 /// foot's last 20–30 N went to the stance foot within a few hundredths of a second and the G1
@@ -187,6 +193,7 @@ pub const TUNING: MotionTuning = MotionTuning {
     com_acceleration: 0.3,
     offset_rate: 1.0,
     offset_acceleration: 1.0,
+    offset_to_stance_point: true,
     damping: 0.039,
 };
 

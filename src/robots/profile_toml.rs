@@ -62,6 +62,7 @@
 //! com_acceleration = 0.3             # m/s²
 //! offset_rate = 1.5                  # 1/s, Koenemann's CoM offset between the feet
 //! offset_acceleration = 6.0          # 1/s²
+//! offset_to_stance_point = false     # Koenemann's offset ends where Poubel's CoM stands on a foot
 //! damping = 0.02                     # m/rad, the solver's damping of near-singular levels
 //! ```
 //!
@@ -122,6 +123,7 @@ struct Tuning {
     com_acceleration: Option<f64>,
     offset_rate: Option<f64>,
     offset_acceleration: Option<f64>,
+    offset_to_stance_point: Option<bool>,
     damping: Option<f64>,
 }
 
@@ -364,6 +366,7 @@ fn tuning(file: Option<Tuning>, scaled: MotionTuning) -> MotionTuning {
         com_acceleration: t.com_acceleration.unwrap_or(scaled.com_acceleration),
         offset_rate: t.offset_rate.unwrap_or(scaled.offset_rate),
         offset_acceleration: t.offset_acceleration.unwrap_or(scaled.offset_acceleration),
+        offset_to_stance_point: (t.offset_to_stance_point).unwrap_or(scaled.offset_to_stance_point),
         damping: t.damping.unwrap_or(scaled.damping),
     }
 }

@@ -96,6 +96,11 @@ pub struct MotionTuning {
     pub offset_rate: f64,
     /// Largest change of that rate (1/s²).
     pub offset_acceleration: f64,
+    /// Whether Koenemann's offset ends at each foot's stance point
+    /// ([`BipedProfile::stance_point`](super::BipedProfile::stance_point), `support_margin`
+    /// from the sole's inner edge, where Poubel et al.'s method puts the CoM on one foot)
+    /// instead of at the sole's centre (the paper). Not a size: the scaling keeps it.
+    pub offset_to_stance_point: bool,
     /// The solver's damping of near-singular levels in Poubel et al.'s method (m/rad: the
     /// damping threshold and the largest damping of
     /// [`Settings`](crate::solver::Settings), in the units of the hands' Jacobian): a level
@@ -176,6 +181,7 @@ impl MotionTuning {
             offset_rate: self.offset_rate * froude * (from.half_stance / to.half_stance),
             offset_acceleration: self.offset_acceleration
                 * ((from.half_stance * from.com_height) / (to.half_stance * to.com_height)),
+            offset_to_stance_point: self.offset_to_stance_point,
             damping: self.damping * arm,
         }
     }

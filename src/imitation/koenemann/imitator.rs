@@ -67,7 +67,8 @@ struct Body {
     folded: [f64; 2],
     hips: [Vector3<f64>; 2],
     limbs: Limbs,
-    /// Sole centres in the sole frames.
+    /// The point of each sole the offset ends at, in the sole frames: its centre, or its
+    /// stance point ([`MotionTuning::offset_to_stance_point`](crate::robots::MotionTuning::offset_to_stance_point)).
     centres: [Vector3<f64>; 2],
     /// Each ankle in its sole frame.
     ankles: [Vector3<f64>; 2],
@@ -110,6 +111,10 @@ pub(crate) struct KoenemannImitator {
     motion: MotionLimits,
     step_envelope: FootArea,
     q_start: Vec<f64>,
+    /// Each joint's velocity over the last frame (rad/s, model variable order).
+    velocity: Vec<f64>,
+    /// [`KoenemannConfig::leg_ramp_time`] resolved (s; 0: the legs are not ramped).
+    leg_ramp_time: f64,
     mode: SupportMode,
     /// How long the robot has been in double support with the human on one foot and its
     /// offset at that foot, against the settle time.
@@ -192,7 +197,10 @@ impl Body {
                 legs: length(&hips, &knees, &ankles),
             },
             centres: Side::BOTH.map(|s| {
-                let [x, y] = profile.sole_centre(s);
+                let [x, y] = match profile.tuning.offset_to_stance_point {
+                    true => profile.stance_point(s, profile.tuning.support_margin),
+                    false => profile.sole_centre(s),
+                };
                 Vector3::new(x, y, 0.0)
             }),
             ankles: Side::BOTH.map(sole_ankle),
@@ -357,6 +365,10 @@ impl KoenemannImitator {
             motion: config.motion_for(&tuning),
             step_envelope: config.step_envelope.unwrap_or(profile.step_envelope),
             q_start: shared.q.clone(),
+            velocity: vec![0.0; shared.q.len()],
+            leg_ramp_time: (method.leg_ramp_time)
+                .or(profile.sway_period)
+                .unwrap_or(0.0),
             offset_speed: (method.offset_speed).unwrap_or_else(|| OffsetSpeed::of_robot(&tuning)),
             config: method,
             frames,
@@ -414,6 +426,10 @@ impl KoenemannImitator {
         self.limit_velocities(dt);
         self.keep_arms_apart(dt)?;
         self.settle_hold(dt)?;
+        for (v, (q, q0)) in (self.velocity.iter_mut()).zip(self.shared.q.iter().zip(&self.q_start))
+        {
+            *v = (q - q0) / dt;
+        }
         self.shared.refresh()?;
         self.measure();
         self.write_output(frame, human, mapped.as_ref())?;
@@ -787,7 +803,8 @@ impl KoenemannImitator {
         sole.transform_point(&self.body.centres[k].into()).coords
     }
 
-    /// §V.D: every joint within its velocity limit for `dt`; the legs scaled together.
+    /// §V.D: every joint within its velocity limit for `dt`; the legs scaled together, then
+    /// ramped ([`Self::ramp_legs`]).
     fn limit_velocities(&mut self, dt: f64) {
         let velocity = self.shared.bounds.velocity();
         let mut legs = 1.0_f64;
@@ -797,17 +814,34 @@ impl KoenemannImitator {
                 legs = legs.min(velocity[i] * dt / delta);
             }
         }
-        for (i, &leg) in self.shared.legs.iter().enumerate() {
+        for i in 0..self.shared.q.len() {
             let delta = self.shared.q[i] - self.q_start[i];
             let reach = velocity[i] * dt;
             self.shared.q[i] = self.q_start[i]
-                + if leg {
-                    delta * legs
-                } else {
-                    delta.clamp(-reach, reach)
+                + match self.shared.legs[i] {
+                    true => self.ramp(i, delta, delta * legs, dt),
+                    false => delta.clamp(-reach, reach),
                 };
         }
         self.shared.bounds.clamp_position(&mut self.shared.q);
+    }
+
+    /// Leg joint `i`'s `step` this frame (rad) toward its `target` (the legs' IK solution, rad
+    /// ahead), ramped: its speed within `√(2 a |target|)`, what stops it there at the
+    /// acceleration `a = v_max / T` ([`KoenemannConfig::leg_ramp_time`] `T`, `v_max` its
+    /// velocity limit), and within `a dt` of its last frame's speed. The legs then start and
+    /// stop smoothly, and so does the CoM they carry. Joint by joint, so the legs leave their
+    /// common line a little; in double support the held sole is put back after
+    /// ([`Self::settle_hold`]).
+    fn ramp(&self, i: usize, target: f64, step: f64, dt: f64) -> f64 {
+        if self.leg_ramp_time <= 0.0 {
+            return step;
+        }
+        let acceleration = self.shared.bounds.velocity()[i] / self.leg_ramp_time;
+        let stop = (2.0 * acceleration * target.abs()).sqrt() * dt;
+        let last = self.velocity[i] * dt;
+        let change = acceleration * dt * dt;
+        step.clamp(-stop, stop).clamp(last - change, last + change)
     }
 
     /// In double support, the held sole put back where it stands, within the frame's velocity

@@ -343,6 +343,7 @@ pub const TUNING: MotionTuning = MotionTuning {
     com_acceleration: 0.3,
     offset_rate: 1.5,
     offset_acceleration: 6.0,
+    offset_to_stance_point: false,
     damping: 0.02,
 };
 
