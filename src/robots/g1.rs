@@ -163,7 +163,7 @@ pub const STAND: [f64; 29] = [
 /// method puts the CoM on one foot: with the CoM parked over a sole's centre the weak model
 /// rolled outward over it (the uncompensated half of its servos' sag), and with the legs
 /// also ramped over a sway period (`KoenemannConfig::leg_ramp_time`) every bundled clip
-/// passes the judge on both models (hold 60; the stance points alone 11 of 16, the ramp alone
+/// passes the judge on both models (hold 60; the stance points alone 12 of 16, the ramp alone
 /// 13; with margins of 10 or 20 mm, or every leg joint ramped at 0.15 or 0.6 rad/s², 15 or 16).
 ///
 /// A lifted foot leaves the ground as slowly as it lands (`soft_liftoff`): lifted at once, the
