@@ -804,7 +804,7 @@ impl KoenemannImitator {
     }
 
     /// §V.D: every joint within its velocity limit for `dt`; the legs scaled together, then
-    /// ramped ([`Self::ramp_legs`]).
+    /// ramped ([`Self::ramp`]).
     fn limit_velocities(&mut self, dt: f64) {
         let velocity = self.shared.bounds.velocity();
         let mut legs = 1.0_f64;
