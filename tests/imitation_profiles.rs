@@ -246,6 +246,19 @@ fn profile_errors_name_the_field() {
     let err = load(&sway(0.0));
     assert!(err.to_string().contains("sway_period"), "{err}");
 
+    // A chest: optional, a frame of the model other than the torso.
+    assert_eq!(
+        BipedProfile::from_toml_str(&toml, &urdf).unwrap().chest,
+        None
+    );
+    let chest = |frame: &str| toml.replace("torso = ", &format!("chest = \"{frame}\"\ntorso = "));
+    let profile = BipedProfile::from_toml_str(&chest("l_shoulder_a"), &urdf).unwrap();
+    assert_eq!(profile.chest.as_deref(), Some("l_shoulder_a"));
+    let err = load(&chest("ribcage"));
+    assert!(err.to_string().contains("ribcage"), "{err}");
+    let err = load(&chest("pelvis"));
+    assert!(err.to_string().contains("profile field chest"), "{err}");
+
     let missing = BipedProfile::from_toml_file(format!("{TINY}nowhere.toml")).unwrap_err();
     assert!(matches!(missing, ProfileError::Io { .. }), "{missing}");
 }

@@ -90,13 +90,13 @@ pub(crate) struct ImitationOptions {
     pub(crate) task_speed: Option<f64>,
     /// Fastest speed of the hand targets toward the scaled human (m/s, > 0), in every phase.
     /// Default: the profile's, once both feet have stood for a second / on one foot and while
-    /// the weight shifts (NAO 0.8 / 0.3, G1 0.3 / 0.3; both methods; --dynamic-walk the second
+    /// the weight shifts (NAO 0.8 / 0.3, G1 1.2 / 0.6; both methods; --dynamic-walk the second
     /// throughout).
     #[arg(long, value_name = "M_PER_S", value_parser = positive, allow_negative_numbers = true)]
     pub(crate) tracking_speed: Option<f64>,
     /// Largest change of the hand targets' speed (m/s², > 0), in every phase: the hands start
     /// and brake instead of reaching their speed in one frame. Default: the profile's (NAO 2,
-    /// G1 100: unshaped; both methods).
+    /// G1 3; both methods).
     #[arg(long, value_name = "M_PER_S2", value_parser = positive, allow_negative_numbers = true)]
     pub(crate) tracking_acceleration: Option<f64>,
     /// Solver iterations per human frame (1–100).

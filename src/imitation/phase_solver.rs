@@ -362,7 +362,7 @@ impl PhaseSolver {
             matches!(
                 t.task,
                 Task::Orientation {
-                    target: OrientationTarget::Upright { .. },
+                    target: OrientationTarget::Upright { .. } | OrientationTarget::Facing { .. },
                     ..
                 }
             )
@@ -399,7 +399,8 @@ impl PhaseSolver {
         }
         // A hand placed on a support moves with the pelvis: then only the other leg settles.
         let legs_may_settle = targets.hand_contacts.iter().all(Option::is_none);
-        let (table, resolved) = (&self.table, (&self.tasks[..], &self.constraints[..]));
+        let resolved = (&self.tasks[..], &self.constraints[..], self.other_sole);
+        let table = &self.table;
         let mut tasks = PhaseTasks::new(model, data, resolved, table, targets, criteria)
             .moving(self.joints.as_deref());
         self.driver.run(&mut self.solver, &mut tasks, q, bounds)?;
@@ -443,7 +444,8 @@ impl PhaseSolver {
         if self.contact.is_none() {
             return Ok(0.0);
         }
-        let (table, resolved) = (&self.table, (&self.tasks[..], &self.constraints[..]));
+        let resolved = (&self.tasks[..], &self.constraints[..], self.other_sole);
+        let table = &self.table;
         let mut tasks = PhaseTasks::new(model, data, resolved, table, targets, criteria);
         let stack = self.solver.stack_mut();
         for task in self.tasks.iter().filter(|t| t.level == 0) {
@@ -619,6 +621,8 @@ struct PhaseTasks<'a> {
     data: &'a mut ModelData,
     tasks: &'a [ResolvedTask],
     constraints: &'a [ResolvedConstraint],
+    /// The other sole's frame (the target of [`OrientationTarget::Facing`]).
+    other_sole: FrameId,
     targets: FrameTargets<'a>,
     gradients: &'a [Gradient],
     criteria: Criteria<'a>,
@@ -631,12 +635,13 @@ struct PhaseTasks<'a> {
 }
 
 impl<'a> PhaseTasks<'a> {
-    /// The `tasks` and `constraints` of `table` (resolved against `model`) aiming at `targets`,
-    /// from the posture in `data`, whose kinematics are current.
+    /// The `tasks` and `constraints` of `table` (resolved against `model`, the other sole at
+    /// `other_sole`) aiming at `targets`, from the posture in `data`, whose kinematics are
+    /// current.
     fn new(
         model: &'a Model,
         data: &'a mut ModelData,
-        (tasks, constraints): (&'a [ResolvedTask], &'a [ResolvedConstraint]),
+        (tasks, constraints, other_sole): (&'a [ResolvedTask], &'a [ResolvedConstraint], FrameId),
         table: &'a TaskTable,
         targets: FrameTargets<'a>,
         criteria: Criteria<'a>,
@@ -646,6 +651,7 @@ impl<'a> PhaseTasks<'a> {
             data,
             tasks,
             constraints,
+            other_sole,
             targets,
             gradients: &table.gradients,
             criteria,
@@ -695,6 +701,12 @@ fn com_goal(
             (Vector2::from(support) + on_other(other)) * 0.5
         }
     }
+}
+
+/// Heading `yaw` (rad about z), then leaning `lean` rad about x (z toward +y for lean > 0):
+/// the target of [`OrientationTarget::Facing`].
+fn facing(lean: f64, yaw: f64) -> Rotation3<f64> {
+    Rotation3::from_axis_angle(&Vector3::x_axis(), -lean) * flat(yaw)
 }
 
 /// Flat (z up) with heading `yaw` (rad about z).
@@ -841,6 +853,14 @@ impl PhaseTasks<'_> {
                 // The vertical leaned by `lean` rad about x (toward +y for lean > 0).
                 let up = Vector3::new(0.0, lean.sin(), lean.cos());
                 upright_rows(self.model, self.data, point.frame, &up, jacobian, error)?
+            }
+            Task::Orientation {
+                target: OrientationTarget::Facing { lean },
+                ..
+            } => {
+                let x = data.frame_placement(self.other_sole).rotation * Vector3::x();
+                let target = facing(lean, 0.5 * x.y.atan2(x.x));
+                orientation_rows(model, data, point.frame, &target, jacobian, error)?
             }
             Task::Orientation {
                 target: OrientationTarget::Leaning,

@@ -226,6 +226,15 @@ pub enum OrientationTarget {
     /// leaning over the stance hip as far as the walking pattern generator's CoM is from the
     /// middle of the feet ([`super::walking`]).
     Leaning,
+    /// As [`OrientationTarget::Upright`] (the z axis leaning `lean` rad about the root sole's
+    /// x axis), with the x axis facing midway between the two soles' headings: 3 rows (the
+    /// rotation vector to that orientation, rad). The hips of a robot with a waist
+    /// ([`BipedProfile::chest`]): the hands then turn its upper body at the waist, not the
+    /// whole robot on its feet.
+    Facing {
+        /// Sideways lean (rad, about the root sole's x axis; + toward +y).
+        lean: f64,
+    },
 }
 
 /// One tracked task of an equality level.
@@ -278,6 +287,10 @@ impl Task {
                 frame,
                 target: OrientationTarget::Upright { .. } | OrientationTarget::Leaning,
             } => format!("{frame}.upright"),
+            Task::Orientation {
+                frame,
+                target: OrientationTarget::Facing { .. },
+            } => format!("{frame}.facing"),
         }
     }
 
@@ -288,7 +301,10 @@ impl Task {
             Task::ComHeight => 1,
             Task::Point { axes, .. } => axes.count(),
             Task::Orientation {
-                target: OrientationTarget::HeldFlat | OrientationTarget::Footstep,
+                target:
+                    OrientationTarget::HeldFlat
+                    | OrientationTarget::Footstep
+                    | OrientationTarget::Facing { .. },
                 ..
             } => 3,
             Task::Orientation {
@@ -508,6 +524,38 @@ fn foot_name(foot: Side) -> &'static str {
 fn foot_frames(profile: &BipedProfile, foot: Side) -> [&str; 3] {
     let f = profile.foot(foot);
     [f.ankle.as_str(), f.toe.as_str(), f.heel.as_str()]
+}
+
+/// The executable tables' posture tasks in `phase`: the torso upright (leaning toward the
+/// support, [`lean_toward_support`]) at its standing height, less [`torso_lowering`]. A robot
+/// with a chest ([`BipedProfile::chest`]) holds it upright too and its torso facing between
+/// its feet ([`OrientationTarget::Facing`]).
+fn posture(phase: SupportPhase, profile: &BipedProfile) -> Vec<Task> {
+    let lean = lean_toward_support(phase, profile);
+    let upright = |frame: &String| Task::Orientation {
+        frame: frame.clone(),
+        target: OrientationTarget::Upright { lean },
+    };
+    let torso = match &profile.chest {
+        Some(_) => Task::Orientation {
+            frame: profile.torso.clone(),
+            target: OrientationTarget::Facing { lean },
+        },
+        None => upright(&profile.torso),
+    };
+    let height = Task::Point {
+        frame: profile.torso.clone(),
+        offset: [0.0; 3],
+        axes: Axes::Z,
+        target: PointTarget::Standing {
+            lower: torso_lowering(phase, profile),
+        },
+    };
+    let chest = profile.chest.iter().map(upright);
+    std::iter::once(torso)
+        .chain(std::iter::once(height))
+        .chain(chest)
+        .collect()
 }
 
 /// How far below standing the executable tables carry the torso in `phase` (m): the profile's
@@ -766,7 +814,12 @@ impl TaskTable {
     ///   the balance level: in single support the hips shift over the
     ///   stance foot instead of the whole robot leaning 16° sideways, which put the swing foot
     ///   on the floor early when a servo sagged; and a hand out of reach cannot stretch the
-    ///   legs straight (a singular, slow posture to step from).
+    ///   legs straight (a singular, slow posture to step from). A robot with a waist
+    ///   ([`BipedProfile::chest`]) holds its chest upright too and its hips facing midway
+    ///   between its feet ([`OrientationTarget::Facing`]): the hands then turn the upper body
+    ///   at the waist's yaw only. Free, the G1's waist rolled up to 0.5 rad under the hand
+    ///   tasks, and with the waist held but the hips' heading free the hands turned the whole
+    ///   robot on its legs: loaded feet slid 3–11 mm in the judge (hold 60, bundled clips).
     /// * **Bodies keep apart** ("collision", below the balance level, when the profile has a
     ///   self-collision model): every pair of
     ///   [`BipedProfile::self_collision`](crate::robots::BipedProfile::self_collision) at least
@@ -848,25 +901,7 @@ impl TaskTable {
         let mut levels: Vec<Level> = contact.map(|c| level("contact", c)).into_iter().collect();
         levels.push(level("balance", vec![Task::ComXY(com)]));
         levels.extend(self_collision_level(profile));
-        levels.push(level(
-            "posture",
-            vec![
-                Task::Orientation {
-                    frame: profile.torso.clone(),
-                    target: OrientationTarget::Upright {
-                        lean: lean_toward_support(phase, profile),
-                    },
-                },
-                Task::Point {
-                    frame: profile.torso.clone(),
-                    offset: [0.0; 3],
-                    axes: Axes::Z,
-                    target: PointTarget::Standing {
-                        lower: torso_lowering(phase, profile),
-                    },
-                },
-            ],
-        ));
+        levels.push(level("posture", posture(phase, profile)));
         if let Some([height, reach]) = swing {
             levels.push(level("swing", height));
             levels.push(level("step", reach));
@@ -931,7 +966,8 @@ impl TaskTable {
                         ..
                     } if !lower.is_finite() => return Err(not_finite("lower")),
                     Task::Orientation {
-                        target: OrientationTarget::Upright { lean },
+                        target:
+                            OrientationTarget::Upright { lean } | OrientationTarget::Facing { lean },
                         ..
                     } if !lean.is_finite() => return Err(not_finite("lean")),
                     Task::Point { offset, .. } if offset.iter().any(|v| !v.is_finite()) => {
@@ -1102,6 +1138,9 @@ impl fmt::Display for TaskTable {
                             }
                             OrientationTarget::Leaning => {
                                 format!("z({frame}) leaning as the walk plans")
+                            }
+                            OrientationTarget::Facing { lean } => {
+                                format!("R({frame}) leaning {lean:.2} rad, facing between the feet")
                             }
                         });
                     }

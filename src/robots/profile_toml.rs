@@ -1,7 +1,7 @@
 //! A [`BipedProfile`] from a small TOML file next to the robot's URDF.
 //!
 //! Lengths in metres, angles in radians, frames as in the URDF (x forward, y left, z up). Every
-//! field but `variables`, `locked`, `stand`, `servo_saturation`, `sway_period`, `frames` and
+//! field but `variables`, `locked`, `chest`, `stand`, `servo_saturation`, `sway_period`, `frames` and
 //! `tuning` is
 //! required; an unknown field is an
 //! error (it is a typo more often than not).
@@ -13,6 +13,8 @@
 //! locked = { gripper = 0.0 }         # optional: joints fixed at a value
 //! hands = ["l_hand", "r_hand"]       # frames (links or `frames` below) tracking the hands
 //! torso = "base"                     # the frame held upright at its standing height
+//! chest = "chest"                    # optional: the upper body's frame above a waist
+//!                                    # (BipedProfile::chest)
 //! stand = { l_knee = 0.3, r_knee = 0.3 }  # standing posture; joints not named are 0
 //! servo_saturation = 0.035           # optional: rad of error at which a position servo gives
 //!                                    # its URDF effort (BipedProfile::servo_saturation)
@@ -93,6 +95,7 @@ struct File {
     locked: BTreeMap<String, f64>,
     hands: [String; 2],
     torso: String,
+    chest: Option<String>,
     #[serde(default)]
     stand: BTreeMap<String, f64>,
     servo_saturation: Option<f64>,
@@ -323,6 +326,7 @@ fn build(file: File, urdf: &str) -> Result<BipedProfile, ProfileError> {
         feet: [foot(Side::Left, feet[0]), foot(Side::Right, feet[1])],
         hands: file.hands,
         torso: file.torso,
+        chest: file.chest,
         points,
         stand,
         step_envelope: FootArea {

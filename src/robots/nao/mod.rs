@@ -378,6 +378,7 @@ pub fn profile_with(models: [Model; 2]) -> BipedProfile {
         feet: Side::BOTH.map(foot),
         hands: ["l_hand".to_owned(), "r_hand".to_owned()],
         torso: "torso".to_owned(),
+        chest: None,
         points: points(),
         stand: STAND.to_vec(),
         step_envelope: STEP_ENVELOPE,
