@@ -87,10 +87,11 @@ pub struct ImitatorConfig {
     /// [`MotionTuning::tracking_speed`](crate::robots::MotionTuning::tracking_speed) once both
     /// the human and the robot have stood on both feet for a second, and its
     /// [`stance_tracking_speed`](crate::robots::MotionTuning::stance_tracking_speed) otherwise
-    /// ([`super::shaping::HandSpeed`]; NAO 0.8 and 0.3 m/s, shaped at 2 m/s², G1 1.2 and 0.6 m/s at 3 m/s²; faster hands
-    /// turned loaded feet in the physics judge, see [`crate::robots::nao::TUNING`]), in both
-    /// methods; Poubel's
-    /// with the dynamic walk on ([`FootstepConfig::dynamic`]) uses the latter throughout.
+    /// ([`super::shaping::HandSpeed`]; NAO 0.8 and 0.3 m/s, shaped at 2 m/s², G1 1.2 and
+    /// 0.6 m/s at 3 m/s²; faster hands turned loaded feet in the physics judge, see
+    /// [`crate::robots::nao::TUNING`] and [`crate::robots::g1::TUNING`]), in both methods;
+    /// Poubel's with the dynamic walk on ([`FootstepConfig::dynamic`]) uses the latter
+    /// throughout.
     pub max_tracking_speed: Option<f64>,
     /// Largest change of the hands' speed toward their targets (m/s², > 0) in every phase, both
     /// methods ([`super::shaping::HandRates`]). `None` (default): the profile's

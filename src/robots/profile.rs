@@ -280,11 +280,11 @@ impl BipedProfile {
     }
 
     /// Checks the profile against its models: both models have the same variables, every frame
-    /// the profile names exists in both, a chest is not the torso, each model's base is its sole, the outlines have three
-    /// or more finite corners, the standing posture is finite and inside the limits, the step
-    /// envelope is valid, the servo saturation (if any) is a finite angle > 0, the
-    /// self-collision bodies resolve on both models ([`SelfCollision::resolve`]) and every pair
-    /// keeps its margin in the standing posture. The error names the field.
+    /// the profile names exists in both, a chest is not the torso, each model's base is its
+    /// sole, the outlines have three or more finite corners, the standing posture is finite and
+    /// inside the limits, the step envelope is valid, the servo saturation (if any) is a finite
+    /// angle > 0, the self-collision bodies resolve on both models ([`SelfCollision::resolve`])
+    /// and every pair keeps its margin in the standing posture. The error names the field.
     pub fn validate(&self) -> Result<(), ProfileError> {
         let invalid = |field: &str, reason: String| ProfileError::Invalid {
             field: field.to_owned(),
