@@ -1,10 +1,9 @@
 //! A [`BipedProfile`] from a small TOML file next to the robot's URDF.
 //!
 //! Lengths in metres, angles in radians, frames as in the URDF (x forward, y left, z up). Every
-//! field but `variables`, `locked`, `chest`, `stand`, `servo_saturation`, `sway_period`, `frames` and
-//! `tuning` is
-//! required; an unknown field is an
-//! error (it is a typo more often than not).
+//! field but `variables`, `locked`, `chest`, `stand`, `servo_saturation`, `sway_period`,
+//! `frames` and `tuning` is required; an unknown field is an error (it is a typo more often
+//! than not).
 //!
 //! ```toml
 //! name = "tiny"
