@@ -439,9 +439,11 @@ fn imitator_config_out_of_range_is_refused_by_name() {
         refused(name, set, &[f64::NAN, f64::INFINITY, 0.0, -1.0]);
     }
     // Footstep thresholds may be 0 (step at once) but not negative or NaN.
-    let steps: [(&str, Set); 4] = [
+    let steps: [(&str, Set); 6] = [
         ("footsteps.distance", |c, v| c.footsteps.distance = v),
         ("footsteps.heading", |c, v| c.footsteps.heading = v),
+        ("footsteps.pivot", |c, v| c.footsteps.pivot = v),
+        ("footsteps.slide", |c, v| c.footsteps.slide = v),
         ("footsteps.stance_time", |c, v| c.footsteps.stance_time = v),
         ("footsteps.swing_timeout", |c, v| {
             c.footsteps.swing_timeout = v

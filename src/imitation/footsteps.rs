@@ -76,6 +76,16 @@ pub struct FootstepConfig {
     /// A foot turned more than this from its target's heading (rad) is moved by a step.
     /// Default 0.087 (5°).
     pub heading: f64,
+    /// Not walking dynamically, a human foot on the ground keeps the footprint it landed with
+    /// until it has turned more than this from it (rad) or moved more than [`Self::slide`];
+    /// from then until it lifts, its footprint is followed (a pivot turn, a shuffle).
+    /// Default 0.26 (15°): a standing human's foot heading (ankle → toe) rolls and jitters by
+    /// up to 12° in the bundled captures, which made the robot step in place on clips where the
+    /// human never steps.
+    pub pivot: f64,
+    /// See [`Self::pivot`] (m, in the human's world, unscaled). Default 0.05: a standing
+    /// human's ankle moves by up to 3.2 cm in the bundled captures as the foot rolls.
+    pub slide: f64,
     /// A human standing on one foot this long (s) is followed onto one leg. Default 0.3.
     pub stance_time: f64,
     /// Walking dynamically, a human standing on one foot this long (s) is followed onto one
@@ -96,6 +106,8 @@ impl Default for FootstepConfig {
             walking_arms: false,
             distance: 0.02,
             heading: 0.087,
+            pivot: 0.26,
+            slide: 0.05,
             stance_time: 0.3,
             long_stance_time: 1.0,
             swing_timeout: 2.0,
@@ -109,6 +121,8 @@ impl FootstepConfig {
         [
             ("footsteps.distance", self.distance),
             ("footsteps.heading", self.heading),
+            ("footsteps.pivot", self.pivot),
+            ("footsteps.slide", self.slide),
             ("footsteps.stance_time", self.stance_time),
             ("footsteps.long_stance_time", self.long_stance_time),
             ("footsteps.swing_timeout", self.swing_timeout),
@@ -174,8 +188,12 @@ enum Step {
 pub struct FootstepPlanner {
     area: FootArea,
     config: FootstepConfig,
-    /// The human's last footprint of each foot (left, right), human world.
+    /// The human's footprint of each foot (left, right; human world): where it landed until
+    /// it pivots or slides (see [`FootstepConfig::pivot`]), then its last; looking ahead,
+    /// where a foot about to be lifted will land.
     human: [Option<GroundPose>; 2],
+    /// Which human feet (left, right) have pivoted or slid since they landed.
+    moved: [bool; 2],
     /// Each human foot's footprint where it last landed (left, right; human world): taken over
     /// the first [`LANDING_SETTLE`] seconds on the ground, then kept while the foot stays
     /// down, so a foot pivoting or rolling in place is no step.
@@ -224,6 +242,7 @@ impl FootstepPlanner {
             area,
             human: [None; 2],
             landed: [None; 2],
+            moved: [false; 2],
             down_for: [0.0; 2],
             origin: None,
             stance: None,
@@ -353,6 +372,7 @@ impl FootstepPlanner {
     /// walking) or the scaled human footprints (walking).
     fn aims(&mut self, feet: [GroundPose; 2], ratio: f64) -> Aims {
         if self.origin.is_none()
+            && Side::BOTH.iter().all(|&f| self.has_settled(f))
             && let [Some(l), Some(r)] = *self.prints()
         {
             let heading = |[l, r]: [GroundPose; 2]| wrap(r.yaw + 0.5 * wrap(l.yaw - r.yaw));
@@ -532,11 +552,12 @@ impl FootstepPlanner {
             if down[i]
                 && let Some(print) = footprint(frame, foot)
             {
-                self.human[i] = Some(print);
                 if self.landed[i].is_none() || self.down_for[i] <= LANDING_SETTLE {
                     self.landed[i] = Some(print);
                 }
+                self.human[i] = Some(self.unless_moved(foot, print));
             }
+            self.moved[i] &= down[i];
             // Looking ahead, a foot about to be lifted (or in the air) aims at where it lands.
             let ahead = self.ahead.as_ref();
             let lift = ahead.and_then(|a| a.schedule.lift_within(foot, frame.time, a.times.shift));
@@ -554,6 +575,28 @@ impl FootstepPlanner {
             (Some(f), _) => Some((f, dt)),
             (None, _) => None,
         };
+    }
+
+    /// Whether the human's `foot` has a footprint that no longer settles: it landed, and has
+    /// stood [`LANDING_SETTLE`] or been lifted since. The starting stances are taken from
+    /// such footprints, as the steps' targets are: a heading taken in the first frames of a
+    /// noisy capture (the Kinect clips' feet turn 6° in their first 0.1 s) would otherwise read as a turn.
+    fn has_settled(&self, foot: Side) -> bool {
+        let i = foot.index();
+        self.landed[i].is_some() && (!self.down[i] || self.down_for[i] > LANDING_SETTLE)
+    }
+
+    /// The footprint `foot` landed with, until `print` (its footprint now, on the ground) has
+    /// turned or moved from it by more than [`FootstepConfig::pivot`] or
+    /// [`FootstepConfig::slide`]; from then until the foot lifts, `print`.
+    fn unless_moved(&mut self, foot: Side, print: GroundPose) -> GroundPose {
+        let i = foot.index();
+        let Some(landed) = self.landed[i] else {
+            return print;
+        };
+        let (c, d) = (&self.config, landed.relative(&print));
+        self.moved[i] |= d.yaw.abs() > c.pivot || d.xy.norm() > c.slide;
+        if self.moved[i] { print } else { landed }
     }
 
     /// The target of `foot` (robot world): its scaled human footprint, clipped to the envelope
@@ -694,10 +737,10 @@ mod tests {
         let mut planner = FootstepPlanner::new(walking(), AREA);
         let double = SupportPhase::Double;
         let dt = 0.01;
-        // Standing: no step.
+        // Standing 0.25 s (the footprints settle): no step.
         let start = human([0.0, -0.1], [0.0, 0.1]);
         let s = planner
-            .update(&start, HumanSupport::Double, 0.25, FEET, double, dt)
+            .update(&start, HumanSupport::Double, 0.25, FEET, double, 0.25)
             .support;
         assert_eq!(s, HumanSupport::Double);
         assert_eq!(planner.steps_pending(), 0);
@@ -778,11 +821,81 @@ mod tests {
                 0.25,
                 FEET,
                 SupportPhase::Double,
-                0.01,
+                0.25,
             )
             .support;
+        assert!(planner.origin.is_some(), "the footprints settled");
         assert_eq!(s, HumanSupport::Double);
         assert_eq!(planner.steps_pending(), 0);
+    }
+
+    /// A standing human with the right toe turned by `yaw` (rad) from +x.
+    fn right_toe_turned(yaw: f64) -> HumanFrame {
+        let mut frame = human([0.0, -0.1], [0.0, 0.1]);
+        let toe = nalgebra::Vector3::new(0.15 * yaw.cos(), -0.1 + 0.15 * yaw.sin(), 0.02);
+        frame.set(HumanJoint::RToe, Some(toe));
+        frame
+    }
+
+    /// A foot on the ground whose heading jitters within `pivot` (12° here, against the 5°
+    /// step threshold) is no step; one that turns past it is followed to its full heading.
+    #[test]
+    fn a_foot_on_the_ground_is_turned_only_by_a_pivot() {
+        let mut planner = FootstepPlanner::new(walking(), AREA);
+        let mut update = |yaw: f64| {
+            let frame = right_toe_turned(yaw);
+            let double = SupportPhase::Double;
+            planner.update(&frame, HumanSupport::Double, 0.25, FEET, double, 0.01);
+            (planner.steps_pending(), planner.target())
+        };
+        // The footprint settles over the first 0.2 s on the ground.
+        for _ in 0..30 {
+            assert_eq!(update(0.0), (0, None));
+        }
+        for k in 0..100 {
+            let jitter = 0.21 * (0.3 * f64::from(k)).sin();
+            assert_eq!(
+                update(jitter),
+                (0, None),
+                "frame {k}: jitter {jitter:.3} rad"
+            );
+        }
+        // 0.3 rad is past the 0.26 rad pivot: the right foot is stepped, to the envelope's
+        // 0.15 rad (the left foot, its reference, stands at 0).
+        let (pending, target) = update(-0.3);
+        assert_eq!(pending, 1);
+        let (foot, target) = target.expect("a step");
+        assert_eq!(foot, Side::Right);
+        assert!((target.yaw + 0.15).abs() < 1e-12, "{target:?}");
+        // Once pivoted, the foot's heading is followed back within the pivot too.
+        let (_, target) = update(-0.1);
+        assert!((target.expect("the step").1.yaw + 0.1).abs() < 1e-12);
+    }
+
+    /// A foot on the ground whose ankle wanders within `slide` (4 cm here, against the 2 cm step
+    /// threshold at ratio 1) is no step; one that slides past it is followed.
+    #[test]
+    fn a_foot_on_the_ground_is_moved_only_by_a_slide() {
+        let mut planner = FootstepPlanner::new(walking(), AREA);
+        let mut update = |x: f64| {
+            let frame = human([x, -0.1], [0.0, 0.1]);
+            let double = SupportPhase::Double;
+            planner.update(&frame, HumanSupport::Double, 1.0, FEET, double, 0.01);
+            (planner.steps_pending(), planner.target())
+        };
+        for _ in 0..30 {
+            assert_eq!(update(0.0), (0, None));
+        }
+        for k in 0..100 {
+            let x = 0.04 * (0.3 * f64::from(k)).sin();
+            assert_eq!(update(x), (0, None), "frame {k}: x {x:.3} m");
+        }
+        // 6 cm forward is past the 5 cm slide: a step, clipped to the envelope's 5 cm.
+        let (pending, target) = update(0.06);
+        assert_eq!(pending, 1);
+        let (foot, target) = target.expect("a step");
+        assert_eq!(foot, Side::Right);
+        assert!((target.xy.x - 0.05).abs() < 1e-12, "{target:?}");
     }
 
     #[test]
@@ -884,7 +997,10 @@ mod tests {
     fn looking_ahead_a_walking_foot_aims_where_the_human_foot_lands() {
         let (h, p) = (HumanSupport::Double, SupportPhase::Double);
         let mut planner = looking_ahead(walking(), 1.5);
-        at(&mut planner, 0.0, h, p);
+        // Standing 0.25 s: the footprints settle.
+        for k in 0..25 {
+            at(&mut planner, 0.01 * f64::from(k), h, p);
+        }
         // 0.4 m ahead, 0.1 m at ratio 0.25, clipped to the envelope's 0.05 m: a step before
         // the human lifts, the foot waiting for the human's.
         let request = at(&mut planner, 0.6, h, p);
