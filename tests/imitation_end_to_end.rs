@@ -209,6 +209,30 @@ fn walks_are_walked() {
     }
 }
 
+/// Walking step by step, a human standing in place takes the robot nowhere: on CMU 02_10 and
+/// the two Kinect clips the human never steps, but a standing foot's heading (ankle → toe)
+/// jitters by up to 12° and its ankle by up to 3.2 cm, against the planner's 5° and 2 cm step
+/// thresholds (before `FootstepConfig::pivot` and `slide` the NAO stepped 3, 1 and 2 times).
+#[test]
+fn walking_takes_no_step_for_a_standing_human() {
+    for name in [
+        "cmu_02_10_wash_self_standing_arm_gestures.bvh",
+        "kinect2_labanotation_ges01_wavehand.csv",
+        "kinect2_labanotation_ges02_balancinghands.csv",
+    ] {
+        let config = ImitatorConfig {
+            footsteps: FootstepConfig {
+                follow: true,
+                ..FootstepConfig::default()
+            },
+            ..ImitatorConfig::default()
+        };
+        let (m, _) = run_held(name, config, HELD_FOOT_TOLERANCE, SETTLE_SECONDS);
+        assert_eq!(m.robot_steps, 0, "{name}");
+        assert_eq!(m.robot_support_sequence, vec!["DS"], "{name}");
+    }
+}
+
 /// How far (m, rad) a standing foot may move in the plan of a dynamic walk: the walking table's
 /// contact level ends every frame with its own Newton step, as the support phases' does
 /// (measured: under 1e-9 m; 4e-5 m on CMU 09_12 before it had one).
