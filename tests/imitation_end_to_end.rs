@@ -11,7 +11,7 @@
 
 mod common;
 
-use taskstack::human::{HumanFrame, Side};
+use taskstack::human::{HumanFrame, HumanJoint, Side};
 use taskstack::imitation::config::ImitationMethod;
 use taskstack::imitation::footsteps::FootstepConfig;
 use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
@@ -50,8 +50,10 @@ const HELD_FOOT_TOLERANCE: f64 = 1e-6;
 const KOENEMANN_FOOT_TOLERANCE: f64 = 2e-5;
 
 /// How far inside the self-collision margin a body may end a frame (m): the IK's first-order
-/// step toward the margin overshoots it by its second-order term, corrected at the next frame.
-const CLEARANCE_TOLERANCE: f64 = 5e-4;
+/// step toward the margin overshoots it by its second-order term, corrected at the next frame
+/// (measured: 0.57 mm of the 10 mm margin, the right forearm over the head on Kinect ges01,
+/// since the arms hang from the robot's shoulders and the waving hand aims over the head).
+const CLEARANCE_TOLERANCE: f64 = 1e-3;
 
 fn run_with(
     name: &str,
@@ -650,6 +652,51 @@ fn the_hands_keep_the_elbows_bent() {
     }
     assert!(least >= 0.27, "an elbow at {least} rad");
     assert!(least < 0.33, "the elbows never near straight: {least} rad");
+}
+
+/// Poubel's method hangs the scaled arms from the robot's shoulders: each frame's shoulder
+/// references are the NAO's shoulder frames in the posture it stood in before the frame
+/// (forward kinematics here, in the model of the frame's root: CMU 07_04 steps onto a leg, so
+/// the root switches soles), and on this walk no hand reference lies beyond the arm's reach
+/// (61 of its frames did with the arms hung from the scaled shoulders, the human's shoulders
+/// swaying as it walks).
+#[test]
+fn the_arms_hang_from_the_robots_shoulders() {
+    let (mut clip, mut imitator) = nao_on("cmu_07_04_slow_walk.bvh");
+    let profile = imitator.profile().clone();
+    let mut data = profile.models.each_ref().map(|m| m.new_data());
+    let mut recorder = MetricsRecorder::new(&imitator);
+    let mut frame = HumanFrame::new(0.0);
+    let mut before: Option<Vec<f64>> = None;
+    let mut checked = 0;
+    while clip.read_frame(&mut frame).unwrap() {
+        let out = imitator.step(&frame).unwrap();
+        recorder.record(out);
+        if let Some(q) = &before {
+            let (model, data) = (profile.model(out.root), &mut data[out.root.index()]);
+            model.forward_kinematics(data, q).unwrap();
+            for (joint, name) in [
+                (HumanJoint::LShoulder, "l_shoulder"),
+                (HumanJoint::RShoulder, "r_shoulder"),
+            ] {
+                let robot = data.frame_placement(model.frame_id(name).unwrap());
+                let reference = out.reference[joint.index()].expect("a shoulder reference");
+                assert!(
+                    (robot.translation.vector - reference).norm() < 1e-12,
+                    "t = {}: {name} {reference} vs the robot's {}",
+                    out.time,
+                    robot.translation.vector
+                );
+            }
+            checked += 1;
+        }
+        before = Some(out.q.clone());
+    }
+    assert!(checked > 400, "{checked} frames");
+    let reach = recorder.finish().hand_reach.expect("the NAO maps its arms");
+    for hand in reach {
+        assert_eq!(hand.unreachable_frames, 0, "{hand:?}");
+    }
 }
 
 /// What a frame reports of the robot (its hands and ankles in the root's frame, the world CoM)

@@ -160,7 +160,9 @@ impl MotionTrack {
         let quat = if w == 0.0 {
             src.root_quat[a]
         } else {
+            // nalgebra's slerp of two nearly equal rotations leaves the norm 1e-9 off.
             let q = unit(src.root_quat[a]).slerp(&unit(src.root_quat[b]), w);
+            let q = UnitQuaternion::new_normalize(q.into_inner());
             [q.i, q.j, q.k, q.w]
         };
         self.root_quat.push(quat);

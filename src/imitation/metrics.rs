@@ -2,7 +2,10 @@
 //!
 //! * **Tracking**: distance between each tracked effector (hands, free ankle) and its scaled
 //!   reference, in the model root's frame (m), split by single support, double support and the
-//!   transition steps ([`SupportKind`]): on every frame whose phase tracks it.
+//!   transition steps ([`SupportKind`]): on every frame whose phase tracks it. The hands'
+//!   references are the human's arms hung from the robot's shoulders (Poubel's method:
+//!   `imitation::shoulder_anchor`; Koenemann's: its own arm mapping), so the error is the arms'
+//!   copy, not the trunk's.
 //! * **Static stability**: the signed distance of the CoM ground projection to the edge of the
 //!   support polygon (positive inside, m): the convex hull of the sole outlines
 //!   ([`FootFrames::outline`](crate::robots::FootFrames::outline)) of the feet on the ground, a foot being on the ground when all its

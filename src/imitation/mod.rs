@@ -28,6 +28,7 @@ mod poubel;
 pub mod reach;
 pub mod scaler;
 pub mod shaping;
+mod shoulder_anchor;
 pub mod support;
 pub mod tables;
 pub mod travel;

@@ -38,6 +38,7 @@ use super::phase_solver::{Criteria, FrameTargets, PhaseSolver};
 use super::reach::Arm;
 use super::scaler::{RobotSkeleton, ScaleConfig, Scaler};
 use super::shaping::{ComReference, HandRates, HandSpeed, MotionLimits, StartRamp, SwingHeight};
+use super::shoulder_anchor::hang_arms_from_robot_shoulders;
 use super::support::{HumanSupport, SupportDetector};
 use super::tables::{PointTarget, Task, TaskTable, TaskTables};
 use super::walking::follower::WalkFollower;
@@ -577,6 +578,13 @@ impl PoubelImitator {
         for (out, (_, p)) in self.shared.output.reference.iter_mut().zip(scaled.points()) {
             *out = p.map(|p| root_t_base.transform_point(&p.into()).coords);
         }
+        // The arms from the robot's shoulders (`shoulder_anchor`): the data is this frame's
+        // root model at the posture before the solve.
+        hang_arms_from_robot_shoulders(
+            &self.arms[root],
+            &self.shared.data[root],
+            &mut self.shared.output.reference,
+        );
         Ok(())
     }
 

@@ -2,7 +2,9 @@
 //! hand targets the imitation keeps within reach.
 //!
 //! A hand's scaled reference is placed from the *scaled* shoulder with the robot's segment
-//! lengths ([`super::scaler`], eq. 1), so it is always within the arm's length of that point.
+//! lengths ([`super::scaler`], eq. 1), so it is always within the arm's length of that point;
+//! Poubel's method then hangs the arm from the robot's shoulder (`imitation::shoulder_anchor`),
+//! which leaves the references the robot's elbow cannot fold to.
 //! The robot's own shoulder is elsewhere whenever its trunk does not follow the scaled one: the
 //! tables hold the torso upright over the stance foot, a robot standing on bent knees carries
 //! its hips lower than the scaled hips, and a robot whose waist is not tracked (the G1) keeps
@@ -64,6 +66,10 @@ pub(super) struct Arm {
     /// The shoulder point is the mean of these frames' origins (the same frame twice for a
     /// [`RobotPoint::Frame`]).
     shoulder: [FrameId; 2],
+    /// The profile's torso frame, and the shoulder point in it in the standing posture: where
+    /// the shoulder stands whatever a waist between them does.
+    torso: FrameId,
+    shoulder_in_torso: Vector3<f64>,
     /// The shoulder–hand distances the elbow spans over its joint range, `[nearest, farthest]`
     /// (m): the arm's reach.
     span: [f64; 2],
@@ -118,10 +124,18 @@ impl Arm {
             hand,
             hand_frame: frame(&profile.hands[side.index()])?,
             shoulder,
+            torso: frame(&profile.torso)?,
+            shoulder_in_torso: Vector3::zeros(),
             span: [0.0; 2],
             kept_reach: 0.0,
             elbow: None,
         };
+        let mut data = model.new_data();
+        model.forward_kinematics(&mut data, &profile.stand).ok()?;
+        let torso = data.frame_placement(arm.torso);
+        arm.shoulder_in_torso = torso
+            .inverse_transform_point(&arm.shoulder_point(&data).into())
+            .coords;
         arm.measure(model, &profile.stand)?;
         Some(arm)
     }
@@ -205,11 +219,19 @@ impl Arm {
     }
 
     /// The shoulder point of the kinematics in `data` (model base frame, m).
-    fn shoulder_point(&self, data: &ModelData) -> Vector3<f64> {
+    pub(super) fn shoulder_point(&self, data: &ModelData) -> Vector3<f64> {
         let [a, b] = self
             .shoulder
             .map(|f| data.frame_placement(f).translation.vector);
         (a + b) * 0.5
+    }
+
+    /// The shoulder point of the standing posture carried by the torso of the kinematics in
+    /// `data` (model base frame, m): the shoulder point itself when no joint lies between
+    /// them, and for a robot with a waist where the shoulder stands with the waist at rest.
+    pub(super) fn torso_shoulder_point(&self, data: &ModelData) -> Vector3<f64> {
+        let torso = data.frame_placement(self.torso);
+        torso.transform_point(&self.shoulder_in_torso.into()).coords
     }
 
     /// The distance from the shoulder point to the hand in `data` (m).
