@@ -183,14 +183,7 @@ fn walks_are_walked() {
         "cmu_09_12_walk_forward_backward_sideways.bvh",
         "cmu_131_01_start_walk_stop_maxskel.bvh",
     ] {
-        let config = ImitatorConfig {
-            footsteps: FootstepConfig {
-                follow: true,
-                ..FootstepConfig::default()
-            },
-            ..ImitatorConfig::default()
-        };
-        let (m, _) = run_held(name, config, HELD_FOOT_TOLERANCE, 60.0);
+        let (m, _) = run_held(name, step_by_step(), HELD_FOOT_TOLERANCE, 60.0);
         let singles: Vec<&str> = m
             .robot_support_sequence
             .iter()
@@ -222,14 +215,7 @@ fn walking_takes_no_step_for_a_standing_human() {
         "kinect2_labanotation_ges01_wavehand.csv",
         "kinect2_labanotation_ges02_balancinghands.csv",
     ] {
-        let config = ImitatorConfig {
-            footsteps: FootstepConfig {
-                follow: true,
-                ..FootstepConfig::default()
-            },
-            ..ImitatorConfig::default()
-        };
-        let (m, _) = run_held(name, config, HELD_FOOT_TOLERANCE, SETTLE_SECONDS);
+        let (m, _) = run_held(name, step_by_step(), HELD_FOOT_TOLERANCE, SETTLE_SECONDS);
         assert_eq!(m.robot_steps, 0, "{name}");
         assert_eq!(m.robot_support_sequence, vec!["DS"], "{name}");
     }
@@ -318,6 +304,17 @@ fn walking_arms_follow_the_human_hands() {
         following < 0.8 * held,
         "{name}: {held:.4} → {following:.4} m"
     );
+}
+
+/// Walking step by step (`--walk`).
+fn step_by_step() -> ImitatorConfig {
+    ImitatorConfig {
+        footsteps: FootstepConfig {
+            follow: true,
+            ..FootstepConfig::default()
+        },
+        ..ImitatorConfig::default()
+    }
 }
 
 fn dynamic() -> ImitatorConfig {
