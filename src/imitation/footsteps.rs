@@ -582,7 +582,8 @@ impl FootstepPlanner {
     /// Whether the human's `foot` has a footprint that no longer settles: it landed, and has
     /// stood [`LANDING_SETTLE`] or been lifted since. The starting stances are taken from
     /// such footprints, as the steps' targets are: a heading taken in the first frames of a
-    /// noisy capture (the Kinect clips' feet turn 6° in their first 0.1 s) would otherwise read as a turn.
+    /// noisy capture (the Kinect clips' feet turn 6° in their first 0.1 s) would otherwise
+    /// read as a turn.
     fn has_settled(&self, foot: Side) -> bool {
         let i = foot.index();
         self.landed[i].is_some() && (!self.down[i] || self.down_for[i] > LANDING_SETTLE)
