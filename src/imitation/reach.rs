@@ -130,26 +130,24 @@ impl Arm {
             kept_reach: 0.0,
             elbow: None,
         };
-        let mut data = model.new_data();
-        model.forward_kinematics(&mut data, &profile.stand).ok()?;
-        let torso = data.frame_placement(arm.torso);
-        arm.shoulder_in_torso = torso
-            .inverse_transform_point(&arm.shoulder_point(&data).into())
-            .coords;
         arm.measure(model, &profile.stand)?;
         Some(arm)
     }
 
-    /// Finds the elbow and the spans from `stand` (see [`Elbow`]); `None` when the forward
-    /// kinematics fails (a posture of the wrong length).
+    /// Finds the shoulder in the torso frame, the elbow and the spans from `stand` (see
+    /// [`Elbow`]); `None` when the forward kinematics fails (a posture of the wrong length).
     fn measure(&mut self, model: &Model, stand: &[f64]) -> Option<()> {
         let mut data = model.new_data();
+        model.forward_kinematics(&mut data, stand).ok()?;
+        let torso = data.frame_placement(self.torso);
+        self.shoulder_in_torso =
+            (torso.inverse_transform_point(&self.shoulder_point(&data).into())).coords;
+        let standing = self.hand_distance(&data);
         let mut q = stand.to_vec();
         let mut distance = |q: &[f64]| {
             model.forward_kinematics(&mut data, q).ok()?;
             Some(self.hand_distance(&data))
         };
-        let standing = distance(&q)?;
         let (mut elbow, mut widest) = (None, 0.0);
         for (k, v) in model.variables().iter().enumerate() {
             if !(v.lower.is_finite() && v.upper.is_finite() && v.upper > v.lower) {

@@ -551,11 +551,9 @@ fn posture(phase: SupportPhase, profile: &BipedProfile) -> Vec<Task> {
             lower: torso_lowering(phase, profile),
         },
     };
-    let chest = profile.chest.iter().map(upright);
-    std::iter::once(torso)
-        .chain(std::iter::once(height))
-        .chain(chest)
-        .collect()
+    let mut tasks = vec![torso, height];
+    tasks.extend(profile.chest.iter().map(upright));
+    tasks
 }
 
 /// How far below standing the executable tables carry the torso in `phase` (m): the profile's
