@@ -696,6 +696,26 @@ fn the_arms_hang_from_the_robots_shoulders() {
     }
 }
 
+/// The CoM tasks move only the joints that turn the torso, a sole or a hand: the NAO's head,
+/// which moves the CoM by millimetres per radian, stays where the posture gradient keeps it,
+/// facing forward (a clip gives no head angles). When the balance level also moved the head,
+/// a level the straight legs could not meet drove it at its speed limit: over CMU 07_04 the
+/// head turned 0.57 rad and pitched 0.37 rad (measured before the change; on 02_10 it swept its
+/// whole yaw range, ±2.09 rad).
+#[test]
+fn the_balance_level_leaves_the_head_alone() {
+    let (mut clip, mut imitator) = nao_on("cmu_07_04_slow_walk.bvh");
+    let model = imitator.profile().model(Side::Right);
+    let head = ["HeadYaw", "HeadPitch"].map(|name| model.variable_index(name).unwrap());
+    let mut frame = HumanFrame::new(0.0);
+    let mut largest: f64 = 0.0;
+    while clip.read_frame(&mut frame).unwrap() {
+        let q = &imitator.step(&frame).unwrap().q;
+        largest = head.iter().fold(largest, |m, &k| m.max(q[k].abs()));
+    }
+    assert!(largest < 0.1, "the head turned {largest} rad");
+}
+
 /// What a frame reports of the robot (its hands and ankles in the root's frame, the world CoM)
 /// is the forward kinematics of the posture it reports, computed here afresh in the model of
 /// the frame's root. Poubel's method reuses the kinematics its last solve left instead of

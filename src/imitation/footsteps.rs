@@ -53,9 +53,9 @@ pub struct FootstepConfig {
     /// place and putting it back where it was. Walking (`imitate --walk`; the imitator then
     /// uses [`TaskTables::centre_stances_for_walking`](super::tables::TaskTables::centre_stances_for_walking))
     /// passes the physics judge on 13 of the NAO's 16 runs of the bundled clips online (hold
-    /// 60, both models; a loaded foot turning 2.3–2.7°, 2° allowed) and on 14 of 16 offline
-    /// (one weak run falls); the G1's walking steps fall on the judge's weak model: not yet
-    /// the default.
+    /// 60, both models; a loaded foot turning 2.0–3.6° on the weak model, 2° allowed) and on
+    /// 14 of 16 offline (07_04's loaded foot turning 2.3–2.4°); the G1's walking steps fall on
+    /// the judge's weak model: not yet the default.
     pub follow: bool,
     /// With `follow`, walk with the pattern generator ([`super::walking`]): dynamic steps
     /// (NAO: 1.0 s double + 0.67 s single support while following the human) instead of

@@ -13,7 +13,7 @@ use super::tables::{
     TaskTable,
 };
 use super::zmp_balance::SupportZmp;
-use crate::human::HumanJoint;
+use crate::human::{HumanJoint, Side};
 use crate::model::{Axis, FrameId, Model, ModelData};
 use crate::robots::BipedProfile;
 use crate::solver::driver::{DriverReport, DriverSettings, PositionDriver, TaskModel};
@@ -56,6 +56,8 @@ struct ResolvedTask {
     held: Vector3<f64>,
     /// Held heading (yaw of the frame's x axis when the step began), rad, root frame.
     held_yaw: f64,
+    /// The joints the task may move ([`balance_joints`] for the CoM); `None`: all.
+    joints: Option<Vec<bool>>,
 }
 
 /// A constraint of a table, resolved against a model: its rows and where they are.
@@ -180,6 +182,7 @@ impl PhaseSolver {
         model.forward_kinematics(&mut rest, &vec![0.0; model.nv()])?;
         let mut initial = model.new_data();
         model.forward_kinematics(&mut initial, initial_q)?;
+        let balance = balance_joints(profile, model, &initial)?;
         let mut tasks = Vec::new();
         for (level, l) in table.levels.iter().enumerate() {
             let mut row = 0;
@@ -220,6 +223,8 @@ impl PhaseSolver {
                     standing,
                     held: Vector3::zeros(),
                     held_yaw: 0.0,
+                    joints: matches!(task, Task::ComXY(_) | Task::ComHeight)
+                        .then(|| balance.clone()),
                 });
                 row += task.rows();
             }
@@ -536,6 +541,31 @@ fn turning(model: &Model, data: &ModelData, frame: FrameId) -> Result<Vec<bool>,
         .collect())
 }
 
+/// The joints the CoM tasks of `profile` may move in `model` (at the posture in `data`): those
+/// that turn the torso, a sole or a hand. A joint that turns none of them (the NAO's head)
+/// moves the CoM by millimetres per radian, so a balance level the legs could not meet (a
+/// knee straight at its limit) drove it at its speed limit: the NAO's head swept its whole
+/// yaw range, ±2.09 rad, back and forth while the human washed (17 rad of travel over CMU
+/// 02_10) and on every walking clip with `--walk`. Such joints follow the posture gradient.
+fn balance_joints(
+    profile: &BipedProfile,
+    model: &Model,
+    data: &ModelData,
+) -> Result<Vec<bool>, ImitationError> {
+    let soles = Side::BOTH.map(|side| profile.foot(side).sole.as_str());
+    let frames = (soles.into_iter())
+        .chain(profile.hands.iter().map(String::as_str))
+        .chain([profile.torso.as_str()]);
+    let mut joints = vec![false; model.nv()];
+    for frame in frames {
+        let turns = turning(model, data, model.frame_id(frame)?)?;
+        for (joint, turns) in joints.iter_mut().zip(turns) {
+            *joint |= turns;
+        }
+    }
+    Ok(joints)
+}
+
 /// The joints that turn `frame` but not `torso` in `model` (at the posture in `data`): a
 /// foot's own leg joints, a hand's own arm joints.
 pub(super) fn own_joints(
@@ -749,6 +779,7 @@ impl TaskModel for PhaseTasks<'_> {
             let mut level = stack.level_mut(task.level);
             let (mut jacobian, target) = level.rows_mut(task.row, task.rows);
             self.write(task, jacobian.as_mut(), target)?;
+            keep_columns(jacobian.as_mut(), task.joints.as_deref());
             keep_columns(jacobian, self.joints);
         }
         for c in self.constraints {

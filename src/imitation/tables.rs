@@ -240,7 +240,9 @@ pub enum OrientationTarget {
 /// One tracked task of an equality level.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Task {
-    /// The CoM ground projection (2 rows).
+    /// The CoM ground projection (2 rows). Like [`Task::ComHeight`] it moves only the joints
+    /// that turn the torso, a sole or a hand: a joint that turns none of them (the NAO's head)
+    /// moves the CoM by millimetres per radian and is left to the posture gradient.
     ComXY(ComGoal),
     /// The CoM's height above the root sole (1 row), at the walk's planned height
     /// ([`super::walking`]): the cart-table's constant height.
