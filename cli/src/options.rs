@@ -46,6 +46,23 @@ pub(crate) struct ImitationOptions {
     /// walking clip: for kinematic retargeting, not yet for a robot.
     #[arg(long, requires = "dynamic_walk")]
     pub(crate) walking_arms: bool,
+    /// With --walk: a robot foot farther than this from its target footprint (m, ≥ 0) takes a
+    /// step. Default 0.02.
+    #[arg(long, value_name = "M", value_parser = non_negative, allow_negative_numbers = true)]
+    pub(crate) step_distance: Option<f64>,
+    /// With --walk: a robot foot turned more than this from its target footprint's heading
+    /// (rad, ≥ 0) takes a step. Default 0.087 (5°).
+    #[arg(long, value_name = "RAD", value_parser = non_negative, allow_negative_numbers = true)]
+    pub(crate) step_heading: Option<f64>,
+    /// With --walk (quasi-static steps): a human foot on the ground keeps the footprint it
+    /// landed with until it has turned more than this from it (rad, ≥ 0) or moved more than
+    /// --step-slide; then it is followed until it lifts (a pivot turn, a shuffle). Default
+    /// 0.26 (15°): a standing human's foot jitters by up to 12° in the bundled captures.
+    #[arg(long, value_name = "RAD", value_parser = non_negative, allow_negative_numbers = true)]
+    pub(crate) step_pivot: Option<f64>,
+    /// With --walk: see --step-pivot (m, ≥ 0, in the human's world, unscaled). Default 0.05.
+    #[arg(long, value_name = "M", value_parser = non_negative, allow_negative_numbers = true)]
+    pub(crate) step_slide: Option<f64>,
     /// Experimental (Poubel's method): balance that sees the whole body's dynamics. A level
     /// below the feet and the CoM keeps the whole body's ZMP (the arms' acceleration
     /// included) inside the support polygon and the floor's vertical moment on the feet below
@@ -228,6 +245,17 @@ impl ImitationOptions {
         config.footsteps.follow = self.walk || self.dynamic_walk;
         config.footsteps.dynamic = self.dynamic_walk;
         config.footsteps.walking_arms = self.walking_arms;
+        let steps = &mut config.footsteps;
+        for (option, field) in [
+            (self.step_distance, &mut steps.distance),
+            (self.step_heading, &mut steps.heading),
+            (self.step_pivot, &mut steps.pivot),
+            (self.step_slide, &mut steps.slide),
+        ] {
+            if let Some(value) = option {
+                *field = value;
+            }
+        }
         config.zmp_balance = self.zmp_balance;
         config.damping_momentum = self.damping_momentum;
         config.damping = self.damping;

@@ -512,6 +512,14 @@ fn bad_options_are_usage_errors_naming_the_option() {
         &["--tracking-speed"],
     );
     fails(&["imitate", c, "--iterations", "0"], 2, &["--iterations"]);
+    for option in [
+        "--step-distance",
+        "--step-heading",
+        "--step-pivot",
+        "--step-slide",
+    ] {
+        fails(&["imitate", c, "--walk", option, "-0.1"], 2, &[option]);
+    }
     fails(
         &["imitate", c, "--robot", "no-such-robot.toml"],
         1,
@@ -524,6 +532,37 @@ fn bad_options_are_usage_errors_naming_the_option() {
     );
     fails(&["batch", c], 2, &["--out"]);
     fails(&["frobnicate"], 2, &["frobnicate"]);
+}
+
+/// `--step-pivot` and `--step-slide` reach the footstep planner: at 0 the robot follows the
+/// jitter of a standing human's footprints (Kinect ges01, where the human never steps) and
+/// steps once; at their defaults it stands.
+#[test]
+fn step_pivot_and_slide_reach_the_footstep_planner() {
+    let dir = temp_dir("step-options");
+    let clip = clip(KINECT);
+    let robot_steps = |name: &str, extra: &[&str]| {
+        let out = dir.join(name);
+        let mut args = vec![
+            "imitate",
+            s(&clip),
+            "--walk",
+            "--hold",
+            "2",
+            "--out",
+            s(&out),
+        ];
+        args.extend_from_slice(extra);
+        let run = taskstack(&args);
+        assert_eq!(run.code, Some(0), "{}", run.stderr);
+        let metrics: Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("metrics.json")).unwrap())
+                .unwrap();
+        metrics["steps"]["robot"].as_u64().unwrap()
+    };
+    assert_eq!(robot_steps("default", &[]), 0);
+    let zero = ["--step-pivot", "0", "--step-slide", "0"];
+    assert!(robot_steps("zero", &zero) > 0);
 }
 
 #[test]

@@ -40,6 +40,10 @@ pub(crate) struct Settings {
     walk: bool,
     dynamic_walk: bool,
     walking_arms: bool,
+    step_distance: Option<f64>,
+    step_heading: Option<f64>,
+    step_pivot: Option<f64>,
+    step_slide: Option<f64>,
     zmp_balance: bool,
     damping: Option<f64>,
     damping_momentum: f64,
@@ -63,6 +67,10 @@ impl Settings {
             walk: false,
             dynamic_walk: false,
             walking_arms: false,
+            step_distance: None,
+            step_heading: None,
+            step_pivot: None,
+            step_slide: None,
             zmp_balance: false,
             damping: None,
             damping_momentum: 0.0,
@@ -86,6 +94,10 @@ impl Settings {
                 "walk" => s.walk = value.extract()?,
                 "dynamic_walk" => s.dynamic_walk = value.extract()?,
                 "walking_arms" => s.walking_arms = value.extract()?,
+                "step_distance" => s.step_distance = value.extract()?,
+                "step_heading" => s.step_heading = value.extract()?,
+                "step_pivot" => s.step_pivot = value.extract()?,
+                "step_slide" => s.step_slide = value.extract()?,
                 "zmp_balance" => s.zmp_balance = value.extract()?,
                 "damping" => s.damping = value.extract()?,
                 "damping_momentum" => s.damping_momentum = value.extract()?,
@@ -195,6 +207,18 @@ impl Settings {
         config.footsteps.follow = self.walk || self.dynamic_walk;
         config.footsteps.dynamic = self.dynamic_walk;
         config.footsteps.walking_arms = self.walking_arms;
+        // Out of range (NaN, < 0), the imitator refuses them by name.
+        let steps = &mut config.footsteps;
+        for (option, field) in [
+            (self.step_distance, &mut steps.distance),
+            (self.step_heading, &mut steps.heading),
+            (self.step_pivot, &mut steps.pivot),
+            (self.step_slide, &mut steps.slide),
+        ] {
+            if let Some(value) = option {
+                *field = value;
+            }
+        }
         config.zmp_balance = self.zmp_balance;
         if !(0.0..=1.0).contains(&self.damping_momentum) {
             return Err(value_error(format!(

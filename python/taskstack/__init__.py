@@ -90,6 +90,10 @@ def imitate_clip(
     walk: bool = False,
     dynamic_walk: bool = False,
     walking_arms: bool = False,
+    step_distance: Optional[float] = None,
+    step_heading: Optional[float] = None,
+    step_pivot: Optional[float] = None,
+    step_slide: Optional[float] = None,
     zmp_balance: bool = False,
     damping: Optional[float] = None,
     damping_momentum: float = 0.0,
@@ -118,6 +122,16 @@ def imitate_clip(
         walking_arms: experimental, with ``dynamic_walk``: the hands follow the human while
             the robot walks (for kinematic retargeting: the physics judge's weak NAO falls on
             the bundled walks).
+        step_distance: with ``walk``, a robot foot farther than this from its target
+            footprint (m) takes a step (the CLI's ``--step-distance``; default 0.02).
+        step_heading: with ``walk``, a robot foot turned more than this from its target
+            footprint's heading (rad) takes a step (default 0.087, 5°).
+        step_pivot: with ``walk``, a human foot on the ground keeps the footprint it landed
+            with until it has turned more than this (rad) or moved more than ``step_slide``
+            (m, the human's world); then it is followed until it lifts (defaults 0.26 and
+            0.05: a standing human's foot jitters by up to 12° and 3.2 cm in the bundled
+            captures).
+        step_slide: see ``step_pivot``.
         zmp_balance: experimental, balance that sees the arms' dynamics (the CLI's
             ``--zmp-balance``): the ZMP of the CoM and the arms' acceleration stays in the
             support polygon and their vertical moment below what friction holds, so faster
@@ -155,6 +169,10 @@ def imitate_clip(
         walk=walk,
         dynamic_walk=dynamic_walk,
         walking_arms=walking_arms,
+        step_distance=step_distance,
+        step_heading=step_heading,
+        step_pivot=step_pivot,
+        step_slide=step_slide,
         zmp_balance=zmp_balance,
         damping=damping,
         damping_momentum=damping_momentum,

@@ -73,6 +73,12 @@ def cli_joints(clip: Path, out: Path, *args: str):
             {"hold": 0, "dynamic_walk": True, "walking_arms": True},
         ),
         (
+            STAND_ON_ONE_LEG,
+            "nao",
+            ["--hold", "0", "--walk", "--step-pivot", "0.1", "--step-slide", "0.02"],
+            {"hold": 0, "walk": True, "step_pivot": 0.1, "step_slide": 0.02},
+        ),
+        (
             KINECT,
             "nao",
             ["--hold", "0", "--zmp-balance", "--tracking-speed", "1.0"],
@@ -163,6 +169,9 @@ def test_bad_input_raises_python_exceptions_with_the_rust_message(tmp):
         taskstack.imitate_clip(KINECT, velocity_fraction=0.0)
     with pytest.raises(ValueError, match="dynamic_walk"):
         taskstack.imitate_clip(KINECT, walking_arms=True)
+    for name in ["step_distance", "step_heading", "step_pivot", "step_slide"]:
+        with pytest.raises(ValueError, match=name.replace("step_", "footsteps.")):
+            taskstack.imitate_clip(KINECT, **{name: -0.1})
     for bad in [-0.1, 1.5, math.nan]:
         with pytest.raises(ValueError, match="damping_momentum"):
             taskstack.imitate_clip(KINECT, damping_momentum=bad)
