@@ -543,8 +543,8 @@ fn turning(model: &Model, data: &ModelData, frame: FrameId) -> Result<Vec<bool>,
 
 /// The joints the CoM tasks of `profile` may move in `model` (at the posture in `data`): those
 /// that turn the torso, a sole or a hand. A joint that turns none of them (the NAO's head)
-/// moves the CoM by millimetres per radian, so a balance level the legs could not meet (a
-/// knee straight at its limit) drove it at its speed limit: the NAO's head swept its whole
+/// moves the CoM by millimetres per radian, so a balance level the legs could not meet (their
+/// joints at their limits) drove it at its speed limit: the NAO's head swept its whole
 /// yaw range, ±2.09 rad, back and forth while the human washed (17 rad of travel over CMU
 /// 02_10) and on every walking clip with `--walk`. Such joints follow the posture gradient.
 fn balance_joints(
