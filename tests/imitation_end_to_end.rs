@@ -699,9 +699,9 @@ fn the_arms_hang_from_the_robots_shoulders() {
 /// The CoM tasks move only the joints that turn the torso, a sole or a hand: the NAO's head,
 /// which moves the CoM by millimetres per radian, stays where the posture gradient keeps it,
 /// facing forward (a clip gives no head angles). When the balance level also moved the head,
-/// a level the straight legs could not meet drove it at its speed limit: over CMU 07_04 the
-/// head turned 0.57 rad and pitched 0.37 rad (measured before the change; on 02_10 it swept its
-/// whole yaw range, ±2.09 rad).
+/// a level the legs could not meet (their joints at their limits) drove it at its speed limit:
+/// over CMU 07_04 the head turned 0.57 rad and pitched 0.37 rad (measured before the change;
+/// on 02_10 it swept its whole yaw range, ±2.09 rad).
 #[test]
 fn the_balance_level_leaves_the_head_alone() {
     let (mut clip, mut imitator) = nao_on("cmu_07_04_slow_walk.bvh");
