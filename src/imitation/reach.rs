@@ -217,7 +217,7 @@ impl Arm {
     }
 
     /// The shoulder point of the kinematics in `data` (model base frame, m).
-    pub(super) fn shoulder_point(&self, data: &ModelData) -> Vector3<f64> {
+    fn shoulder_point(&self, data: &ModelData) -> Vector3<f64> {
         let [a, b] = self
             .shoulder
             .map(|f| data.frame_placement(f).translation.vector);
