@@ -167,3 +167,51 @@ fn an_inequality_row_may_take_its_whole_room_in_one_step() {
         assert!((q - expected).abs() < 1e-12, "{limit:?}: {q}");
     }
 }
+
+/// [`Pair`] counting its calls: the Jacobian writes of `evaluate` and the errors alone of
+/// `measure`.
+#[derive(Default)]
+struct Counted {
+    evaluations: usize,
+    measures: usize,
+}
+
+impl TaskModel for Counted {
+    type Error = SolverError;
+    fn evaluate(&mut self, q: &[f64], stack: &mut TaskStack) -> Result<(), SolverError> {
+        self.evaluations += 1;
+        Pair { limit: None }.evaluate(q, stack)
+    }
+
+    fn measure(&mut self, q: &[f64], stack: &mut TaskStack) -> Result<(), SolverError> {
+        self.measures += 1;
+        let mut level = stack.level_mut(0);
+        let (_, error) = level.rows_mut(0, 2);
+        error.copy_from_slice(&[1.0 - q[0], 1.0 - q[1]]);
+        Ok(())
+    }
+}
+
+#[test]
+fn the_iterate_after_the_last_step_is_measured_not_evaluated() {
+    // Three steps of 0.05 toward 1 (no tolerance met): three evaluations before the steps, one
+    // measure of the result, whose errors the report holds (1 − 0.15 per task).
+    let shape = StackShape::new(2).with_level("x", &[("a", 1), ("b", 1)]);
+    let mut solver = Solver::new(&shape).unwrap();
+    let settings = DriverSettings {
+        max_iterations: 3,
+        max_joint_step: f64::INFINITY,
+        ..DriverSettings::default()
+    };
+    let mut driver = PositionDriver::new(&solver, settings).unwrap();
+    let (mut q, mut model) = ([0.0, 0.0], Counted::default());
+    let bounds = JointBounds::unbounded(2);
+    let report = driver
+        .run(&mut solver, &mut model, &mut q, &bounds)
+        .unwrap();
+    assert_eq!((model.evaluations, model.measures), (3, 1));
+    assert_eq!(report.stop, StopReason::IterationLimit);
+    for e in report.task_errors() {
+        assert!((e - 0.85).abs() < 1e-12, "{:?}", report.task_errors());
+    }
+}

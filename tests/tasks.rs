@@ -236,3 +236,83 @@ fn bad_input_gives_typed_errors() {
         TaskError::UnknownTask("l_hand".into())
     );
 }
+
+#[test]
+fn the_errors_alone_are_the_errors_of_the_rows() {
+    use taskstack::tasks::{
+        FramePoint, com_error, com_rows, orientation_error, orientation_rows, point_error,
+        point_rows, upright_error, upright_rows,
+    };
+    let model = nao::rfoot();
+    let q = bent(&model);
+    let mut data = model.new_data();
+    model.forward_kinematics(&mut data, &q).unwrap();
+    let hand = model.frame_id("l_hand").unwrap();
+    let point = FramePoint {
+        frame: hand,
+        offset: Vector3::new(0.01, -0.02, 0.03),
+    };
+    let (target, axes) = (Vector3::new(0.1, 0.2, 0.3), [Axis::Z, Axis::X]);
+    let turn = Rotation3::from_axis_angle(&Vector3::y_axis(), 0.4);
+    let up = Vector3::new(0.0, 0.6, 0.8);
+    let mut jacobian = Mat::<f64>::zeros(3, model.nv());
+    let (mut rows, mut alone) = ([0.0; 3], [0.0; 3]);
+    point_rows(
+        &model,
+        &data,
+        &point,
+        &axes,
+        &target,
+        jacobian.as_mut().subrows_mut(0, 2),
+        &mut rows,
+    )
+    .unwrap();
+    point_error(&model, &data, &point, &axes, &target, &mut alone).unwrap();
+    assert_eq!(rows, alone);
+    orientation_rows(
+        &model,
+        &data,
+        hand,
+        &turn,
+        jacobian.as_mut().subrows_mut(0, 3),
+        &mut rows,
+    )
+    .unwrap();
+    orientation_error(&model, &data, hand, &turn, &mut alone).unwrap();
+    assert_eq!(rows, alone);
+    upright_rows(
+        &model,
+        &data,
+        hand,
+        &up,
+        jacobian.as_mut().subrows_mut(0, 2),
+        &mut rows,
+    )
+    .unwrap();
+    upright_error(&model, &data, hand, &up, &mut alone).unwrap();
+    assert_eq!(rows, alone);
+    com_rows(
+        &model,
+        &data,
+        &[0.1, 0.2],
+        jacobian.as_mut().subrows_mut(0, 2),
+        &mut rows,
+    )
+    .unwrap();
+    com_error(&model, &data, &[0.1, 0.2], &mut alone).unwrap();
+    assert_eq!(rows, alone);
+
+    // A frame of another, larger model and data without kinematics are typed errors.
+    let g1 = g1::right_sole();
+    let last = &g1.frames()[g1.frames().len() - 1];
+    let foreign = g1.frame_id(&last.name).unwrap();
+    assert!(foreign.index() >= model.frames().len());
+    assert!(matches!(
+        orientation_error(&model, &data, foreign, &turn, &mut alone),
+        Err(ModelError::FrameOutOfRange(_))
+    ));
+    assert_eq!(
+        upright_error(&model, &model.new_data(), hand, &up, &mut alone),
+        Err(ModelError::KinematicsNotComputed)
+    );
+}

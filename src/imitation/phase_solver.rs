@@ -22,8 +22,8 @@ use crate::solver::{
     StackShape, TaskStack,
 };
 use crate::tasks::{
-    CapsuleDistanceTask, FramePoint, InequalityTask, com_rows, orientation_rows, point_rows,
-    upright_rows,
+    CapsuleDistanceTask, FramePoint, InequalityTask, com_error, com_rows, orientation_error,
+    orientation_rows, point_error, point_rows, upright_error, upright_rows,
 };
 
 /// Residual of the contact step's linear system (m and rad, the rows' units) above which a
@@ -456,7 +456,7 @@ impl PhaseSolver {
         for task in self.tasks.iter().filter(|t| t.level == 0) {
             let mut level = stack.level_mut(0);
             let (jacobian, error) = level.rows_mut(task.row, task.rows);
-            tasks.write(task, jacobian, error)?;
+            tasks.write(task, Some(jacobian), error)?;
         }
         let stack = self.solver.stack();
         let errors = &stack.stacked_target()[..stack.level_start(1)];
@@ -744,6 +744,13 @@ fn flat(yaw: f64) -> Rotation3<f64> {
     Rotation3::from_axis_angle(&Vector3::z_axis(), yaw)
 }
 
+/// The goal of an orientation task: a whole orientation (three rows) or the direction its
+/// frame's z axis points (two rows, yaw free).
+enum Attitude {
+    Rotation(Rotation3<f64>),
+    Up(Vector3<f64>),
+}
+
 impl TaskModel for PhaseTasks<'_> {
     type Error = ImitationError;
 
@@ -776,33 +783,88 @@ impl TaskModel for PhaseTasks<'_> {
             self.model.forward_kinematics(self.data, q)?;
         }
         for task in self.tasks {
-            let mut level = stack.level_mut(task.level);
-            let (mut jacobian, target) = level.rows_mut(task.row, task.rows);
-            self.write(task, jacobian.as_mut(), target)?;
-            keep_columns(jacobian.as_mut(), task.joints.as_deref());
-            keep_columns(jacobian, self.joints);
+            self.write_rows(task, stack)?;
         }
         for c in self.constraints {
-            let mut level = stack.level_mut(c.level);
-            let (mut jacobian, lower, upper) = level.inequalities_mut();
-            let count = match &c.rows {
-                ConstraintRows::Distance(d) => d.rows(),
-                ConstraintRows::Zmp(z) => z.task.rows(),
-            };
-            let (rows, (model, data)) = (c.row..c.row + count, (self.model, &*self.data));
-            let mut jacobian = jacobian.as_mut().subrows_mut(c.row, count);
-            let (lower, upper) = (&mut lower[rows.clone()], &mut upper[rows]);
-            match &c.rows {
-                ConstraintRows::Distance(d) => {
-                    d.write(model, data, jacobian.as_mut(), lower, upper)?
-                }
-                ConstraintRows::Zmp(z) => {
-                    z.task
-                        .write(model, data, q, jacobian.as_mut(), lower, upper)?
-                }
-            }
-            keep_columns(jacobian, self.joints);
+            self.write_constraint(c, q, stack)?;
         }
+        self.write_gradient(q, stack)
+    }
+
+    /// The errors and rooms at the frame's final `q`; the Jacobians of the contact level too,
+    /// which [`PhaseSolver::settle_contact`] steps from.
+    fn measure(&mut self, q: &[f64], stack: &mut TaskStack) -> Result<(), ImitationError> {
+        if !std::mem::take(&mut self.fresh) {
+            self.model.forward_kinematics(self.data, q)?;
+        }
+        for task in self.tasks {
+            if task.level == 0 {
+                self.write_rows(task, stack)?;
+            } else {
+                let mut level = stack.level_mut(task.level);
+                let (_, error) = level.rows_mut(task.row, task.rows);
+                self.write(task, None, error)?;
+            }
+        }
+        for c in self.constraints {
+            let ConstraintRows::Distance(d) = &c.rows else {
+                // A ZMP row's room comes with its Jacobian.
+                self.write_constraint(c, q, stack)?;
+                continue;
+            };
+            let mut level = stack.level_mut(c.level);
+            let (_, lower, upper) = level.inequalities_mut();
+            let (lower, upper) = (&mut lower[c.row..c.row + 1], &mut upper[c.row..c.row + 1]);
+            d.write_room(self.model, self.data, lower, upper)?;
+        }
+        Ok(())
+    }
+}
+
+impl PhaseTasks<'_> {
+    /// The Jacobian rows (over the moving joints) and error of `task` into `stack`.
+    fn write_rows(
+        &mut self,
+        task: &ResolvedTask,
+        stack: &mut TaskStack,
+    ) -> Result<(), ImitationError> {
+        let mut level = stack.level_mut(task.level);
+        let (mut jacobian, target) = level.rows_mut(task.row, task.rows);
+        self.write(task, Some(jacobian.as_mut()), target)?;
+        keep_columns(jacobian.as_mut(), task.joints.as_deref());
+        keep_columns(jacobian, self.joints);
+        Ok(())
+    }
+
+    /// The rows (Jacobian over the moving joints, room) of constraint `c` at `q` into `stack`.
+    fn write_constraint(
+        &self,
+        c: &ResolvedConstraint,
+        q: &[f64],
+        stack: &mut TaskStack,
+    ) -> Result<(), ImitationError> {
+        let mut level = stack.level_mut(c.level);
+        let (mut jacobian, lower, upper) = level.inequalities_mut();
+        let count = match &c.rows {
+            ConstraintRows::Distance(d) => d.rows(),
+            ConstraintRows::Zmp(z) => z.task.rows(),
+        };
+        let (rows, (model, data)) = (c.row..c.row + count, (self.model, &*self.data));
+        let mut jacobian = jacobian.as_mut().subrows_mut(c.row, count);
+        let (lower, upper) = (&mut lower[rows.clone()], &mut upper[rows]);
+        match &c.rows {
+            ConstraintRows::Distance(d) => d.write(model, data, jacobian.as_mut(), lower, upper)?,
+            ConstraintRows::Zmp(z) => {
+                z.task
+                    .write(model, data, q, jacobian.as_mut(), lower, upper)?
+            }
+        }
+        keep_columns(jacobian, self.joints);
+        Ok(())
+    }
+
+    /// The gradient term of the table's criteria at `q` into `stack`, over the moving joints.
+    fn write_gradient(&mut self, q: &[f64], stack: &mut TaskStack) -> Result<(), ImitationError> {
         stack.clear_gradient();
         for g in self.gradients {
             match g.kind {
@@ -825,88 +887,79 @@ impl TaskModel for PhaseTasks<'_> {
 }
 
 impl PhaseTasks<'_> {
-    /// The Jacobian rows and error of `task`.
+    /// The error of `task` and, when `jacobian` is given, its Jacobian rows.
     fn write(
         &mut self,
         task: &ResolvedTask,
-        jacobian: MatMut<'_, f64>,
+        jacobian: Option<MatMut<'_, f64>>,
         error: &mut [f64],
     ) -> Result<(), ImitationError> {
         let (model, data) = (self.model, &*self.data);
         let Some(point) = &task.point else {
             let com = self.targets.com;
-            match task.task {
-                Task::ComHeight => {
-                    model.com_jacobian_axes(data, &[Axis::Z], jacobian)?;
+            match (&task.task, jacobian) {
+                (Task::ComHeight, jacobian) => {
+                    if let Some(jacobian) = jacobian {
+                        model.com_jacobian_axes(data, &[Axis::Z], jacobian)?;
+                    }
                     error[0] = self.targets.com_height - model.com(data)?.z;
                 }
-                _ => com_rows(model, data, &[com.x, com.y], jacobian, error)?,
+                (_, Some(jacobian)) => com_rows(model, data, &[com.x, com.y], jacobian, error)?,
+                (_, None) => com_error(model, data, &[com.x, com.y], error)?,
             }
             return Ok(());
         };
+        let frame = point.frame;
         match task.task {
             // A free hand's support task: no rows.
             Task::Point {
                 target: PointTarget::HandContact(side),
                 ..
             } if self.targets.hand_contacts[side.index()].is_none() => {
-                let (mut jacobian, error) = (jacobian, error);
-                jacobian.fill(0.0);
+                if let Some(mut jacobian) = jacobian {
+                    jacobian.fill(0.0);
+                }
                 error.fill(0.0);
             }
             Task::Point { target, .. } => {
                 let goal = self.point_goal(task, target, point)?;
                 let axes = &task.axes[..task.rows];
-                point_rows(model, data, point, axes, &goal, jacobian, error)?;
+                match jacobian {
+                    Some(j) => point_rows(model, data, point, axes, &goal, j, error)?,
+                    None => point_error(model, data, point, axes, &goal, error)?,
+                }
             }
-            Task::Orientation {
-                target: OrientationTarget::HeldFlat,
-                ..
-            } => orientation_rows(
-                model,
-                data,
-                point.frame,
-                &flat(task.held_yaw),
-                jacobian,
-                error,
-            )?,
-            Task::Orientation {
-                target: OrientationTarget::Footstep,
-                ..
-            } => {
-                let yaw = self.targets.footstep.map_or(task.held_yaw, |f| f.yaw);
-                orientation_rows(model, data, point.frame, &flat(yaw), jacobian, error)?;
-            }
-            Task::Orientation {
-                target: OrientationTarget::Upright { lean },
-                ..
-            } => {
-                // The vertical leaned by `lean` rad about x (toward +y for lean > 0).
-                let up = Vector3::new(0.0, lean.sin(), lean.cos());
-                upright_rows(self.model, self.data, point.frame, &up, jacobian, error)?
-            }
-            Task::Orientation {
-                target: OrientationTarget::Facing { lean },
-                ..
-            } => {
-                let x = data.frame_placement(self.other_sole).rotation * Vector3::x();
-                let target = facing(lean, 0.5 * x.y.atan2(x.x));
-                orientation_rows(model, data, point.frame, &target, jacobian, error)?
-            }
-            Task::Orientation {
-                target: OrientationTarget::Leaning,
-                ..
-            } => upright_rows(
-                self.model,
-                self.data,
-                point.frame,
-                &self.targets.up,
-                jacobian,
-                error,
-            )?,
+            Task::Orientation { target, .. } => match (self.attitude(task, target), jacobian) {
+                (Attitude::Rotation(r), Some(j)) => {
+                    orientation_rows(model, data, frame, &r, j, error)?
+                }
+                (Attitude::Rotation(r), None) => orientation_error(model, data, frame, &r, error)?,
+                (Attitude::Up(up), Some(j)) => upright_rows(model, data, frame, &up, j, error)?,
+                (Attitude::Up(up), None) => upright_error(model, data, frame, &up, error)?,
+            },
             Task::ComXY(_) | Task::ComHeight => unreachable!("a CoM task has no point"),
         }
         Ok(())
+    }
+
+    /// What an orientation task asks of its frame this frame.
+    fn attitude(&self, task: &ResolvedTask, target: OrientationTarget) -> Attitude {
+        match target {
+            OrientationTarget::HeldFlat => Attitude::Rotation(flat(task.held_yaw)),
+            OrientationTarget::Footstep => {
+                let yaw = self.targets.footstep.map_or(task.held_yaw, |f| f.yaw);
+                Attitude::Rotation(flat(yaw))
+            }
+            // The vertical leaned by `lean` rad about x (toward +y for lean > 0).
+            OrientationTarget::Upright { lean } => {
+                Attitude::Up(Vector3::new(0.0, lean.sin(), lean.cos()))
+            }
+            OrientationTarget::Facing { lean } => {
+                let x = self.data.frame_placement(self.other_sole).rotation * Vector3::x();
+                Attitude::Rotation(facing(lean, 0.5 * x.y.atan2(x.x)))
+            }
+            OrientationTarget::Leaning => Attitude::Up(self.targets.up),
+        }
     }
 
     /// Where a point task's point goes this frame (root frame, m).

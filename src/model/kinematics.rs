@@ -364,7 +364,7 @@ impl Model {
         Ok(())
     }
 
-    fn check_computed(&self, data: &ModelData) -> Result<(), ModelError> {
+    pub(crate) fn check_computed(&self, data: &ModelData) -> Result<(), ModelError> {
         self.check_data(data)?;
         if !data.computed {
             return Err(ModelError::KinematicsNotComputed);

@@ -29,6 +29,15 @@ pub trait TaskModel {
     /// clears it).
     fn evaluate(&mut self, q: &[f64], stack: &mut TaskStack) -> Result<(), Self::Error>;
 
+    /// For configuration `q` after the last step (no solve follows): writes what the driver
+    /// reads then, every task's error and every inequality row's room, as [`Self::evaluate`]
+    /// does; the Jacobians and the gradient may be left as they are. A model whose Jacobians
+    /// cost most of an evaluation saves them here (one iteration a frame: half its
+    /// evaluations). Default: [`Self::evaluate`].
+    fn measure(&mut self, q: &[f64], stack: &mut TaskStack) -> Result<(), Self::Error> {
+        self.evaluate(q, stack)
+    }
+
     /// Largest error norm task `task` (stack order, from 0) may ask for in one iteration, in
     /// task units, when it differs from [`DriverSettings::max_task_error`]: a task the caller
     /// lets move faster (a hand following a human) or slower than the rest. Default: none; a limit that is not > 0 (NaN, 0) is ignored.
@@ -244,7 +253,8 @@ impl PositionDriver {
     /// when [`DriverSettings::patience`] stops the run: then it is the best one, comparing task
     /// errors in stack order (the first that differs by more than the stall tolerance decides,
     /// then the inequality violation; an error within the tolerance counts as met), and the
-    /// model was evaluated there last. Errors: wrong sizes, a non-finite `q`,
+    /// model was evaluated there last; otherwise the stack holds the model's
+    /// [`TaskModel::measure`] of the result. Errors: wrong sizes, a non-finite `q`,
     /// a non-finite Jacobian entry, task error or gradient from the model
     /// ([`SolverError::NonFinite`], naming the place), or the model's own error.
     pub fn run<M: TaskModel>(
@@ -269,7 +279,11 @@ impl PositionDriver {
         let mut since_best = 0;
         self.run_start.copy_from_slice(q);
         let stop = loop {
-            model.evaluate(q, solver.stack_mut())?;
+            if iterations >= s.max_iterations {
+                model.measure(q, solver.stack_mut())?;
+            } else {
+                model.evaluate(q, solver.stack_mut())?;
+            }
             // Before measuring: a NaN task error must not pass the tolerance test as converged.
             solver.stack().check_finite()?;
             self.measure_errors(solver.stack());

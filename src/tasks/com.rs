@@ -72,6 +72,20 @@ pub fn com_rows(
     error: &mut [f64],
 ) -> Result<(), ModelError> {
     model.com_jacobian_rows(data, target.len(), jacobian)?;
+    com_error(model, data, target, error)
+}
+
+/// The error `e = c* − c(q)` of [`com_rows`] alone (m, `target.len()` entries): for a task
+/// model that measures its tasks after its last step, where no Jacobian is needed.
+///
+/// # Errors
+/// [`ModelError`] when `data` has no kinematics or the model has no mass.
+pub fn com_error(
+    model: &Model,
+    data: &ModelData,
+    target: &[f64],
+    error: &mut [f64],
+) -> Result<(), ModelError> {
     let c = model.com(data)?;
     for (r, t) in target.iter().enumerate() {
         error[r] = t - c[r];

@@ -230,6 +230,23 @@ impl CapsuleDistanceTask {
         Ok(self.closest(model, data)?.distance)
     }
 
+    /// The row's room alone, `margin − d` into `lower[0]` and `+∞` into `upper[0]`, as
+    /// [`InequalityTask::write`] writes them: for a task model that measures its rows after its
+    /// last step, where no Jacobian is needed.
+    ///
+    /// # Errors
+    /// [`ModelError`] when `data` has no kinematics or a frame is not in `model`.
+    pub fn write_room(
+        &self,
+        model: &Model,
+        data: &ModelData,
+        lower: &mut [f64],
+        upper: &mut [f64],
+    ) -> Result<(), ModelError> {
+        write_room(self.margin, self.distance(model, data)?, lower, upper);
+        Ok(())
+    }
+
     fn closest(&self, model: &Model, data: &ModelData) -> Result<Closest, ModelError> {
         self.first.closest(&self.second, model, data)
     }

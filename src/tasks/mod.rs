@@ -60,17 +60,17 @@ use thiserror::Error;
 use crate::model::{Model, ModelData, ModelError};
 use crate::solver::{JointBounds, SolverError};
 
-pub use com::{ComTask, com_rows};
+pub use com::{ComTask, com_error, com_rows};
 pub use com_polygon::{ComPolygonTask, convex_hull, hull_margin};
 pub use contact_normal::ContactNormalTask;
 pub use distance::{Capsule, CapsuleDistanceTask, PlaneDistanceTask, closest_segment_parameters};
 pub use inequality::InequalityTask;
-pub use orientation::{OrientationTask, orientation_rows};
+pub use orientation::{OrientationTask, orientation_error, orientation_rows};
 pub use pose::PoseTask;
-pub use position::{FramePoint, PositionTask, point_rows};
+pub use position::{FramePoint, PositionTask, point_error, point_rows};
 pub use posture::PostureTask;
 pub use set::TaskSet;
-pub use upright::{UprightTask, upright_rows};
+pub use upright::{UprightTask, upright_error, upright_rows};
 pub use zmp::{GRAVITY, ZmpTask};
 
 /// Errors of building or evaluating tasks.

@@ -55,6 +55,23 @@ pub fn orientation_rows(
     error: &mut [f64],
 ) -> Result<(), ModelError> {
     model.orientation_jacobian(data, frame, jacobian)?;
+    orientation_error(model, data, frame, target, error)
+}
+
+/// The error `e = log(R* R(q)ᵀ)` of [`orientation_rows`] alone (rad, 3 entries): for a task
+/// model that measures its tasks after its last step, where no Jacobian is needed.
+///
+/// # Errors
+/// [`ModelError`] when `data` has no kinematics or the frame is not in `model`.
+pub fn orientation_error(
+    model: &Model,
+    data: &ModelData,
+    frame: FrameId,
+    target: &Rotation3<f64>,
+    error: &mut [f64],
+) -> Result<(), ModelError> {
+    model.check_computed(data)?;
+    model.check_frame(frame)?;
     let current = data.frame_placement(frame).rotation;
     let e = rotation_vector(&(target * current.inverse()));
     error[..3].copy_from_slice(e.as_slice());

@@ -35,17 +35,33 @@ pub fn point_rows(
     error: &mut [f64],
 ) -> Result<(), ModelError> {
     let FramePoint { frame, offset } = point;
-    let x = model.point_position(data, *frame, offset)?;
     // All three axes in order: one walk of the chain instead of three.
-    let xyz = axes == [Axis::X, Axis::Y, Axis::Z];
-    if xyz {
+    if axes == [Axis::X, Axis::Y, Axis::Z] {
         model.point_jacobian(data, *frame, offset, jacobian.as_mut())?;
-    }
-    for (r, &axis) in axes.iter().enumerate() {
-        if !xyz {
+    } else {
+        for (r, &axis) in axes.iter().enumerate() {
             let row = jacobian.as_mut().subrows_mut(r, 1);
             model.point_jacobian_row(data, *frame, offset, axis, row)?;
         }
+    }
+    point_error(model, data, point, axes, target, error)
+}
+
+/// The error `e = x* − x(q)` of [`point_rows`] alone (m, `axes.len()` entries): for a task
+/// model that measures its tasks after its last step, where no Jacobian is needed.
+///
+/// # Errors
+/// [`ModelError`] when `data` has no kinematics or the frame is not in `model`.
+pub fn point_error(
+    model: &Model,
+    data: &ModelData,
+    point: &FramePoint,
+    axes: &[Axis],
+    target: &Vector3<f64>,
+    error: &mut [f64],
+) -> Result<(), ModelError> {
+    let x = model.point_position(data, point.frame, &point.offset)?;
+    for (r, &axis) in axes.iter().enumerate() {
         error[r] = target[axis as usize] - x[axis as usize];
     }
     Ok(())

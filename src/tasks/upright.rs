@@ -72,6 +72,23 @@ pub fn upright_rows(
     error: &mut [f64],
 ) -> Result<(), ModelError> {
     model.orientation_jacobian_rows(data, frame, 2, jacobian)?;
+    upright_error(model, data, frame, up, error)
+}
+
+/// The error of [`upright_rows`] alone (rad, 2 entries): for a task model that measures its
+/// tasks after its last step, where no Jacobian is needed.
+///
+/// # Errors
+/// [`ModelError`] when `data` has no kinematics or the frame is not in `model`.
+pub fn upright_error(
+    model: &Model,
+    data: &ModelData,
+    frame: FrameId,
+    up: &Vector3<f64>,
+    error: &mut [f64],
+) -> Result<(), ModelError> {
+    model.check_computed(data)?;
+    model.check_frame(frame)?;
     let rotation = &data.frame_placement(frame).rotation;
     let tilt = (rotation * Vector3::z()).cross(up);
     error[..2].copy_from_slice(&[tilt.x, tilt.y]);
