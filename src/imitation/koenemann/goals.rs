@@ -301,6 +301,23 @@ impl TaskModel for GoalRows<'_> {
     type Error = ImitationError;
 
     fn evaluate(&mut self, moving: &[f64], stack: &mut TaskStack) -> Result<(), ImitationError> {
+        self.write(moving, stack, true)
+    }
+
+    fn measure(&mut self, moving: &[f64], stack: &mut TaskStack) -> Result<(), ImitationError> {
+        self.write(moving, stack, false)
+    }
+}
+
+impl GoalRows<'_> {
+    /// The goals' errors, the distance rows' rooms and, with `jacobians`, their Jacobians over
+    /// the moving joints and the posture gradient, at the moving joints' positions `moving`.
+    fn write(
+        &mut self,
+        moving: &[f64],
+        stack: &mut TaskStack,
+        jacobians: bool,
+    ) -> Result<(), ImitationError> {
         for (&k, &v) in self.columns.iter().zip(moving) {
             self.q[k] = v;
         }
@@ -309,9 +326,10 @@ impl TaskModel for GoalRows<'_> {
         let data = &*self.data;
         let torso = *data.frame_placement(self.torso);
         let [jt, jwt, jx, jw, full] = &mut *self.scratch;
-        model.point_jacobian(data, self.torso, &Vector3::zeros(), jt.as_mut())?;
-        model.orientation_jacobian(data, self.torso, jwt.as_mut())?;
-        let rt = torso.rotation.inverse();
+        if jacobians {
+            model.point_jacobian(data, self.torso, &Vector3::zeros(), jt.as_mut())?;
+            model.orientation_jacobian(data, self.torso, jwt.as_mut())?;
+        }
         let (mut level, mut first) = (0, 0);
         for goal in self.goals {
             let rows = goal.rows();
@@ -322,109 +340,162 @@ impl TaskModel for GoalRows<'_> {
             let mut rows_of = stack.level_mut(level);
             let (mut jac, error) = rows_of.rows_mut(first, rows);
             first += rows;
-            // The goal's rows over every joint; the moving columns are taken below.
-            let jac_all = &mut *full;
-            match *goal {
-                Goal::TorsoPoint {
-                    frame,
-                    offset,
-                    target,
-                }
-                | Goal::RootPoint {
-                    frame,
-                    offset,
-                    target,
-                } => {
-                    let x = model.point_position(data, frame, &offset)?;
-                    model.point_jacobian(data, frame, &offset, jx.as_mut())?;
-                    let in_torso = matches!(goal, Goal::TorsoPoint { .. });
-                    let current = if in_torso {
-                        rt * (x - torso.translation.vector)
-                    } else {
-                        x
-                    };
-                    let lever = x - torso.translation.vector;
-                    for k in 0..q.len() {
-                        let col = column(jx, k);
-                        let col = match in_torso {
-                            true => rt * (col - column(jt, k) + lever.cross(&column(jwt, k))),
-                            false => col,
-                        };
-                        for r in 0..3 {
-                            jac_all[(r, k)] = col[r];
-                        }
+            goal_error(goal, model, data, &torso, error)?;
+            if jacobians {
+                // The goal's rows over every joint; the moving columns are taken here.
+                let torso_jacobians = [&*jt, &*jwt];
+                goal_jacobian(goal, model, data, &torso, torso_jacobians, [jx, jw], full)?;
+                for (c, &k) in self.columns.iter().enumerate() {
+                    for r in 0..rows {
+                        jac[(r, c)] = full[(r, k)];
                     }
-                    for r in 0..3 {
-                        error[r] = target[r] - current[r];
-                    }
-                }
-                Goal::TorsoNormal { frame, normal } | Goal::RootNormal { frame, normal } => {
-                    let in_torso = matches!(goal, Goal::TorsoNormal { .. });
-                    let z_root = data.frame_placement(frame).rotation * Vector3::z();
-                    let z = if in_torso { rt * z_root } else { z_root };
-                    model.orientation_jacobian(data, frame, jw.as_mut())?;
-                    let across = across_basis(&z);
-                    for k in 0..q.len() {
-                        let omega = match in_torso {
-                            true => column(jw, k) - column(jwt, k),
-                            false => column(jw, k),
-                        };
-                        let dz = omega.cross(&z_root);
-                        let dz = if in_torso { rt * dz } else { dz };
-                        for (r, t) in across.iter().enumerate() {
-                            jac_all[(r, k)] = NORMAL_WEIGHT * t.dot(&dz);
-                        }
-                    }
-                    for (r, t) in across.iter().enumerate() {
-                        error[r] = NORMAL_WEIGHT * t.dot(&(normal - z));
-                    }
-                }
-                Goal::RootCom { target } => {
-                    let com = model.com(data)?;
-                    model.com_jacobian_rows(data, 2, jac_all.as_mut().subrows_mut(0, 2))?;
-                    error[0] = target.x - com.x;
-                    error[1] = target.y - com.y;
-                }
-                Goal::RootOrientation { frame, target } => {
-                    // ½ Σ cᵢ × cᵢ*, the columns of the current and target rotations: the
-                    // rotation vector for small errors, and never NaN.
-                    let current = data.frame_placement(frame).rotation;
-                    let (c, t) = (current.matrix(), target.matrix());
-                    let e = (0..3).fold(Vector3::zeros(), |e, i| {
-                        e + c.column(i).cross(&t.column(i)) * 0.5
-                    });
-                    model.orientation_jacobian(data, frame, jw.as_mut())?;
-                    for k in 0..q.len() {
-                        for r in 0..3 {
-                            jac_all[(r, k)] = NORMAL_WEIGHT * jw[(r, k)];
-                        }
-                    }
-                    for r in 0..3 {
-                        error[r] = NORMAL_WEIGHT * e[r];
-                    }
-                }
-            }
-            for (c, &k) in self.columns.iter().enumerate() {
-                for r in 0..rows {
-                    jac[(r, c)] = jac_all[(r, k)];
                 }
             }
         }
-        self.write_distances(stack)?;
-        stack.clear_gradient();
-        if let Some((posture, gains)) = self.posture {
-            let gradient = stack.gradient_mut();
-            for (c, &k) in self.columns.iter().enumerate() {
-                gradient[c] = gains[k] * (posture[k] - self.q[k]);
+        self.write_distances(stack, jacobians)?;
+        if jacobians {
+            stack.clear_gradient();
+            if let Some((posture, gains)) = self.posture {
+                let gradient = stack.gradient_mut();
+                for (c, &k) in self.columns.iter().enumerate() {
+                    gradient[c] = gains[k] * (posture[k] - self.q[k]);
+                }
             }
         }
         Ok(())
     }
 }
 
+/// The error of `goal` (m, or [`NORMAL_WEIGHT`]-weighted rad) at the forward kinematics in
+/// `data`, the torso at `torso`.
+fn goal_error(
+    goal: &Goal,
+    model: &Model,
+    data: &ModelData,
+    torso: &IsometryMatrix3<f64>,
+    error: &mut [f64],
+) -> Result<(), ImitationError> {
+    let rt = torso.rotation.inverse();
+    match *goal {
+        Goal::TorsoPoint {
+            frame,
+            offset,
+            target,
+        }
+        | Goal::RootPoint {
+            frame,
+            offset,
+            target,
+        } => {
+            let x = model.point_position(data, frame, &offset)?;
+            let current = match goal {
+                Goal::TorsoPoint { .. } => rt * (x - torso.translation.vector),
+                _ => x,
+            };
+            for r in 0..3 {
+                error[r] = target[r] - current[r];
+            }
+        }
+        Goal::TorsoNormal { frame, normal } | Goal::RootNormal { frame, normal } => {
+            let z_root = data.frame_placement(frame).rotation * Vector3::z();
+            let z = match goal {
+                Goal::TorsoNormal { .. } => rt * z_root,
+                _ => z_root,
+            };
+            for (r, t) in across_basis(&z).iter().enumerate() {
+                error[r] = NORMAL_WEIGHT * t.dot(&(normal - z));
+            }
+        }
+        Goal::RootCom { target } => {
+            let com = model.com(data)?;
+            error[0] = target.x - com.x;
+            error[1] = target.y - com.y;
+        }
+        Goal::RootOrientation { frame, target } => {
+            // ½ Σ cᵢ × cᵢ*, the columns of the current and target rotations: the rotation
+            // vector for small errors, and never NaN.
+            let current = data.frame_placement(frame).rotation;
+            let (c, t) = (current.matrix(), target.matrix());
+            let e = (0..3).fold(Vector3::zeros(), |e, i| {
+                e + c.column(i).cross(&t.column(i)) * 0.5
+            });
+            for r in 0..3 {
+                error[r] = NORMAL_WEIGHT * e[r];
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The Jacobian rows of `goal` over every joint into `out` (`goal.rows()` rows), from the
+/// torso's point and orientation Jacobians `[jt, jwt]` at the forward kinematics in `data`
+/// (the torso at `torso`), with `[jx, jw]` as scratch (3 × nv each).
+fn goal_jacobian(
+    goal: &Goal,
+    model: &Model,
+    data: &ModelData,
+    torso: &IsometryMatrix3<f64>,
+    [jt, jwt]: [&Mat<f64>; 2],
+    [jx, jw]: [&mut Mat<f64>; 2],
+    out: &mut Mat<f64>,
+) -> Result<(), ImitationError> {
+    let rt = torso.rotation.inverse();
+    let nv = model.nv();
+    match *goal {
+        Goal::TorsoPoint { frame, offset, .. } | Goal::RootPoint { frame, offset, .. } => {
+            let x = model.point_position(data, frame, &offset)?;
+            model.point_jacobian(data, frame, &offset, jx.as_mut())?;
+            let in_torso = matches!(goal, Goal::TorsoPoint { .. });
+            let lever = x - torso.translation.vector;
+            for k in 0..nv {
+                let col = column(jx, k);
+                let col = match in_torso {
+                    true => rt * (col - column(jt, k) + lever.cross(&column(jwt, k))),
+                    false => col,
+                };
+                for r in 0..3 {
+                    out[(r, k)] = col[r];
+                }
+            }
+        }
+        Goal::TorsoNormal { frame, .. } | Goal::RootNormal { frame, .. } => {
+            let in_torso = matches!(goal, Goal::TorsoNormal { .. });
+            let z_root = data.frame_placement(frame).rotation * Vector3::z();
+            let z = if in_torso { rt * z_root } else { z_root };
+            model.orientation_jacobian(data, frame, jw.as_mut())?;
+            let across = across_basis(&z);
+            for k in 0..nv {
+                let omega = match in_torso {
+                    true => column(jw, k) - column(jwt, k),
+                    false => column(jw, k),
+                };
+                let dz = omega.cross(&z_root);
+                let dz = if in_torso { rt * dz } else { dz };
+                for (r, t) in across.iter().enumerate() {
+                    out[(r, k)] = NORMAL_WEIGHT * t.dot(&dz);
+                }
+            }
+        }
+        Goal::RootCom { .. } => model.com_jacobian_rows(data, 2, out.as_mut().subrows_mut(0, 2))?,
+        Goal::RootOrientation { frame, .. } => {
+            model.orientation_jacobian(data, frame, jw.as_mut())?;
+            for k in 0..nv {
+                for r in 0..3 {
+                    out[(r, k)] = NORMAL_WEIGHT * jw[(r, k)];
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
 impl GoalRows<'_> {
-    /// The distance rows over the moving joints.
-    fn write_distances(&mut self, stack: &mut TaskStack) -> Result<(), ImitationError> {
+    /// The distance rows' rooms and, with `jacobians`, their Jacobians over the moving joints.
+    fn write_distances(
+        &mut self,
+        stack: &mut TaskStack,
+        jacobians: bool,
+    ) -> Result<(), ImitationError> {
         if self.distances.is_empty() {
             return Ok(());
         }
@@ -432,6 +503,11 @@ impl GoalRows<'_> {
         let (mut jac, lower, upper) = level.inequalities_mut();
         let [.., full] = &mut *self.scratch;
         for (r, d) in self.distances.iter().enumerate() {
+            if !jacobians {
+                let (lower, upper) = (&mut lower[r..r + 1], &mut upper[r..r + 1]);
+                d.write_room(self.model, self.data, lower, upper)?;
+                continue;
+            }
             d.write(
                 self.model,
                 self.data,
