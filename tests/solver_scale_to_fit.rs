@@ -76,3 +76,35 @@ fn a_joint_at_its_position_limit_is_clamped_and_the_rest_refitted() {
     assert_relative_eq!(v[0], 2.0, epsilon = 1e-12);
     assert_eq!(v[1], 0.0);
 }
+
+#[test]
+fn a_rank_deficient_level_is_solved_for_every_part_on_one_factorization() {
+    // Level 0 asks q̇0 + q̇1 = 2 and = 4 (the same row twice): its least-squares solve (the
+    // stacked-matrix branch, rank 1 of 2 rows) gives q̇0 + q̇1 = 3, part (1.5, 1.5), which fits
+    // |q̇| ≤ 2. Level 1: q̇0 − q̇1 = 2, part (1, −1); 1.5 + s ≤ 2 gives s = 0.5: q̇ = (2, 1).
+    let shape = StackShape::new(2)
+        .with_level("pair", &[("pair", 2)])
+        .with_level("apart", &[("apart", 1)]);
+    let settings = Settings {
+        scale_to_fit: true,
+        ..Settings::default()
+    };
+    let mut s = Solver::with_settings(&shape, settings).unwrap();
+    let (mut jacobian, desired) = s.stack_mut().task_mut("pair").unwrap();
+    for r in 0..2 {
+        jacobian[(r, 0)] = 1.0;
+        jacobian[(r, 1)] = 1.0;
+    }
+    desired.copy_from_slice(&[2.0, 4.0]);
+    let (mut jacobian, desired) = s.stack_mut().task_mut("apart").unwrap();
+    jacobian[(0, 0)] = 1.0;
+    jacobian[(0, 1)] = -1.0;
+    desired[0] = 2.0;
+    let solution = s
+        .solve(&[0.0, 0.0], &velocity_bounds(&[2.0, 2.0]), 0.01)
+        .unwrap();
+    assert_eq!(solution.report.levels()[0].rank, 1);
+    let v = solution.velocity.to_vec();
+    assert_relative_eq!(v[0], 2.0, epsilon = 1e-12);
+    assert_relative_eq!(v[1], 1.0, epsilon = 1e-12);
+}

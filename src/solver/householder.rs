@@ -109,18 +109,25 @@ pub(crate) fn qr_col_pivoting(
     steps
 }
 
-/// Householder QR without pivoting of the `rows × cols` column-major matrix `a` (`rows ≥ cols`),
-/// applying the same reflectors to the right-hand side `b` (length `rows`). On return `a` holds `R`
-/// on and above the diagonal and `b[..cols]` holds `(Qᵀ b)[..cols]`.
-pub(crate) fn qr_with_rhs(a: &mut [f64], rows: usize, cols: usize, b: &mut [f64]) {
+/// Householder QR without pivoting of the `rows × cols` column-major matrix `a` (`rows ≥ cols`).
+/// On return `a` holds `R` on and above the diagonal and the reflectors below it, `tau[..cols]`
+/// their factors: [`apply_qt`] applies `Qᵀ` to any number of right-hand sides.
+pub(crate) fn qr_factor(a: &mut [f64], rows: usize, cols: usize, tau: &mut [f64]) {
     for k in 0..cols {
         let (head, rest) = a.split_at_mut((k + 1) * rows);
         let v = &mut head[k * rows + k..];
-        let tau = make_reflector(v);
+        tau[k] = make_reflector(v);
         for c in 0..cols - k - 1 {
-            apply_reflector(v, tau, &mut rest[c * rows + k..(c + 1) * rows]);
+            apply_reflector(v, tau[k], &mut rest[c * rows + k..(c + 1) * rows]);
         }
-        apply_reflector(v, tau, &mut b[k..rows]);
+    }
+}
+
+/// `b ← Qᵀ b` (length `rows`) for the factorization [`qr_factor`] left in `a` and `tau`: then
+/// `b[..cols]` holds `(Qᵀ b)[..cols]`.
+pub(crate) fn apply_qt(a: &[f64], rows: usize, cols: usize, tau: &[f64], b: &mut [f64]) {
+    for k in 0..cols {
+        apply_reflector(&a[k * rows + k..(k + 1) * rows], tau[k], &mut b[k..rows]);
     }
 }
 
@@ -172,6 +179,28 @@ mod tests {
         // The largest column (2·c0, norm 2√14) is chosen first.
         assert_eq!(perm[0], 1);
         assert!((a[0].abs() - 2.0 * 14f64.sqrt()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn one_factorization_solves_several_least_squares_right_hand_sides() {
+        // A = [[1, 0], [0, 1], [1, 1]] (column-major). By hand, x = (AᵀA)⁻¹ Aᵀ b with
+        // (AᵀA)⁻¹ = ⅓ [[2, −1], [−1, 2]]: b = (1, 2, 3) gives Aᵀb = (4, 5), x = (1, 2);
+        // b = (1, 0, 0) gives Aᵀb = (1, 0), x = (⅔, −⅓).
+        let mut a = [1.0, 0.0, 1.0, 0.0, 1.0, 1.0];
+        let mut tau = [0.0; 2];
+        qr_factor(&mut a, 3, 2, &mut tau);
+        for (b, x) in [
+            ([1.0, 2.0, 3.0], [1.0, 2.0]),
+            ([1.0, 0.0, 0.0], [2.0 / 3.0, -1.0 / 3.0]),
+        ] {
+            let mut b = b;
+            apply_qt(&a, 3, 2, &tau, &mut b);
+            solve_upper(&a, 3, 2, &mut b);
+            assert!(
+                (b[0] - x[0]).abs() < 1e-14 && (b[1] - x[1]).abs() < 1e-14,
+                "{b:?}"
+            );
+        }
     }
 
     #[test]

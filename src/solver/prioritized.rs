@@ -45,7 +45,8 @@
 use super::SolverError;
 use super::bounds::JointBounds;
 use super::householder::{
-    apply_reflector, dot, norm, qr_col_pivoting, qr_with_rhs, solve_upper, solve_upper_transposed,
+    apply_qt, apply_reflector, dot, norm, qr_col_pivoting, qr_factor, solve_upper,
+    solve_upper_transposed,
 };
 use super::report::{ActiveInequality, Bound, Solution, SolveReport};
 use super::stack::{StackShape, TaskStack, check_finite_slice, check_len, prefix_sums};
@@ -335,8 +336,14 @@ pub struct Solver {
     damp_toward_reference: bool,
     /// The damping reference in reduced coordinates, rotated level by level (length n).
     reference_coords: Vec<f64>,
-    /// Damped least-squares scratch: `(2 m_max) × m_max` and `2 m_max`.
-    ls_matrix: Vec<f64>,
+    /// Per level (from `damped_start[j]`): the QR of a damped or rank-deficient level's
+    /// stacked matrix `[Rᵀ; μ I]`, factored once per pass and reused for every right-hand side
+    /// of the pass's repeats ([`Solver::repeat_pass`]); its reflectors' factors at the level's
+    /// start in `damped_tau`.
+    damped_qr: Vec<f64>,
+    damped_start: Vec<usize>,
+    damped_tau: Vec<f64>,
+    /// Damped least-squares right-hand side (`2 m_max`).
     ls_rhs: Vec<f64>,
     /// Vector in reduced coordinates (length n).
     coords: Vec<f64>,
@@ -385,6 +392,9 @@ impl Solver {
             .map(|(m, p)| m + p)
             .collect();
         let m_max = capacities.iter().copied().max().unwrap_or(0);
+        // A level's stacked matrix: its rows plus one damping row per kept direction, by the
+        // kept directions (at most the level's rows and the joints).
+        let damped_start = prefix_sums(capacities.iter().map(|&m| (m + m.min(n)) * m.min(n)));
         let seg_start = prefix_sums(capacities.into_iter());
         let capacity = seg_start[levels];
         Ok(Self {
@@ -402,7 +412,9 @@ impl Solver {
             reference_coeff: vec![0.0; capacity],
             damp_toward_reference: false,
             reference_coords: vec![0.0; n],
-            ls_matrix: vec![0.0; 2 * m_max * m_max],
+            damped_qr: vec![0.0; damped_start[levels]],
+            damped_start,
+            damped_tau: vec![0.0; capacity],
             ls_rhs: vec![0.0; 2 * m_max],
             coords: vec![0.0; n],
             free: Vec::with_capacity(n),
@@ -685,7 +697,7 @@ impl Solver {
             if self.damp_toward_reference {
                 self.project_reference(j, offset);
             }
-            self.solve_level(j);
+            self.solve_level(j, true);
             dim -= rank;
             offset += rank;
         }
@@ -710,7 +722,7 @@ impl Solver {
             return self.pass();
         }
         for j in 0..self.stack.level_count() {
-            self.solve_level(j);
+            self.solve_level(j, false);
         }
         self.assemble_velocity();
     }
@@ -819,8 +831,9 @@ impl Solver {
     }
 
     /// Level j's right-hand side ([`Solver::level_rhs`]) and its least-squares coefficients
-    /// `w_j` from the level's factorization.
-    fn solve_level(&mut self, j: usize) {
+    /// `w_j` from the level's factorization; with `factor`, a damped or rank-deficient level's
+    /// stacked matrix is factored first (once per pass: the repeats reuse it).
+    fn solve_level(&mut self, j: usize, factor: bool) {
         self.level_rhs(j);
         let n = self.stack.dof();
         let start = self.seg_start[j];
@@ -845,16 +858,20 @@ impl Solver {
                 // min ‖[Rᵀ; μ I] w − [c; μ w_ref]‖ by a QR of the stacked matrix, w_ref the
                 // damping reference's coordinates (0 without one), scaled with the level.
                 let aug_rows = rows + if damping > 0.0 { rank } else { 0 };
-                let m = &mut self.ls_matrix[..aug_rows * rank];
-                m.fill(0.0);
-                for l in 0..rank {
-                    // Rᵀ is lower-trapezoidal; below R's diagonal `a` holds reflectors.
-                    for t in l..rows {
-                        m[l * aug_rows + t] = a[t * dim + l];
+                let m = &mut self.damped_qr[self.damped_start[j]..][..aug_rows * rank];
+                let tau = &mut self.damped_tau[start..start + rank];
+                if factor {
+                    m.fill(0.0);
+                    for l in 0..rank {
+                        // Rᵀ is lower-trapezoidal; below R's diagonal `a` holds reflectors.
+                        for t in l..rows {
+                            m[l * aug_rows + t] = a[t * dim + l];
+                        }
+                        if damping > 0.0 {
+                            m[l * aug_rows + rows + l] = damping;
+                        }
                     }
-                    if damping > 0.0 {
-                        m[l * aug_rows + rows + l] = damping;
-                    }
+                    qr_factor(m, aug_rows, rank, tau);
                 }
                 c[rows..aug_rows].fill(0.0);
                 // A level holding inequality rows at their bounds is damped toward rest: a
@@ -866,7 +883,7 @@ impl Solver {
                         *ck = damping * self.scales[j] * r;
                     }
                 }
-                qr_with_rhs(m, aug_rows, rank, &mut c[..aug_rows]);
+                apply_qt(m, aug_rows, rank, tau, &mut c[..aug_rows]);
                 solve_upper(m, aug_rows, rank, c);
             }
             w[..rank].copy_from_slice(&c[..rank]);
