@@ -232,12 +232,19 @@ impl PhaseSolver {
         let constraints = resolve_constraints(table, profile, model, &initial)?;
         let solver = Solver::with_settings(&table.shape(model.nv()), settings)?;
         let driver = PositionDriver::new(&solver, DriverSettings::default())?;
+        // The contact step's bounds are the frame's reach, position bounds far inside its
+        // velocity limits over its 1 s step, which scaling never scales: the clamping loop
+        // alone gives the same step in one pass instead of one per part.
+        let contact_settings = Settings {
+            scale_to_fit: false,
+            ..settings
+        };
         let contact = (table.levels.first())
             .filter(|level| level.name == "contact")
             .map(|level| {
                 let rows: usize = level.tasks.iter().map(Task::rows).sum();
                 let shape = StackShape::new(model.nv()).with_level("contact", &[("contact", rows)]);
-                Solver::with_settings(&shape, settings)
+                Solver::with_settings(&shape, contact_settings)
             })
             .transpose()?;
         let other = profile.foot(table.model_root.other());

@@ -591,16 +591,28 @@ impl Solver {
         let parts = self.scales.len();
         let mut factored = false;
         for _ in 0..=n {
+            // Without fixed velocities there is no base part: the factoring pass gives level
+            // 0's part instead.
+            let no_base = self.fixed_velocity.iter().all(|&v| v == 0.0);
             self.scales.fill(0.0);
+            self.scales[0] = if no_base { 1.0 } else { 0.0 };
             self.pass();
-            self.base_velocity.copy_from_slice(&self.velocity);
+            let first_part = if no_base {
+                self.base_velocity.fill(0.0);
+                self.contributions[..n].copy_from_slice(&self.velocity);
+                1
+            } else {
+                self.base_velocity.copy_from_slice(&self.velocity);
+                0
+            };
             self.saved_fixed.copy_from_slice(&self.fixed_velocity);
             self.fixed_velocity.fill(0.0);
-            // Each part is the same factorization with another right-hand side.
-            for k in 0..parts {
+            // Each part is the same factorization with another right-hand side; the levels
+            // above part k have none.
+            for k in first_part..parts {
                 self.scales.fill(0.0);
                 self.scales[k] = 1.0;
-                self.repeat_pass();
+                self.repeat_pass_from(k);
                 self.contributions[k * n..(k + 1) * n].copy_from_slice(&self.velocity);
             }
             self.fixed_velocity.copy_from_slice(&self.saved_fixed);
@@ -718,11 +730,22 @@ impl Solver {
     /// factorization (same free joints, same used rows): the velocity a new pass would give,
     /// bit for bit, without projecting and factoring the levels again.
     fn repeat_pass(&mut self) {
+        self.repeat_pass_from(0);
+    }
+
+    /// [`Solver::repeat_pass`] for a right-hand side that is zero on the levels above `first`
+    /// (their scales 0, no fixed velocities): their coefficients are zero and not solved for.
+    fn repeat_pass_from(&mut self, first: usize) {
         if !matches!(self.settings.method, Method::Prioritized) {
             return self.pass();
         }
         for j in 0..self.stack.level_count() {
-            self.solve_level(j, false);
+            if j < first {
+                let start = self.seg_start[j];
+                self.coeff[start..start + self.factors[j].rows].fill(0.0);
+            } else {
+                self.solve_level(j, false);
+            }
         }
         self.assemble_velocity();
     }
