@@ -112,7 +112,8 @@ pub struct Settings {
     /// scale `s_k ∈ [0, 1]` taken as large as the joint intervals allow given the levels above it
     /// ("saturation in the null space", Flacco et al. 2012, with whole-level scaling). A level
     /// keeps its direction and never costs a higher level any of its motion. The clamping loop
-    /// then only has the joints whose interval excludes 0 (a start outside the limits). Off by
+    /// then only has the joints whose interval excludes 0 (a start outside the limits). A step
+    /// that fits every interval unscaled is taken as it is, in one pass (every scale 1). Off by
     /// default: the paper's clamping loop alone, which keeps higher levels exact by pinning joints
     /// at their bounds, but can leave them few joints when a lower level asks for much more than
     /// the limits allow.
@@ -224,6 +225,16 @@ impl Settings {
             Method::WeightedDls { damping } => check("damping", damping, true),
         }
     }
+}
+
+/// What [`Solver::fit_scales`] leaves for the clamping loop.
+enum Fitted {
+    /// The whole step fits: `velocity` is the step.
+    Step,
+    /// `velocity` holds the scaled parts; the factorization is of the joints still free.
+    Factored,
+    /// The clamping ran out of joints to clamp: the next pass must factor again.
+    Refactor,
 }
 
 /// Per-level factorization data, in the stacked workspace buffers.
@@ -512,15 +523,16 @@ impl Solver {
         if let Method::WeightedDls { .. } = self.settings.method {
             self.update_limit_weights(q, bounds);
         }
-        // fit_scales leaves the factorization of the free joints it ends with.
-        let mut factored = self.settings.scale_to_fit && self.fit_scales();
+        let mut next = match self.settings.scale_to_fit {
+            true => self.fit_scales(),
+            false => Fitted::Refactor,
+        };
         loop {
             self.report.clamping_iterations += 1;
-            if factored {
-                self.repeat_pass();
-                factored = false;
-            } else {
-                self.pass();
+            match std::mem::replace(&mut next, Fitted::Refactor) {
+                Fitted::Step => {}
+                Fitted::Factored => self.repeat_pass(),
+                Fitted::Refactor => self.pass(),
             }
             // Clamp the worst violator only, then solve again: clamping every violator at once
             // lets a near-singular raw solution decide the fate of joints it would not need.
@@ -584,24 +596,37 @@ impl Solver {
     /// one prioritized pass. A free joint at a position limit that the unscaled step pushes
     /// through it is clamped first (no scale can help it); then, highest level first, each scale
     /// is the largest in [0, 1] that keeps the running sum inside every free joint's interval.
-    /// Returns whether the last factorization is of the joints still free (false only when the
-    /// clamping ran out of joints to clamp).
-    fn fit_scales(&mut self) -> bool {
+    /// The whole step, every scale 1, comes first: when it fits, it is the step
+    /// ([`Fitted::Step`]), and the parts are not computed.
+    fn fit_scales(&mut self) -> Fitted {
         let n = self.stack.dof();
         let parts = self.scales.len();
-        let mut factored = false;
+        self.scales.fill(1.0);
+        self.pass();
+        let fits = |i: &usize| (self.step_lo[*i]..=self.step_hi[*i]).contains(&self.velocity[*i]);
+        if self.free.iter().all(fits) {
+            return Fitted::Step;
+        }
+        // The whole step's pass factored the free joints, and none has a fixed velocity yet.
+        let mut whole_step_factored = true;
+        let mut fitted = Fitted::Refactor;
         for _ in 0..=n {
             // Without fixed velocities there is no base part: the factoring pass gives level
             // 0's part instead.
             let no_base = self.fixed_velocity.iter().all(|&v| v == 0.0);
-            self.scales.fill(0.0);
-            self.scales[0] = if no_base { 1.0 } else { 0.0 };
-            self.pass();
-            let first_part = if no_base {
+            let first_part = if std::mem::take(&mut whole_step_factored) {
+                self.base_velocity.fill(0.0);
+                0
+            } else if no_base {
+                self.scales.fill(0.0);
+                self.scales[0] = 1.0;
+                self.pass();
                 self.base_velocity.fill(0.0);
                 self.contributions[..n].copy_from_slice(&self.velocity);
                 1
             } else {
+                self.scales.fill(0.0);
+                self.pass();
                 self.base_velocity.copy_from_slice(&self.velocity);
                 0
             };
@@ -648,7 +673,7 @@ impl Solver {
                 }
             }
             if !blocked {
-                factored = true;
+                fitted = Fitted::Factored;
                 break;
             }
         }
@@ -674,7 +699,7 @@ impl Solver {
                 *v += scale * c;
             }
         }
-        factored
+        fitted
     }
 
     /// One solve by the configured method over the joints not clamped; writes `self.velocity`.
