@@ -109,8 +109,8 @@ pub struct ImitatorConfig {
     /// joints the balance level needs) and [`Settings::warm_start`] on (each frame's
     /// active-set solve starts from the last frame's active bounds). [`Settings::max_passes`]
     /// bounds a frame's solve (default: the method's own cap). Measured on the NAO over the
-    /// bundled clips: most frames take one pass of about 13 µs on top of a 35–45 µs step, one
-    /// frame in a hundred 8–13 (arm limits, lifts, landings), the slowest 31. A budget of 8
+    /// bundled clips: most frames take one pass (about 6 µs of a 16 µs step), one frame in a
+    /// hundred 7–11 (arm limits, lifts, landings), the slowest 21–31. A budget of 8
     /// cuts the p99 step by 20–40 % and the judge passes every clip on both models, but a
     /// solve cut short leaves the higher levels part of their motion: on CMU 07_04 with
     /// `--walk` the robot, its lifts cut frame after frame, walked 0.07 of 0.88 m (0.55 m
