@@ -599,8 +599,6 @@ impl Solver {
     /// The whole step, every scale 1, comes first: when it fits, it is the step
     /// ([`Fitted::Step`]), and the parts are not computed.
     fn fit_scales(&mut self) -> Fitted {
-        let n = self.stack.dof();
-        let parts = self.scales.len();
         self.scales.fill(1.0);
         self.pass();
         let fits = |i: &usize| (self.step_lo[*i]..=self.step_hi[*i]).contains(&self.velocity[*i]);
@@ -608,76 +606,98 @@ impl Solver {
             return Fitted::Step;
         }
         // The whole step's pass factored the free joints, and none has a fixed velocity yet.
-        let mut whole_step_factored = true;
+        let mut factored = true;
         let mut fitted = Fitted::Refactor;
-        for _ in 0..=n {
-            // Without fixed velocities there is no base part: the factoring pass gives level
-            // 0's part instead.
-            let no_base = self.fixed_velocity.iter().all(|&v| v == 0.0);
-            let first_part = if std::mem::take(&mut whole_step_factored) {
-                self.base_velocity.fill(0.0);
-                0
-            } else if no_base {
-                self.scales.fill(0.0);
-                self.scales[0] = 1.0;
-                self.pass();
-                self.base_velocity.fill(0.0);
-                self.contributions[..n].copy_from_slice(&self.velocity);
-                1
-            } else {
-                self.scales.fill(0.0);
-                self.pass();
-                self.base_velocity.copy_from_slice(&self.velocity);
-                0
-            };
-            self.saved_fixed.copy_from_slice(&self.fixed_velocity);
-            self.fixed_velocity.fill(0.0);
-            // Each part is the same factorization with another right-hand side; the levels
-            // above part k have none.
-            for k in first_part..parts {
-                self.scales.fill(0.0);
-                self.scales[k] = 1.0;
-                self.repeat_pass_from(k);
-                self.contributions[k * n..(k + 1) * n].copy_from_slice(&self.velocity);
-            }
-            self.fixed_velocity.copy_from_slice(&self.saved_fixed);
-            // A bound tighter than the velocity limit comes from a position limit: a joint
-            // pushed through it is clamped there (the paper's clamping), since slowing the
-            // step would only have it creep toward the limit. Velocity limits are left to the
-            // scales. The running sums are checked level by level, as the scales add them up: a
-            // joint at its limit that a higher level pushes out and a lower one pulls back in
-            // would otherwise scale the higher level, and every level after it, to zero, and
-            // the robot would stop for good. Every such joint is clamped at once (each is
-            // pinned by its own limit, whatever the others do), then the parts are recomputed.
-            let mut blocked = false;
-            for i in 0..n {
-                if self.clamped[i] {
-                    continue;
-                }
-                let (lo, hi, v) = (self.step_lo[i], self.step_hi[i], self.step_vmax[i]);
-                let mut sum = self.base_velocity[i];
-                for k in 0..parts {
-                    sum += self.contributions[k * n + i];
-                    let bound = if sum > hi && hi < v {
-                        hi
-                    } else if sum < lo && lo > -v {
-                        lo
-                    } else {
-                        continue;
-                    };
-                    self.clamped[i] = true;
-                    self.fixed_velocity[i] = bound;
-                    self.report.clamped.push(i);
-                    blocked = true;
-                    break;
-                }
-            }
-            if !blocked {
+        for _ in 0..=self.stack.dof() {
+            self.solve_parts(std::mem::take(&mut factored));
+            if !self.clamp_blocked() {
                 fitted = Fitted::Factored;
                 break;
             }
         }
-        // Running sum of the scaled parts, kept in `velocity`.
+        self.sum_scaled_parts();
+        fitted
+    }
+
+    /// The base part into `base_velocity` and each level's and the gradient's part into
+    /// `contributions`, over the free joints; `factored`: the last pass factored them and no
+    /// joint has a fixed velocity.
+    fn solve_parts(&mut self, factored: bool) {
+        let (n, parts) = (self.stack.dof(), self.scales.len());
+        // Without fixed velocities there is no base part: the factoring pass gives level 0's
+        // part instead.
+        let no_base = self.fixed_velocity.iter().all(|&v| v == 0.0);
+        let first_part = if factored {
+            self.base_velocity.fill(0.0);
+            0
+        } else if no_base {
+            self.scales.fill(0.0);
+            self.scales[0] = 1.0;
+            self.pass();
+            self.base_velocity.fill(0.0);
+            self.contributions[..n].copy_from_slice(&self.velocity);
+            1
+        } else {
+            self.scales.fill(0.0);
+            self.pass();
+            self.base_velocity.copy_from_slice(&self.velocity);
+            0
+        };
+        self.saved_fixed.copy_from_slice(&self.fixed_velocity);
+        self.fixed_velocity.fill(0.0);
+        // Each part is the same factorization with another right-hand side; the levels above
+        // part k have none.
+        for k in first_part..parts {
+            self.scales.fill(0.0);
+            self.scales[k] = 1.0;
+            self.repeat_pass_from(k);
+            self.contributions[k * n..(k + 1) * n].copy_from_slice(&self.velocity);
+        }
+        self.fixed_velocity.copy_from_slice(&self.saved_fixed);
+    }
+
+    /// Clamps every free joint that the running sum of the parts pushes through a position
+    /// limit; returns whether it clamped any (the parts must then be solved again).
+    ///
+    /// A bound tighter than the velocity limit comes from a position limit: a joint pushed
+    /// through it is clamped there (the paper's clamping), since slowing the step would only
+    /// have it creep toward the limit. Velocity limits are left to the scales. The running sums
+    /// are checked level by level, as the scales add them up: a joint at its limit that a
+    /// higher level pushes out and a lower one pulls back in would otherwise scale the higher
+    /// level, and every level after it, to zero, and the robot would stop for good. Every such
+    /// joint is clamped at once (each is pinned by its own limit, whatever the others do).
+    fn clamp_blocked(&mut self) -> bool {
+        let (n, parts) = (self.stack.dof(), self.scales.len());
+        let mut blocked = false;
+        for i in 0..n {
+            if self.clamped[i] {
+                continue;
+            }
+            let (lo, hi, v) = (self.step_lo[i], self.step_hi[i], self.step_vmax[i]);
+            let mut sum = self.base_velocity[i];
+            for k in 0..parts {
+                sum += self.contributions[k * n + i];
+                let bound = if sum > hi && hi < v {
+                    hi
+                } else if sum < lo && lo > -v {
+                    lo
+                } else {
+                    continue;
+                };
+                self.clamped[i] = true;
+                self.fixed_velocity[i] = bound;
+                self.report.clamped.push(i);
+                blocked = true;
+                break;
+            }
+        }
+        blocked
+    }
+
+    /// Each scale, highest level first, the largest in [0, 1] that keeps the running sum of the
+    /// scaled parts inside every free joint's interval; the sum into `velocity`.
+    fn sum_scaled_parts(&mut self) {
+        let (n, parts) = (self.stack.dof(), self.scales.len());
         self.velocity.copy_from_slice(&self.base_velocity);
         for k in 0..parts {
             let part = &self.contributions[k * n..(k + 1) * n];
@@ -699,7 +719,6 @@ impl Solver {
                 *v += scale * c;
             }
         }
-        fitted
     }
 
     /// One solve by the configured method over the joints not clamped; writes `self.velocity`.
