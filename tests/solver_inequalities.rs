@@ -403,7 +403,10 @@ fn level_costs(problem: &Problem, x: &[f64]) -> Vec<f64> {
 /// more than `tol` at the first level where their costs differ: the reference (an interior-point
 /// solver at 1e-10 tolerances, each level's optimum fixed as a constraint) then traded a higher
 /// level's exactness for a lower one's, and the difference of the solutions is the reference's
-/// inaccuracy (seed 4502148433111797730: level 1 violated by 4e-6 for a 4e-5 gain at level 2).
+/// inaccuracy (seed 4502148433111797730: level 1 violated by 4e-6 for a 4e-5 gain at level 2;
+/// seed 5807991262180742083: the last level's equality missed by 7e-7, counted unmet and kept at
+/// that value, for a 2e-3 smaller norm). Costs are squared residuals: `tol` = `MET²` tells a
+/// residual the reference counts as unmet from rounding.
 fn lexicographically_better(problem: &Problem, ours: &[f64], reference: &[f64], tol: f64) -> bool {
     let (a, b) = (level_costs(problem, ours), level_costs(problem, reference));
     let inside = (ours.iter().enumerate())
@@ -433,7 +436,7 @@ proptest! {
         let error = norm(&ours.iter().zip(&expected).map(|(a, b)| a - b).collect::<Vec<_>>());
         prop_assert!(
             error <= 1e-5 * (1.0 + norm(&expected))
-                || lexicographically_better(&problem, &ours, &expected, 1e-12),
+                || lexicographically_better(&problem, &ours, &expected, MET * MET),
             "ours {ours:?}\nreference {expected:?}\n{problem:?}\n{:?}", solver.report()
         );
     }
@@ -464,7 +467,7 @@ proptest! {
         let error = norm(&ours.iter().zip(&expected).map(|(a, b)| a - b).collect::<Vec<_>>());
         prop_assert!(
             error <= 1e-5 * (1.0 + norm(&expected))
-                || lexicographically_better(&problem, &ours, &expected, 1e-12),
+                || lexicographically_better(&problem, &ours, &expected, MET * MET),
             "ours {ours:?}\nreference {expected:?}\n{problem:?}\n{:?}", solver.report()
         );
         let again = solve_with(&mut solver, &problem, levels);

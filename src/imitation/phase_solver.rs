@@ -891,9 +891,7 @@ impl PhaseTasks<'_> {
         }
         Ok(())
     }
-}
 
-impl PhaseTasks<'_> {
     /// The error of `task` and, when `jacobian` is given, its Jacobian rows.
     fn write(
         &mut self,
