@@ -315,4 +315,25 @@ fn the_errors_alone_are_the_errors_of_the_rows() {
         upright_error(&model, &model.new_data(), hand, &up, &mut alone),
         Err(ModelError::KinematicsNotComputed)
     );
+    // Outputs too short, and a CoM with four axes, are typed errors, not panics.
+    assert!(matches!(
+        orientation_error(&model, &data, hand, &turn, &mut alone[..2]),
+        Err(ModelError::OutputShape {
+            expected_rows: 3,
+            rows: 2,
+            ..
+        })
+    ));
+    assert!(matches!(
+        point_error(&model, &data, &point, &axes, &target, &mut alone[..1]),
+        Err(ModelError::OutputShape {
+            expected_rows: 2,
+            rows: 1,
+            ..
+        })
+    ));
+    assert_eq!(
+        com_error(&model, &data, &[0.0; 4], &mut [0.0; 4]),
+        Err(ModelError::BadRowCount(4))
+    );
 }

@@ -79,13 +79,18 @@ pub fn com_rows(
 /// model that measures its tasks after its last step, where no Jacobian is needed.
 ///
 /// # Errors
-/// [`ModelError`] when `data` has no kinematics or the model has no mass.
+/// [`ModelError`] when `data` has no kinematics, the model has no mass, `target` has not 1 to 3
+/// entries or `error` fewer.
 pub fn com_error(
     model: &Model,
     data: &ModelData,
     target: &[f64],
     error: &mut [f64],
 ) -> Result<(), ModelError> {
+    if target.is_empty() || target.len() > 3 {
+        return Err(ModelError::BadRowCount(target.len()));
+    }
+    super::check_error_len(error, target.len())?;
     let c = model.com(data)?;
     for (r, t) in target.iter().enumerate() {
         error[r] = t - c[r];

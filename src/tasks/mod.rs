@@ -73,6 +73,20 @@ pub use set::TaskSet;
 pub use upright::{UprightTask, upright_error, upright_rows};
 pub use zmp::{GRAVITY, ZmpTask};
 
+/// `Ok` when an error output of `error.len()` entries holds a task's `rows` rows, else the
+/// [`ModelError::OutputShape`] of an `error.len() × 1` output.
+pub(crate) fn check_error_len(error: &[f64], rows: usize) -> Result<(), ModelError> {
+    if error.len() < rows {
+        return Err(ModelError::OutputShape {
+            expected_rows: rows,
+            expected_cols: 1,
+            rows: error.len(),
+            cols: 1,
+        });
+    }
+    Ok(())
+}
+
 /// Errors of building or evaluating tasks.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum TaskError {

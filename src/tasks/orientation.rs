@@ -62,7 +62,8 @@ pub fn orientation_rows(
 /// model that measures its tasks after its last step, where no Jacobian is needed.
 ///
 /// # Errors
-/// [`ModelError`] when `data` has no kinematics or the frame is not in `model`.
+/// [`ModelError`] when `data` has no kinematics, the frame is not in `model` or `error` has
+/// fewer than 3 entries.
 pub fn orientation_error(
     model: &Model,
     data: &ModelData,
@@ -72,6 +73,7 @@ pub fn orientation_error(
 ) -> Result<(), ModelError> {
     model.check_computed(data)?;
     model.check_frame(frame)?;
+    super::check_error_len(error, 3)?;
     let current = data.frame_placement(frame).rotation;
     let e = rotation_vector(&(target * current.inverse()));
     error[..3].copy_from_slice(e.as_slice());

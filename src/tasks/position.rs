@@ -51,7 +51,8 @@ pub fn point_rows(
 /// model that measures its tasks after its last step, where no Jacobian is needed.
 ///
 /// # Errors
-/// [`ModelError`] when `data` has no kinematics or the frame is not in `model`.
+/// [`ModelError`] when `data` has no kinematics, the frame is not in `model` or `error` is
+/// shorter than `axes`.
 pub fn point_error(
     model: &Model,
     data: &ModelData,
@@ -60,6 +61,7 @@ pub fn point_error(
     target: &Vector3<f64>,
     error: &mut [f64],
 ) -> Result<(), ModelError> {
+    super::check_error_len(error, axes.len())?;
     let x = model.point_position(data, point.frame, &point.offset)?;
     for (r, &axis) in axes.iter().enumerate() {
         error[r] = target[axis as usize] - x[axis as usize];

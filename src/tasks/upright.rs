@@ -79,7 +79,8 @@ pub fn upright_rows(
 /// tasks after its last step, where no Jacobian is needed.
 ///
 /// # Errors
-/// [`ModelError`] when `data` has no kinematics or the frame is not in `model`.
+/// [`ModelError`] when `data` has no kinematics, the frame is not in `model` or `error` has
+/// fewer than 2 entries.
 pub fn upright_error(
     model: &Model,
     data: &ModelData,
@@ -89,6 +90,7 @@ pub fn upright_error(
 ) -> Result<(), ModelError> {
     model.check_computed(data)?;
     model.check_frame(frame)?;
+    super::check_error_len(error, 2)?;
     let rotation = &data.frame_placement(frame).rotation;
     let tilt = (rotation * Vector3::z()).cross(up);
     error[..2].copy_from_slice(&[tilt.x, tilt.y]);
