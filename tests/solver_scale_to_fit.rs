@@ -108,3 +108,33 @@ fn a_rank_deficient_level_is_solved_for_every_part_on_one_factorization() {
     assert_relative_eq!(v[0], 2.0, epsilon = 1e-12);
     assert_relative_eq!(v[1], 1.0, epsilon = 1e-12);
 }
+
+#[test]
+fn a_step_that_fits_is_the_unscaled_solve_in_one_pass() {
+    // Level 0: q̇0 + q̇1 = 2, level 1: q̇0 − q̇1 = 1, gradient (0, 0, 1): by hand q̇ = (1.5, 0.5,
+    // 1), inside |q̇| ≤ 2. Scaling to fit takes it as it is, bit for bit the clamping loop's
+    // one pass, and solves nothing more.
+    let levels: &[(&[f64], f64)] = &[(&[1.0, 1.0, 0.0], 2.0), (&[1.0, -1.0, 0.0], 1.0)];
+    let gradient = [0.0, 0.0, 1.0];
+    let bounds = velocity_bounds(&[2.0; 3]);
+    let mut fitting = solver(3, levels, &gradient);
+    let solution = fitting.solve(&[0.0; 3], &bounds, 0.01).unwrap();
+    assert_eq!(solution.report.clamping_iterations(), 1);
+    let fitted = solution.velocity.to_vec();
+    let mut plain = solver(3, levels, &gradient);
+    plain
+        .set_settings(Settings {
+            scale_to_fit: false,
+            ..*plain.settings()
+        })
+        .unwrap();
+    let unscaled = plain
+        .solve(&[0.0; 3], &bounds, 0.01)
+        .unwrap()
+        .velocity
+        .to_vec();
+    assert_eq!(fitted, unscaled);
+    for (v, by_hand) in fitted.iter().zip([1.5, 0.5, 1.0]) {
+        assert_relative_eq!(*v, by_hand, epsilon = 1e-12);
+    }
+}
