@@ -6,7 +6,7 @@ mod common;
 use faer::Mat;
 use nalgebra::Vector3;
 use proptest::prelude::*;
-use taskstack::model::{Model, ModelError, UrdfOptions};
+use taskstack::model::{FrameId, Model, ModelError, UrdfOptions};
 use taskstack::robots::nao;
 
 const TREE: &str = include_str!("data/tree.urdf");
@@ -68,8 +68,75 @@ fn angular_momentum_jacobian_matches_the_links_motion() {
     }
 }
 
+/// Per variable of `model`: `Σ |μ| ℓ` over its joints' levers to a point within `extent` of
+/// `frame` (m per rad or per m): what bounds the point's speed per unit of the variable.
+fn variable_levers(model: &Model, frame: FrameId, extent: f64) -> Vec<f64> {
+    let mut out = vec![0.0; model.nv()];
+    let levers = model.levers(frame, extent).unwrap();
+    for (joint, lever) in model.joints().iter().zip(levers) {
+        if let (Some(v), Some(l)) = (joint.variable, lever) {
+            out[v] += joint.multiplier.abs() * l;
+        }
+    }
+    out
+}
+
+#[test]
+fn planar_arm_levers_by_hand() {
+    let model = Model::from_dh_str(PLANAR, "planar3r.toml").unwrap();
+    let tip = model.frame_id("tip").unwrap();
+    // Below joint 3 the last link (0.1 m), below joint 2 also the middle one (0.2 m), below
+    // joint 1 the whole arm (0.6 m); a point within 0.05 m of the tip adds 0.05.
+    let levers = model.levers(tip, 0.05).unwrap();
+    let expected = [0.65, 0.35, 0.15];
+    for (got, want) in levers.iter().zip(expected) {
+        assert!((got.unwrap() - want).abs() < 1e-15, "{levers:?}");
+    }
+    // Stretched (q = 0), the tip moves at the whole arm's length per radian of joint 1: the
+    // bound is reached.
+    let mut data = model.new_data();
+    model.forward_kinematics(&mut data, &[0.0; 3]).unwrap();
+    let mut j = Mat::<f64>::zeros(3, 3);
+    (model.point_jacobian(&data, tip, &Vector3::zeros(), j.as_mut())).unwrap();
+    let speed = (j[(0, 0)].powi(2) + j[(1, 0)].powi(2)).sqrt();
+    assert!((speed - 0.6).abs() < 1e-15);
+    // A frame of another model is refused.
+    let foreign = nao::rfoot().frame_id("l_sole").unwrap();
+    assert!(matches!(
+        model.levers(foreign, 0.0),
+        Err(ModelError::FrameOutOfRange(_))
+    ));
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(16))]
+    #[test]
+    fn levers_bound_every_points_speed(
+        u in proptest::collection::vec(0.0..1.0f64, 29),
+        offset in proptest::collection::vec(-1.0..1.0f64, 3),
+    ) {
+        // A prismatic joint, mimics and a fixed tool (the tree, also re-rooted at a leaf), the
+        // NAO's coupled hips, the G1's URDF.
+        let models = [tree(None), tree(Some("hand2")), nao::rfoot(), taskstack::robots::g1::left_sole()];
+        let extent = 0.05;
+        let offset = Vector3::new(offset[0], offset[1], offset[2]) * (extent / 3f64.sqrt());
+        for model in models {
+            let q = common::q_from_unit(&model, &u[..model.nv()]);
+            let mut data = model.new_data();
+            model.forward_kinematics(&mut data, &q).unwrap();
+            let mut j = Mat::<f64>::zeros(3, model.nv());
+            for f in model.frames() {
+                let id = model.frame_id(&f.name).unwrap();
+                model.point_jacobian(&data, id, &offset, j.as_mut()).unwrap();
+                let bound = variable_levers(&model, id, extent);
+                for (v, b) in bound.iter().enumerate() {
+                    let speed = (0..3).map(|r| j[(r, v)].powi(2)).sum::<f64>().sqrt();
+                    prop_assert!(speed <= b + 1e-12, "{} {} variable {v}: {speed} > {b}", model.name(), f.name);
+                }
+            }
+        }
+    }
+
     #[test]
     fn nao_jacobians_match_finite_differences(u in proptest::collection::vec(0.0..1.0f64, 23)) {
         for model in [nao::rfoot(), nao::lfoot()] {

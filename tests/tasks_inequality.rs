@@ -9,8 +9,8 @@ use faer::Mat;
 use nalgebra::Vector3;
 use taskstack::model::{Model, ModelData, ModelError};
 use taskstack::robots::nao;
-use taskstack::solver::Solver;
 use taskstack::solver::driver::{DriverSettings, PositionDriver};
+use taskstack::solver::{Solver, StackShape};
 use taskstack::tasks::{
     Capsule, CapsuleDistanceTask, ComPolygonTask, ContactNormalTask, GRAVITY, InequalityTask,
     PlaneDistanceTask, PositionTask, Task, TaskError, TaskSet, ZmpTask, closest_segment_parameters,
@@ -88,6 +88,166 @@ fn capsule_distance_jacobian_matches_finite_differences() {
             task.distance(&model, data).unwrap()
         });
     }
+}
+
+/// The rate bounds against central differences of the distance: no variable changes it faster,
+/// in several postures; the legs, which carry both arms and the torso, not at all.
+#[test]
+fn capsule_distance_rates_bound_its_change() {
+    let model = nao::rfoot();
+    let torso = Capsule::new(&model, "torso", Vector3::zeros(), Vector3::z() * 0.1, 0.06).unwrap();
+    let legs: Vec<usize> = (model.variables().iter().enumerate())
+        .filter(|(_, v)| {
+            v.name.contains("Hip") || v.name.contains("Knee") || v.name.contains("Ankle")
+        })
+        .map(|(k, _)| k)
+        .collect();
+    assert_eq!(legs.len(), 11);
+    for second in [torso, forearm(&model, "r")] {
+        let task =
+            CapsuleDistanceTask::new(&model, "arm", forearm(&model, "l"), second, 0.01).unwrap();
+        let rates = task.rate_bounds();
+        assert_eq!(rates.len(), model.nv());
+        assert!(legs.iter().all(|&k| rates[k] == 0.0), "{rates:?}");
+        let h = 1e-6;
+        for scale in [-1.0, 0.5, 1.0, 2.0] {
+            let q: Vec<f64> = bent(&model).iter().map(|v| v * scale).collect();
+            for k in 0..model.nv() {
+                let (mut plus, mut minus) = (q.clone(), q.clone());
+                plus[k] += h;
+                minus[k] -= h;
+                let distance = |q: &[f64]| task.distance(&model, &data_at(&model, q)).unwrap();
+                let rate = (distance(&plus) - distance(&minus)) / (2.0 * h);
+                assert!(
+                    rate.abs() <= rates[k] + 1e-6,
+                    "variable {k}: {rate} > {}",
+                    rates[k]
+                );
+            }
+        }
+    }
+}
+
+/// Standing, the forearms are farther apart than a 10 ms step at the NAO's rated speeds can
+/// close: the row is written open and without its Jacobian, and a solve with it is the solve
+/// with the full row, bit for bit. A step that could close the gap gets the full row.
+#[test]
+fn a_pair_no_step_can_bring_to_its_margin_skips_its_jacobian() {
+    let model = nao::rfoot();
+    let q = nao::profile().stand.clone();
+    let data = data_at(&model, &q);
+    let margin = 0.01;
+    let task = CapsuleDistanceTask::new(
+        &model,
+        "arms",
+        forearm(&model, "l"),
+        forearm(&model, "r"),
+        margin,
+    )
+    .unwrap();
+    let bounds = joint_bounds(&model).unwrap();
+    let dt = 0.01;
+    let step: Vec<f64> = bounds.velocity().iter().map(|v| v * dt).collect();
+    let reach: f64 = task
+        .rate_bounds()
+        .iter()
+        .zip(&step)
+        .map(|(k, s)| k * s)
+        .sum();
+    let room = task.distance(&model, &data).unwrap() - margin;
+    assert!(room > reach && reach > 0.01, "room {room}, reach {reach}");
+    let nv = model.nv();
+    let write = |step: &[f64]| {
+        let (mut jacobian, mut lower, mut upper) = (faer::Mat::zeros(1, nv), [0.0], [0.0]);
+        let full = (task.write_for_step(
+            &model,
+            &data,
+            step,
+            jacobian.as_mut(),
+            &mut lower,
+            &mut upper,
+        ))
+        .unwrap();
+        (
+            full,
+            (0..nv).map(|k| jacobian[(0, k)]).collect::<Vec<f64>>(),
+            lower[0],
+            upper[0],
+        )
+    };
+    let (full, open_row, lower, upper) = write(&step);
+    assert!(!full && lower == f64::NEG_INFINITY && upper == f64::INFINITY);
+    assert!(open_row.iter().all(|&c| c == 0.0));
+    let (row, room_bound) = inequality_row(&task, &model, &data);
+    assert_eq!(
+        write(&vec![1.0; nv]),
+        (true, row.clone(), room_bound, f64::INFINITY)
+    );
+    // The left hand pulled 5 cm toward the right one, below the distance level.
+    let mut hand = faer::Mat::<f64>::zeros(3, nv);
+    let l_hand = model.frame_id("l_wrist").unwrap();
+    model
+        .point_jacobian(&data, l_hand, &Vector3::zeros(), hand.as_mut())
+        .unwrap();
+    let shape = StackShape::new(nv)
+        .with_inequality_level("apart", &[("arms", 1)])
+        .with_level("hand", &[("l_hand", 3)]);
+    let solve = |row: &[f64], lower: f64| {
+        let mut solver = Solver::new(&shape).unwrap();
+        let stack = solver.stack_mut();
+        stack
+            .level_mut(0)
+            .set_inequality_row(0, row, lower / dt, f64::INFINITY)
+            .unwrap();
+        let mut level = stack.level_mut(1);
+        for r in 0..3 {
+            let jacobian: Vec<f64> = (0..nv).map(|k| hand[(r, k)]).collect();
+            level
+                .set_row(r, &jacobian, if r == 1 { -5.0 } else { 0.0 })
+                .unwrap();
+        }
+        solver.solve(&q, &bounds, dt).unwrap().velocity.to_vec()
+    };
+    let (with_row, open) = (solve(&row, room_bound), solve(&open_row, lower));
+    assert!(with_row.iter().any(|&v| v != 0.0));
+    assert_eq!(with_row, open);
+}
+
+/// `write_for_step` refuses a step or a Jacobian view of the wrong size.
+#[test]
+fn write_for_step_checks_its_sizes() {
+    let model = nao::rfoot();
+    let data = data_at(&model, &bent(&model));
+    let task = CapsuleDistanceTask::new(
+        &model,
+        "arms",
+        forearm(&model, "l"),
+        forearm(&model, "r"),
+        0.01,
+    )
+    .unwrap();
+    let nv = model.nv();
+    let (mut lower, mut upper) = ([0.0], [0.0]);
+    let mut jacobian = faer::Mat::zeros(1, nv);
+    let short = vec![0.0; nv - 1];
+    let error = task.write_for_step(
+        &model,
+        &data,
+        &short,
+        jacobian.as_mut(),
+        &mut lower,
+        &mut upper,
+    );
+    assert!(matches!(error, Err(ModelError::OutputShape { rows, .. }) if rows == nv - 1));
+    let mut wide = faer::Mat::zeros(1, nv + 1);
+    let step = vec![0.0; nv];
+    let error = task.write_for_step(&model, &data, &step, wide.as_mut(), &mut lower, &mut upper);
+    assert!(matches!(error, Err(ModelError::OutputShape { cols, .. }) if cols == nv + 1));
+    let error = task.write_for_step(&model, &data, &step, jacobian.as_mut(), &mut [], &mut upper);
+    assert!(matches!(
+        error,
+        Err(ModelError::OutputShape { rows: 0, .. })
+    ));
 }
 
 #[test]

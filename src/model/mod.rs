@@ -49,6 +49,7 @@
 
 pub mod dh;
 mod kinematics;
+mod levers;
 mod statics;
 mod tree;
 pub mod urdf;

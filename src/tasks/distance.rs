@@ -16,7 +16,7 @@ use faer::MatMut;
 use nalgebra::Vector3;
 
 use super::inequality::InequalityTask;
-use super::{TaskError, finite_target};
+use super::{TaskError, check_error_len, finite_target};
 use crate::model::{FrameId, Model, ModelData, ModelError};
 
 /// A segment `[a, b]` fixed in a frame (m, in the frame's axes), swept by a sphere of `radius`
@@ -121,6 +121,11 @@ impl Capsule {
     fn local(&self, s: f64) -> Vector3<f64> {
         self.a + (self.b - self.a) * s
     }
+
+    /// [`Model::levers`] of the segment's points (within `max(|a|, |b|)` of the frame's origin).
+    fn levers(&self, model: &Model) -> Result<Vec<Option<f64>>, ModelError> {
+        model.levers(self.frame, self.a.norm().max(self.b.norm()))
+    }
 }
 
 /// Parameters `(s, t) ∈ [0, 1]²` of the closest points `p₁ + s d₁`, `p₂ + t d₂` of two segments
@@ -191,12 +196,24 @@ fn check_margin(task: &str, margin: f64) -> Result<(), TaskError> {
 }
 
 /// Two capsules kept at least `margin` apart (m): one row, `margin − d ≤ C δq`.
+///
+/// # How fast the distance changes
+///
+/// Entry `v` of `C = nᵀ (J_{p₁} − J_{p₂})` sums the joints driven by variable `v`. A joint that
+/// moves both capsules turns (or shifts) them together: its part `μ nᵀ (w × (p₁ − p₂))` is 0, as
+/// `p₁ − p₂` is along `n`. A joint that moves one of them contributes at most `|μ| ℓ`, its
+/// [lever](Model::levers) to that capsule's segment. So `|C_v| ≤ k_v`, the sum of those
+/// bounds ([`CapsuleDistanceTask::rate_bounds`], fixed for the task), in every posture, and a
+/// step moving each variable by at most `δ_v` changes `d` by at most `Σ_v k_v δ_v` to first
+/// order: farther apart than that beyond the margin, the row cannot bind
+/// ([`CapsuleDistanceTask::write_for_step`]).
 #[derive(Debug, Clone)]
 pub struct CapsuleDistanceTask {
     name: String,
     first: Capsule,
     second: Capsule,
     margin: f64,
+    rates: Vec<f64>,
 }
 
 impl CapsuleDistanceTask {
@@ -214,14 +231,76 @@ impl CapsuleDistanceTask {
         margin: f64,
     ) -> Result<Self, TaskError> {
         check_margin(name, margin)?;
-        model.check_frame(first.frame)?;
-        model.check_frame(second.frame)?;
+        let (levers, others) = (first.levers(model)?, second.levers(model)?);
+        let mut rates = vec![0.0; model.nv()];
+        for ((joint, lever), other) in model.joints().iter().zip(levers).zip(others) {
+            let one_side = match (lever, other) {
+                (Some(l), None) | (None, Some(l)) => l,
+                _ => continue,
+            };
+            if let Some(v) = joint.variable {
+                rates[v] += joint.multiplier.abs() * one_side;
+            }
+        }
         Ok(Self {
             name: name.to_owned(),
             first,
             second,
             margin,
+            rates,
         })
+    }
+
+    /// Per variable `v` of the model, `k_v` with `|∂d/∂q_v| ≤ k_v` in every posture (m/rad, or
+    /// m/m for a prismatic variable; see the type's docs).
+    pub fn rate_bounds(&self) -> &[f64] {
+        &self.rates
+    }
+
+    /// [`InequalityTask::write`] for a step that moves each variable `v` by at most `step[v]`
+    /// (rad or m, ≥ 0): when the capsules are farther apart than the margin plus
+    /// `Σ_v k_v step[v]` ([`CapsuleDistanceTask::rate_bounds`]), no such step brings them to the
+    /// margin, and the row is written as `0 · δq ≥ −∞` without computing its Jacobian, the
+    /// costly part of the row; otherwise in full. Returns whether the row was written in full.
+    /// A solver keeping the step within those bounds finds the same solution with either row.
+    ///
+    /// # Errors
+    /// [`ModelError::OutputShape`] for a `step` of another length than the model's variables;
+    /// [`ModelError`] when `data` has no kinematics or a frame is not in `model`.
+    pub fn write_for_step(
+        &self,
+        model: &Model,
+        data: &ModelData,
+        step: &[f64],
+        mut jacobian: MatMut<'_, f64>,
+        lower: &mut [f64],
+        upper: &mut [f64],
+    ) -> Result<bool, ModelError> {
+        let nv = self.rates.len();
+        check_error_len(lower, 1)?;
+        check_error_len(upper, 1)?;
+        let shape = |expected_rows, expected_cols, (rows, cols)| ModelError::OutputShape {
+            expected_rows,
+            expected_cols,
+            rows,
+            cols,
+        };
+        if step.len() != nv {
+            return Err(shape(nv, 1, (step.len(), 1)));
+        }
+        if (jacobian.nrows(), jacobian.ncols()) != (1, nv) {
+            return Err(shape(1, nv, (jacobian.nrows(), jacobian.ncols())));
+        }
+        let closest = self.closest(model, data)?;
+        let reach: f64 = self.rates.iter().zip(step).map(|(k, s)| k * s).sum();
+        if closest.distance - self.margin > reach {
+            jacobian.fill(0.0);
+            lower[0] = f64::NEG_INFINITY;
+            upper[0] = f64::INFINITY;
+            return Ok(false);
+        }
+        self.write_closest(model, &closest, data, jacobian, lower, upper)?;
+        Ok(true)
     }
 
     /// The signed distance `d` (m; < 0 when the capsules overlap) at the forward kinematics in
@@ -250,6 +329,26 @@ impl CapsuleDistanceTask {
     fn closest(&self, model: &Model, data: &ModelData) -> Result<Closest, ModelError> {
         self.first.closest(&self.second, model, data)
     }
+
+    /// The row at the capsules' closest approach `closest`.
+    fn write_closest(
+        &self,
+        model: &Model,
+        closest: &Closest,
+        data: &ModelData,
+        jacobian: MatMut<'_, f64>,
+        lower: &mut [f64],
+        upper: &mut [f64],
+    ) -> Result<(), ModelError> {
+        let (first, second) = (self.first.local(closest.s), self.second.local(closest.t));
+        let mut jacobian = jacobian;
+        jacobian.fill(0.0);
+        let n = closest.normal;
+        model.add_point_jacobian_along(data, self.first.frame, &first, &n, jacobian.as_mut())?;
+        model.add_point_jacobian_along(data, self.second.frame, &second, &-n, jacobian.as_mut())?;
+        write_room(self.margin, closest.distance, lower, upper);
+        Ok(())
+    }
 }
 
 impl InequalityTask for CapsuleDistanceTask {
@@ -265,18 +364,12 @@ impl InequalityTask for CapsuleDistanceTask {
         &self,
         model: &Model,
         data: &ModelData,
-        mut jacobian: MatMut<'_, f64>,
+        jacobian: MatMut<'_, f64>,
         lower: &mut [f64],
         upper: &mut [f64],
     ) -> Result<(), ModelError> {
         let closest = self.closest(model, data)?;
-        let (first, second) = (self.first.local(closest.s), self.second.local(closest.t));
-        jacobian.fill(0.0);
-        let n = closest.normal;
-        model.add_point_jacobian_along(data, self.first.frame, &first, &n, jacobian.as_mut())?;
-        model.add_point_jacobian_along(data, self.second.frame, &second, &-n, jacobian.as_mut())?;
-        write_room(self.margin, closest.distance, lower, upper);
-        Ok(())
+        self.write_closest(model, &closest, data, jacobian, lower, upper)
     }
 
     fn as_any_mut(&mut self) -> &mut dyn Any {
