@@ -113,7 +113,7 @@ pub(crate) struct ImitationOptions {
     pub(crate) tracking_speed: Option<f64>,
     /// Largest change of the hand targets' speed (m/s², > 0), in every phase: the hands start
     /// and brake instead of reaching their speed in one frame. Default: the profile's (NAO 2,
-    /// G1 3; both methods).
+    /// G1 5; both methods).
     #[arg(long, value_name = "M_PER_S2", value_parser = positive, allow_negative_numbers = true)]
     pub(crate) tracking_acceleration: Option<f64>,
     /// Solver iterations per human frame (1–100).

@@ -88,7 +88,7 @@ pub struct ImitatorConfig {
     /// the human and the robot have stood on both feet for a second, and its
     /// [`stance_tracking_speed`](crate::robots::MotionTuning::stance_tracking_speed) otherwise
     /// ([`super::shaping::HandSpeed`]; NAO 0.8 and 0.3 m/s, shaped at 2 m/s², G1 1.2 and
-    /// 0.6 m/s at 3 m/s²; faster hands turned loaded feet in the physics judge, see
+    /// 0.6 m/s at 5 m/s²; faster hands turned loaded feet in the physics judge, see
     /// [`crate::robots::nao::TUNING`] and [`crate::robots::g1::TUNING`]), in both methods;
     /// Poubel's with the dynamic walk on ([`FootstepConfig::dynamic`]) uses the latter
     /// throughout.
