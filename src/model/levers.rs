@@ -1,29 +1,29 @@
-//! How fast a point of a link can move per unit of each joint, in every posture.
-//!
-//! A point `x` fixed to the link of frame `f`, within `e` of the frame's origin, moves with a
-//! revolute joint `i` on the path from the base by `μ_i w_i × (x − p_i)` per unit of its
-//! variable ([module docs](super)), whose norm is at most `|μ_i| ‖x − p_i‖`. Between the joint's
-//! axis point `p_i` (its link's origin) and the frame's origin lie the constant placements `P_j`
-//! of the joints below it and the frame's own placement: rigid offsets that the joints between
-//! only turn, so, whatever the posture,
-//!
-//! ```text
-//! ‖x − p_i‖ ≤ ℓ_i = e + ‖t(F)‖ + Σ_{j below i on the path} (‖t(P_j)‖ + travel_j)
-//! ```
-//!
-//! with `t(·)` a placement's translation, `F` the frame's placement in its link and `travel_j`
-//! the largest `|v_j|` of a prismatic joint `j` (its variable's limits; infinite when they are)
-//! and 0 for the others. A prismatic joint moves the point by `μ_i w_i`: lever `|μ_i|`, the unit
-//! axis' length. [`Model::levers`] gives `ℓ_i` (the lever of each joint on the path).
+//! How fast a point of a link can move per unit of each joint, in every posture
+//! ([`Model::levers`]).
 
 use super::{FrameId, JointKind, Model, ModelError};
 
 impl Model {
     /// Per joint (in [`Model::joints`] order): `Some(ℓ)`, a bound (m per unit of the joint's
     /// value: m/rad for a revolute joint, 1 for a prismatic one) on how fast a point within
-    /// `extent` m of `frame`'s origin moves with the joint, valid in every posture (see the
-    /// [module docs](self)), for the joints that move the frame; `None` for the others and for
-    /// fixed joints. Multiply by the joint's `|multiplier|` for a rate per unit of its variable.
+    /// `extent` m of `frame`'s origin moves with the joint, valid in every posture, for the
+    /// joints that move the frame; `None` for the others and for fixed joints. Multiply by the
+    /// joint's `|multiplier|` for a rate per unit of its variable.
+    ///
+    /// A point `x` fixed to the frame's link moves with a revolute joint `i` on the path from
+    /// the base by `μ_i w_i × (x − p_i)` per unit of its variable ([module docs](super)), at
+    /// most `|μ_i| ‖x − p_i‖`. Between the joint's axis point `p_i` (its link's origin) and the
+    /// frame's origin lie the constant placements `P_j` of the joints below it and the frame's
+    /// own placement `F`: rigid offsets that the joints between only turn, so, whatever the
+    /// posture,
+    ///
+    /// ```text
+    /// ‖x − p_i‖ ≤ ℓ_i = extent + ‖t(F)‖ + Σ_{j below i on the path} (‖t(P_j)‖ + travel_j)
+    /// ```
+    ///
+    /// with `t(·)` a placement's translation and `travel_j` the largest `|v_j|` of a prismatic
+    /// joint `j` (from its variable's limits; infinite when they are), 0 for the others. A
+    /// prismatic joint moves the point by `μ_i w_i`: lever 1, its unit axis' length.
     ///
     /// # Errors
     /// [`ModelError::FrameOutOfRange`] for a frame of another model.
