@@ -183,6 +183,15 @@ fn a_pair_no_step_can_bring_to_its_margin_skips_its_jacobian() {
         write(&vec![1.0; nv]),
         (true, row.clone(), room_bound, f64::INFINITY)
     );
+    // A step is a magnitude; a NaN one cannot vouch for anything.
+    let backward: Vec<f64> = step.iter().map(|s| -s).collect();
+    assert!(!write(&backward).0);
+    let mut unknown = step.clone();
+    unknown[0] = f64::NAN;
+    assert_eq!(
+        write(&unknown),
+        (true, row.clone(), room_bound, f64::INFINITY)
+    );
     // The left hand pulled 5 cm toward the right one, below the distance level.
     let mut hand = faer::Mat::<f64>::zeros(3, nv);
     let l_hand = model.frame_id("l_wrist").unwrap();

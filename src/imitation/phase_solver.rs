@@ -748,9 +748,12 @@ impl<'a> PhaseTasks<'a> {
         Self { joints, ..self }
     }
 
-    /// The same, for a solve whose steps of `dt` (s) stay within `bounds`, measured in `reach`.
+    /// The same, for a solve whose steps of `dt` (s) stay within `bounds`, measured in `reach`
+    /// when the table has distance rows.
     fn reaching(self, (reach, bounds, dt): (&'a mut StepReach, &'a JointBounds, f64)) -> Self {
-        let reach = Some((reach, bounds, dt));
+        let distances =
+            (self.constraints.iter()).any(|c| matches!(c.rows, ConstraintRows::Distance(_)));
+        let reach = distances.then_some((reach, bounds, dt));
         Self { reach, ..self }
     }
 }

@@ -292,7 +292,11 @@ impl CapsuleDistanceTask {
             return Err(shape(1, nv, (jacobian.nrows(), jacobian.ncols())));
         }
         let closest = self.closest(model, data)?;
-        let reach: f64 = self.rates.iter().zip(step).map(|(k, s)| k * s).sum();
+        // A joint that does not move adds nothing, whatever its bound (an unbounded prismatic
+        // joint's is infinite); a NaN step makes the reach NaN, and the row is written in full.
+        let reach: f64 = (self.rates.iter().zip(step))
+            .map(|(k, s)| if *s == 0.0 { 0.0 } else { k * s.abs() })
+            .sum();
         if closest.distance - self.margin > reach {
             jacobian.fill(0.0);
             lower[0] = f64::NEG_INFINITY;
