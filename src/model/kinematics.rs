@@ -379,7 +379,7 @@ impl Model {
         Ok(())
     }
 
-    fn check_shape(&self, out: &MatMut<'_, f64>, rows: usize) -> Result<(), ModelError> {
+    pub(crate) fn check_shape(&self, out: &MatMut<'_, f64>, rows: usize) -> Result<(), ModelError> {
         if out.nrows() != rows || out.ncols() != self.variables.len() {
             return Err(ModelError::OutputShape {
                 expected_rows: rows,

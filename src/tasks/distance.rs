@@ -279,18 +279,15 @@ impl CapsuleDistanceTask {
         let nv = self.rates.len();
         check_error_len(lower, 1)?;
         check_error_len(upper, 1)?;
-        let shape = |expected_rows, expected_cols, (rows, cols)| ModelError::OutputShape {
-            expected_rows,
-            expected_cols,
-            rows,
-            cols,
-        };
         if step.len() != nv {
-            return Err(shape(nv, 1, (step.len(), 1)));
+            return Err(ModelError::OutputShape {
+                expected_rows: nv,
+                expected_cols: 1,
+                rows: step.len(),
+                cols: 1,
+            });
         }
-        if (jacobian.nrows(), jacobian.ncols()) != (1, nv) {
-            return Err(shape(1, nv, (jacobian.nrows(), jacobian.ncols())));
-        }
+        model.check_shape(&jacobian, 1)?;
         let closest = self.closest(model, data)?;
         // A joint that does not move adds nothing, whatever its bound (an unbounded prismatic
         // joint's is infinite); a NaN step makes the reach NaN, and the row is written in full.
@@ -340,12 +337,11 @@ impl CapsuleDistanceTask {
         model: &Model,
         closest: &Closest,
         data: &ModelData,
-        jacobian: MatMut<'_, f64>,
+        mut jacobian: MatMut<'_, f64>,
         lower: &mut [f64],
         upper: &mut [f64],
     ) -> Result<(), ModelError> {
         let (first, second) = (self.first.local(closest.s), self.second.local(closest.t));
-        let mut jacobian = jacobian;
         jacobian.fill(0.0);
         let n = closest.normal;
         model.add_point_jacobian_along(data, self.first.frame, &first, &n, jacobian.as_mut())?;
