@@ -274,26 +274,37 @@ fn used_row(stack: &TaskStack, row: UsedRow, scale: f64) -> (&[f64], f64) {
 }
 
 /// Applies the reflectors of `factors` (levels `0..factors.len()`, level j's stored at
-/// `n · seg_start[j]` in `qr`) to `coords` (free-joint coordinates): afterwards
-/// `coords[o_j..o_j + k_j]` is `U_jᵀ v` for each level's range basis `U_j = Z_{j−1} Q_j[:, ..k_j]`.
-/// Returns the offset where the remaining null-space coordinates start.
+/// `n · seg_start[j]` in `qr`) to each vector `v` of free-joint coordinates stored `stride`
+/// apart in `vectors`: afterwards `v[o_j..o_j + k_j]` is `U_jᵀ v` for each level's range basis
+/// `U_j = Z_{j−1} Q_j[:, ..k_j]`. Returns the offset where the remaining null-space coordinates
+/// start.
+///
+/// Each reflector goes to every vector before the next one does: a reflector's product waits
+/// on the last one's update of the same vector, and the other vectors' products fill that
+/// wait. Each vector sees the same operations in the same order as alone, so the result is
+/// the same bit for bit; a level's rows are projected about twice as fast.
 fn apply_chain(
     qr: &[f64],
     n: usize,
     tau: &[f64],
     factors: &[LevelFactor],
     seg_start: &[usize],
-    coords: &mut [f64],
+    vectors: &mut [f64],
+    stride: usize,
 ) -> usize {
     let mut offset = 0;
     for (j, f) in factors.iter().enumerate() {
-        let start = seg_start[j];
-        apply_level(
-            &qr[n * start..],
-            &tau[start..],
-            f,
-            &mut coords[offset..offset + f.dim],
-        );
+        let (start, factor) = (seg_start[j], &qr[n * seg_start[j]..]);
+        for l in 0..f.rank {
+            let reflector = &factor[l * f.dim + l..(l + 1) * f.dim];
+            for v in vectors.chunks_mut(stride) {
+                apply_reflector(
+                    reflector,
+                    tau[start + l],
+                    &mut v[offset + l..offset + f.dim],
+                );
+            }
+        }
         offset += f.rank;
     }
     offset
@@ -801,25 +812,23 @@ impl Solver {
         let n = self.stack.dof();
         let seg = self.seg_start[j];
         let rows = self.list_used_rows(j);
-        let (head, tail) = self.qr.split_at_mut(n * seg);
+        // Each row's free-joint coordinates, rotated in place in its `projections` slot (n
+        // entries): the first `offset` are the row's coordinates along the levels above, the
+        // next `dim` its column of `A_jᵀ`.
+        let block = &mut self.projections[n * seg..n * (seg + rows)];
         self.row_scale = 0.0;
-        for t in 0..rows {
+        for (t, coords) in block.chunks_mut(n).enumerate() {
             let (row, _) = used_row(&self.stack, self.used[seg + t], self.scales[j]);
             self.row_scale = self.row_scale.max(norm(row));
-            for (c, &i) in self.coords.iter_mut().zip(&self.free) {
+            for (c, &i) in coords.iter_mut().zip(&self.free) {
                 *c = row[i];
             }
-            let offset = apply_chain(
-                head,
-                n,
-                &self.tau,
-                &self.factors[..j],
-                &self.seg_start,
-                &mut self.coords,
-            );
-            let at = n * (seg + t);
-            self.projections[at..at + offset].copy_from_slice(&self.coords[..offset]);
-            tail[t * dim..(t + 1) * dim].copy_from_slice(&self.coords[offset..offset + dim]);
+        }
+        let (head, tail) = self.qr.split_at_mut(n * seg);
+        let (factors, seg_start) = (&self.factors[..j], &self.seg_start);
+        let offset = apply_chain(head, n, &self.tau, factors, seg_start, block, n);
+        for (t, coords) in block.chunks(n).enumerate() {
+            tail[t * dim..(t + 1) * dim].copy_from_slice(&coords[offset..offset + dim]);
         }
         rows
     }
@@ -974,6 +983,7 @@ impl Solver {
             &self.factors,
             &self.seg_start,
             &mut self.coords,
+            n,
         );
         // Fold back: at level j the vector is [w_j; (deeper part)] in r_{j−1} coordinates.
         for j in (0..levels).rev() {

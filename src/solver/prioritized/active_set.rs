@@ -556,6 +556,7 @@ impl Solver {
             factors,
             &self.seg_start,
             &mut self.coords,
+            n,
         );
     }
 
