@@ -282,7 +282,8 @@ fn used_row(stack: &TaskStack, row: UsedRow, scale: f64) -> (&[f64], f64) {
 /// Each reflector goes to every vector before the next one does: a reflector's product waits
 /// on the last one's update of the same vector, and the other vectors' products fill that
 /// wait. Each vector sees the same operations in the same order as alone, so the result is
-/// the same bit for bit; a level's rows are projected about twice as fast.
+/// the same bit for bit; with a level's rows passed together, whole solves took 6–14 % less
+/// time than with the rows one by one (`cargo bench --bench solver`).
 fn apply_chain(
     qr: &[f64],
     n: usize,
