@@ -136,8 +136,8 @@ fn the_scaling_rules_keep_the_invariants_they_state() {
 #[test]
 fn the_rules_give_the_g1_what_was_tuned_on_it_independently() {
     // The G1's hand speed on one foot (0.6 m/s) and its torso lowering (0.05 m) were tuned on
-    // the G1 in the judge (`g1::TUNING`; the hands with its chest held, shaped at 3 m/s² then): the
-    // rules land within 10 % of both from the NAO's 0.3 m/s (shaped at 2 m/s²).
+    // the G1 in the judge (`g1::TUNING`; the hands with its chest held, shaped at 3 m/s² then):
+    // the rules land within 10 % of both from the NAO's 0.3 m/s (shaped at 2 m/s²).
     let g1 = g1::profile().size().unwrap();
     let rules = nao::TUNING.scaled(&nao::SIZE, &g1);
     // The G1's damping is the rules' value, rounded to 1 mm/rad; its legs' fraction in

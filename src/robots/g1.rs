@@ -136,11 +136,10 @@ pub const STAND: [f64; 29] = [
 /// feet the hands came within 1.4–8.9 cm but three nominal runs failed (feet tilting 3.7° on
 /// CMU 05_12, turning 2.9° on 09_12 and 131_01), and 1.2 m/s on one foot too turned 131_01's
 /// loaded foot 2.9°. Without the chest held, 0.5 m/s failed 6 runs (loaded feet sliding
-/// 7–8 mm). The
-/// URDF's velocity limits are the motors' no-load speeds (20–37 rad/s): 10 % of them is
-/// already more than the NAO's arms get at 50 %. The torso is carried 0.05 m below its
-/// standing height, not the NAO's 0.02 m: with legs three times as long, at 0.02 m the free
-/// leg ended straight 22 µm above the floor on CMU 05_02 and the landing never finished.
+/// 7–8 mm). The URDF's velocity limits are the motors' no-load speeds (20–37 rad/s): 10 % of them
+/// is already more than the NAO's arms get at 50 %. The torso is carried 0.05 m below its standing
+/// height, not the NAO's 0.02 m: with legs three times as long, at 0.02 m the free leg ended
+/// straight 22 µm above the floor on CMU 05_02 and the landing never finished.
 ///
 /// The lean, the support margin and the CoM reference's bounds are the NAO's, not what the
 /// scaling rules of [`crate::robots::tuning`] give (0.23 rad, 14 mm, 0.08 m/s, 0.12 m/s²):

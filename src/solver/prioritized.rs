@@ -295,31 +295,30 @@ fn apply_chain(
 ) -> usize {
     let mut offset = 0;
     for (j, f) in factors.iter().enumerate() {
-        let (start, factor) = (seg_start[j], &qr[n * seg_start[j]..]);
-        for l in 0..f.rank {
-            let reflector = &factor[l * f.dim + l..(l + 1) * f.dim];
-            for v in vectors.chunks_mut(stride) {
-                apply_reflector(
-                    reflector,
-                    tau[start + l],
-                    &mut v[offset + l..offset + f.dim],
-                );
-            }
-        }
+        let start = seg_start[j];
+        apply_level(&qr[n * start..], &tau[start..], f, vectors, stride, offset);
         offset += f.rank;
     }
     offset
 }
 
 /// Applies the reflectors of one level `f` (its factor and `tau` from the level's start) to
-/// `cur` (its `r_{j−1}` coordinates): afterwards `cur[..k_j]` is `Q_j[:, ..k_j]ᵀ cur`.
-fn apply_level(factor: &[f64], tau: &[f64], f: &LevelFactor, cur: &mut [f64]) {
+/// each vector `v` stored `stride` apart in `vectors`, whose `r_{j−1}` coordinates start at
+/// `offset`: afterwards `v[offset..offset + k_j]` is `Q_j[:, ..k_j]ᵀ` of them. Reflector by
+/// reflector, every vector in turn ([`apply_chain`]).
+fn apply_level(
+    factor: &[f64],
+    tau: &[f64],
+    f: &LevelFactor,
+    vectors: &mut [f64],
+    stride: usize,
+    offset: usize,
+) {
     for l in 0..f.rank {
-        apply_reflector(
-            &factor[l * f.dim + l..(l + 1) * f.dim],
-            tau[l],
-            &mut cur[l..],
-        );
+        let reflector = &factor[l * f.dim + l..(l + 1) * f.dim];
+        for v in vectors.chunks_mut(stride) {
+            apply_reflector(reflector, tau[l], &mut v[offset + l..offset + f.dim]);
+        }
     }
 }
 
@@ -778,7 +777,8 @@ impl Solver {
     fn project_reference(&mut self, j: usize, offset: usize) {
         let (n, start, f) = (self.stack.dof(), self.seg_start[j], self.factors[j]);
         let cur = &mut self.reference_coords[offset..offset + f.dim];
-        apply_level(&self.qr[n * start..], &self.tau[start..], &f, cur);
+        let dim = cur.len();
+        apply_level(&self.qr[n * start..], &self.tau[start..], &f, cur, dim, 0);
         self.reference_coeff[start..start + f.rank].copy_from_slice(&cur[..f.rank]);
     }
 

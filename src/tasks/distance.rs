@@ -258,8 +258,9 @@ impl CapsuleDistanceTask {
     }
 
     /// [`InequalityTask::write`] for a step that moves each variable `v` by at most `step[v]`
-    /// (rad or m; its size counts, and a NaN entry writes the row in full): when the capsules are farther apart than the margin plus
-    /// `Σ_v k_v step[v]` ([`CapsuleDistanceTask::rate_bounds`]), no such step brings them to the
+    /// (rad or m; its size counts, and a NaN entry writes the row in full): when the capsules
+    /// are farther apart than the margin plus `Σ_v k_v |step[v]|`
+    /// ([`CapsuleDistanceTask::rate_bounds`]), no such step brings them to the
     /// margin, and the row is written as `0 · δq ≥ −∞` without computing its Jacobian, the
     /// costly part of the row; otherwise in full. Returns whether the row was written in full.
     /// A solver keeping the step within those bounds finds the same solution with either row.
