@@ -697,6 +697,9 @@ pub fn metrics_value(m: &ImitationMetrics, clip: &Path) -> Value {
                 "frames": r.frames,
                 "unreachable_frames": r.unreachable_frames,
                 "shortfall_m": { "mean": r.mean_shortfall_m, "max": r.max_shortfall_m },
+                "error_m": r.mean_error_m,
+                "least_error_m": { "mean": r.mean_least_error_m, "max": r.max_least_error_m },
+                "posture_unreachable_frames": r.posture_unreachable_frames,
             });
             json!({ "l_hand": arm(&arms[0]), "r_hand": arm(&arms[1]) })
         }),

@@ -15,6 +15,7 @@ use taskstack::imitation::contact_events::ContactConfig;
 use taskstack::imitation::hand_support::{HandContactPlan, HandSupportConfig};
 use taskstack::imitation::look_ahead::{FootLookAhead, FootSchedule};
 use taskstack::imitation::metrics::ImitationMetrics;
+use taskstack::imitation::reach::POSTURE_UNREACHABLE;
 use taskstack::imitation::support::SupportConfig;
 use taskstack::scene::Scene;
 
@@ -387,5 +388,24 @@ fn print_reach(text: &mut String, m: &ImitationMetrics) {
         arms[0].reach_m * 100.0,
         hand("l_hand", &arms[0]),
         hand("r_hand", &arms[1])
+    );
+    let split = |name: &str, a: &taskstack::imitation::reach::HandReach| match (
+        a.mean_error_m,
+        a.mean_least_error_m,
+    ) {
+        (Some(error), Some(least)) => format!(
+            "{name} {:.1} of {:.1} cm ({} frames beyond {:.0} cm)",
+            least * 100.0,
+            error * 100.0,
+            a.posture_unreachable_frames,
+            POSTURE_UNREACHABLE * 100.0
+        ),
+        _ => format!("{name} no frames"),
+    };
+    let _ = writeln!(
+        text,
+        "hand error no arm posture within the joint limits removes, of the mean over the clip: {}; {}",
+        split("l_hand", &arms[0]),
+        split("r_hand", &arms[1])
     );
 }

@@ -24,6 +24,11 @@
 //! A hand's error on such a frame is at least its shortfall whatever the arm does. Positions
 //! in the left-rooted model's base frame; the references are moved there from the frame's root.
 //!
+//! The distance test cannot see the joint ranges: [`posture`] finds, per frame, the least
+//! error any posture of the arm within its joint ranges (and the profile's self-collision
+//! margin) gets, which splits a hand's error into what no arm posture removes and the rest,
+//! lateness or an arm caught in a posture it cannot follow the reference from.
+//!
 //! Poubel's method aims each hand at its reference pulled along the line to the shoulder until
 //! the arm reaches it with its elbow `MIN_ELBOW_BEND` (0.3 rad) from straight
 //! (`Arm::within_reach`), and keeps the elbow at least that bent (`Elbow::interval`). A
@@ -31,13 +36,17 @@
 //! is no singularity, and moving such targets out cost the G1 2 cm of mean hand error on CMU
 //! 131_01.
 
+mod posture;
+
 use nalgebra::{IsometryMatrix3, Matrix3, Vector3};
 
+use self::posture::ArmPostures;
 use super::imitator::RobotFrame;
 use super::output::EFFECTORS;
 use crate::human::{HumanJoint, Side};
 use crate::model::{FrameId, Model, ModelData};
 use crate::robots::{BipedProfile, RobotPoint};
+use crate::tasks::Capsule;
 
 /// How far one hand's references lay beyond the arm's reach over the frames measured.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -55,7 +64,34 @@ pub struct HandReach {
     pub mean_shortfall_m: Option<f64>,
     /// Largest shortfall (m); `None` without any unreachable frame.
     pub max_shortfall_m: Option<f64>,
+    /// Mean distance of the hand from its reference over the frames measured (m); `None`
+    /// without any.
+    pub mean_error_m: Option<f64>,
+    /// Mean over the frames measured of the least distance from the reference to which some
+    /// posture of the arm within its joint ranges (the rest of the body at the frame's posture,
+    /// the profile's self-collision margin kept) brings the hand, as far as a multi-start
+    /// search finds ([`posture`]): an upper bound on the error no arm posture removes (m);
+    /// `None` without any frame. `mean_error_m` less this is error some posture removes.
+    pub mean_least_error_m: Option<f64>,
+    /// The largest of those least distances (m); `None` without any frame.
+    pub max_least_error_m: Option<f64>,
+    /// Frames whose least distance exceeded [`POSTURE_UNREACHABLE`]: the reference lay out of
+    /// the arm's joint ranges, whatever its distance from the shoulder.
+    pub posture_unreachable_frames: usize,
 }
+
+/// A frame whose reference no posture of the arm brings the hand nearer than this (m) counts
+/// in [`HandReach::posture_unreachable_frames`].
+pub const POSTURE_UNREACHABLE: f64 = 0.01;
+
+/// A hand at most this far from its reference (m) is not searched for a nearer posture: its
+/// own distance stands for the least.
+const SEARCH_FROM: f64 = 2e-3;
+
+/// How far inside the self-collision margin (or the frame's own clearance, if nearer) a
+/// searched posture may end (m): the IK's first-order steps end a hair inside, as the
+/// imitation's do.
+const MARGIN_SLACK: f64 = 1e-4;
 
 /// One robot arm in a model: the frames of its shoulder point and hand, and how near to and
 /// far from the shoulder its elbow can bring the hand.
@@ -297,7 +333,26 @@ pub struct ReachMeter {
     /// The soles in the left-rooted model (`[left, right]`): where a frame's root is.
     soles: [FrameId; 2],
     arms: [Arm; 2],
-    counts: [(usize, usize, f64, f64); 2],
+    postures: [ArmPostures; 2],
+    /// The profile's self-collision pairs and margin, and the pairs' distances at the frame's
+    /// own posture.
+    pairs: Vec<[Capsule; 2]>,
+    margin: f64,
+    frame_distances: Vec<f64>,
+    tallies: [Tally; 2],
+}
+
+/// One hand's sums over the frames measured.
+#[derive(Debug, Clone, Copy, Default)]
+struct Tally {
+    frames: usize,
+    unreachable: usize,
+    shortfall_sum: f64,
+    shortfall_max: f64,
+    error_sum: f64,
+    least_sum: f64,
+    least_max: f64,
+    posture_unreachable: usize,
 }
 
 impl ReachMeter {
@@ -307,54 +362,100 @@ impl ReachMeter {
         let model = profile.models[Side::Left.index()].clone();
         let arm = |side| Arm::of(profile, &model, side);
         let arms = [arm(Side::Left)?, arm(Side::Right)?];
-        let sole = |side: Side| model.frame_id(&profile.foot(side).sole).ok();
+        let frame = |name: &str| model.frame_id(name).ok();
+        let upper_body = frame(profile.chest.as_ref().unwrap_or(&profile.torso))?;
+        let postures = |arm: &Arm| ArmPostures::of(&model, &profile.stand, upper_body, arm.hand_frame);
+        let postures = [postures(&arms[0])?, postures(&arms[1])?];
+        let pairs = profile.self_collision.resolve(&model, &profile.stand).ok()?;
         Some(Self {
             data: model.new_data(),
-            soles: [sole(Side::Left)?, sole(Side::Right)?],
-            model,
+            soles: [
+                frame(&profile.foot(Side::Left).sole)?,
+                frame(&profile.foot(Side::Right).sole)?,
+            ],
             arms,
-            counts: [(0, 0, 0.0, 0.0); 2],
+            postures,
+            frame_distances: vec![0.0; pairs.len()],
+            pairs,
+            margin: profile.self_collision.margin,
+            model,
+            tallies: [Tally::default(); 2],
         })
     }
 
     /// Records one frame of the clip.
     pub fn record(&mut self, frame: &RobotFrame) {
-        if self
-            .model
-            .forward_kinematics(&mut self.data, &frame.q)
-            .is_err()
-        {
+        let Self {
+            model, data, soles, arms, postures, pairs, margin, frame_distances, tallies,
+        } = self;
+        if model.forward_kinematics(data, &frame.q).is_err() {
             return;
         }
-        let base_t_root: IsometryMatrix3<f64> =
-            *self.data.frame_placement(self.soles[frame.root.index()]);
-        for (arm, counts) in self.arms.iter().zip(&mut self.counts) {
+        let base_t_root: IsometryMatrix3<f64> = *data.frame_placement(soles[frame.root.index()]);
+        let mut searches = [None; 2];
+        for (k, (arm, tally)) in arms.iter().zip(tallies.iter_mut()).enumerate() {
             let Some(reference) = frame.reference[arm.hand.index()] else {
+                postures[k].forget();
                 continue;
             };
             let reference = base_t_root.transform_point(&reference.into()).coords;
-            let shortfall = arm.shortfall(&self.data, &reference);
-            counts.0 += 1;
+            let shortfall = arm.shortfall(data, &reference);
+            tally.frames += 1;
             if shortfall > 0.0 {
-                counts.1 += 1;
-                counts.2 += shortfall;
-                counts.3 = counts.3.max(shortfall);
+                tally.unreachable += 1;
+                tally.shortfall_sum += shortfall;
+                tally.shortfall_max = tally.shortfall_max.max(shortfall);
             }
+            let hand = data.frame_placement(arm.hand_frame).translation.vector;
+            searches[k] = Some((reference, (reference - hand).norm()));
+        }
+        let distance = |[a, b]: &[Capsule; 2], model: &Model, data: &ModelData| {
+            a.distance_to(b, model, data).unwrap_or(f64::NEG_INFINITY)
+        };
+        for (d, pair) in frame_distances.iter_mut().zip(pairs.iter()) {
+            *d = distance(pair, model, data);
+        }
+        // A posture counts when it brings no pair nearer than the margin, or than the
+        // frame's own posture had it where that was nearer.
+        let keeps_apart = |model: &Model, data: &ModelData| {
+            let floors = frame_distances.iter().map(|&d| margin.min(d) - MARGIN_SLACK);
+            pairs.iter().zip(floors).all(|(pair, floor)| distance(pair, model, data) >= floor)
+        };
+        for (k, search) in searches.iter().enumerate() {
+            let Some((reference, error)) = *search else {
+                continue;
+            };
+            let least = match error > SEARCH_FROM {
+                true => postures[k]
+                    .least_error(model, data, &frame.q, &reference, keeps_apart)
+                    .map_or(error, |found| found.min(error)),
+                false => error,
+            };
+            let tally = &mut tallies[k];
+            tally.error_sum += error;
+            tally.least_sum += least;
+            tally.least_max = tally.least_max.max(least);
+            tally.posture_unreachable += usize::from(least > POSTURE_UNREACHABLE);
         }
     }
 
     /// The reach of both hands (`[left, right]`) over the frames recorded.
     pub fn reach(&self) -> [HandReach; 2] {
         std::array::from_fn(|k| {
-            let (frames, unreachable, sum, max) = self.counts[k];
-            let any = unreachable > 0;
+            let t = self.tallies[k];
+            let any = t.unreachable > 0;
+            let measured = t.frames > 0;
             HandReach {
                 reach_m: self.arms[k].span[1],
                 min_reach_m: self.arms[k].span[0],
-                frames,
-                unreachable_frames: unreachable,
-                mean_shortfall_m: any.then(|| sum / unreachable as f64),
-                max_shortfall_m: any.then_some(max),
+                frames: t.frames,
+                unreachable_frames: t.unreachable,
+                mean_shortfall_m: any.then(|| t.shortfall_sum / t.unreachable as f64),
+                max_shortfall_m: any.then_some(t.shortfall_max),
+                mean_error_m: measured.then(|| t.error_sum / t.frames as f64),
+                mean_least_error_m: measured.then(|| t.least_sum / t.frames as f64),
+                max_least_error_m: measured.then_some(t.least_max),
+                posture_unreachable_frames: t.posture_unreachable,
             }
         })
     }
