@@ -401,6 +401,51 @@ fn the_report_counts_hand_references_beyond_the_arms_reach() {
     assert!(cell["shortfall_m"]["max"].as_f64().unwrap() >= waving.mean_shortfall_m.unwrap());
 }
 
+/// The report splits each hand's error into what no arm posture within the joint limits
+/// removes and the rest (issue 31 item 3). Checked against bounds computed another way: the
+/// least error is at most the hand's own error on every frame (the robot's own posture is one
+/// of the arm's postures), and at least the distance test's shortfall (no posture brings the
+/// hand nearer the shoulder than the bent elbow, or farther than the straight arm), so over
+/// the clip the sums keep the same order; the hand's own mean equals the tracking table's over
+/// every clip frame (every phase tracks the hands).
+#[test]
+fn the_report_splits_hand_error_into_what_no_arm_posture_removes() {
+    let (m, json) = nao_clip_metrics(SHORT[0]);
+    let reach = m.hand_reach.expect("the NAO maps shoulders and hands");
+    for (arm, name) in reach.iter().zip(["l_hand", "r_hand"]) {
+        let frames = arm.frames as f64;
+        let (error, least) = (arm.mean_error_m.unwrap(), arm.mean_least_error_m.unwrap());
+        assert!(
+            least <= error + 1e-12,
+            "{name}: least {least} m > error {error} m"
+        );
+        let shortfalls = arm.mean_shortfall_m.unwrap_or(0.0) * arm.unreachable_frames as f64;
+        assert!(
+            least * frames >= shortfalls - 1e-9,
+            "{name}: least errors {} m < shortfalls {shortfalls} m",
+            least * frames
+        );
+        assert!(arm.max_least_error_m.unwrap() >= least);
+        assert!(arm.posture_unreachable_frames <= arm.frames);
+        let hand = m.effectors_clip.iter().find(|e| e.name == name).unwrap();
+        let cells = [hand.single_support, hand.double_support, hand.transitions];
+        let counted: usize = cells.iter().map(|c| c.count).sum();
+        assert_eq!(counted, arm.frames, "{name}");
+        let table: f64 = cells.iter().map(|c| c.mean * c.count as f64).sum::<f64>() / frames;
+        assert!(
+            (table - error).abs() < 1e-9,
+            "{name}: table {table} m, reach {error} m"
+        );
+        let cell = &json["hand_reach"][name];
+        assert_eq!(
+            cell["posture_unreachable_frames"],
+            arm.posture_unreachable_frames
+        );
+        assert_eq!(cell["least_error_m"]["mean"].as_f64(), Some(least));
+        assert_eq!(cell["error_m"].as_f64(), Some(error));
+    }
+}
+
 /// The URDF NAO's hand distance from its shoulder frame, standing, with the `side` elbow roll
 /// at its bent and at its straight limit (m).
 fn urdf_arm_span(side: Side) -> [f64; 2] {

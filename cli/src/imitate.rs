@@ -394,9 +394,9 @@ fn print_reach(text: &mut String, m: &ImitationMetrics) {
         a.mean_least_error_m,
     ) {
         (Some(error), Some(least)) => format!(
-            "{name} {:.1} of {:.1} cm ({} frames beyond {:.0} cm)",
-            least * 100.0,
+            "{name} {:.1} cm, {:.1} cm of it ({} frames over {:.0} cm)",
             error * 100.0,
+            least * 100.0,
             a.posture_unreachable_frames,
             POSTURE_UNREACHABLE * 100.0
         ),
@@ -404,7 +404,7 @@ fn print_reach(text: &mut String, m: &ImitationMetrics) {
     };
     let _ = writeln!(
         text,
-        "hand error no arm posture within the joint limits removes, of the mean over the clip: {}; {}",
+        "mean hand error over the clip, and the part no arm posture within the joint limits removes: {}; {}",
         split("l_hand", &arms[0]),
         split("r_hand", &arms[1])
     );

@@ -21,7 +21,10 @@
 //!   steps of both, catch-up time after the clip, the hands' lag; tracking errors over the clip's
 //!   own frames apart from the hold that follows it ([`MetricsRecorder::mark_clip_end`]).
 //! * **Reach** ([`super::reach`]): the clip's frames whose hand reference lay beyond the arm's
-//!   reach from the robot's own shoulder, and by how much (m): error that is not lateness.
+//!   reach from the robot's own shoulder, and by how much (m); and per hand the part of its
+//!   error that no arm posture within the joint limits (and the self-collision margin)
+//!   removes, as far as a multi-start IK of the arm finds: the rest is lateness or an arm
+//!   posture that cannot follow the reference.
 //! * **Hands held as supports** ([`super::hand_support`]): per hand, the contacts made, the
 //!   time from the start of placing to the contact (s, robot clock), and the distance of the
 //!   held hand from its contact point (m).

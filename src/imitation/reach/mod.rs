@@ -364,9 +364,13 @@ impl ReachMeter {
         let arms = [arm(Side::Left)?, arm(Side::Right)?];
         let frame = |name: &str| model.frame_id(name).ok();
         let upper_body = frame(profile.chest.as_ref().unwrap_or(&profile.torso))?;
-        let postures = |arm: &Arm| ArmPostures::of(&model, &profile.stand, upper_body, arm.hand_frame);
+        let postures =
+            |arm: &Arm| ArmPostures::of(&model, &profile.stand, upper_body, arm.hand_frame);
         let postures = [postures(&arms[0])?, postures(&arms[1])?];
-        let pairs = profile.self_collision.resolve(&model, &profile.stand).ok()?;
+        let pairs = profile
+            .self_collision
+            .resolve(&model, &profile.stand)
+            .ok()?;
         Some(Self {
             data: model.new_data(),
             soles: [
@@ -386,7 +390,15 @@ impl ReachMeter {
     /// Records one frame of the clip.
     pub fn record(&mut self, frame: &RobotFrame) {
         let Self {
-            model, data, soles, arms, postures, pairs, margin, frame_distances, tallies,
+            model,
+            data,
+            soles,
+            arms,
+            postures,
+            pairs,
+            margin,
+            frame_distances,
+            tallies,
         } = self;
         if model.forward_kinematics(data, &frame.q).is_err() {
             return;
@@ -418,8 +430,13 @@ impl ReachMeter {
         // A posture counts when it brings no pair nearer than the margin, or than the
         // frame's own posture had it where that was nearer.
         let keeps_apart = |model: &Model, data: &ModelData| {
-            let floors = frame_distances.iter().map(|&d| margin.min(d) - MARGIN_SLACK);
-            pairs.iter().zip(floors).all(|(pair, floor)| distance(pair, model, data) >= floor)
+            let floors = frame_distances
+                .iter()
+                .map(|&d| margin.min(d) - MARGIN_SLACK);
+            pairs
+                .iter()
+                .zip(floors)
+                .all(|(pair, floor)| distance(pair, model, data) >= floor)
         };
         for (k, search) in searches.iter().enumerate() {
             let Some((reference, error)) = *search else {

@@ -15,10 +15,12 @@
 //!
 //! (`J` the hand's 3 × k position Jacobian in the arm's free variables, positions in the model's
 //! base frame, m; a variable at a limit that the step would push past is held there and its
-//! column left out). The steps start from the frame's own posture, then from the last frame's
-//! best arm posture, then from [`spread`] postures over the joint ranges, and stop at the
-//! first that brings the hand within [`REACHED`]. A posture counts only when the caller
-//! accepts it (the meter requires the profile's self-collision margin).
+//! column left out; a step that does not bring the hand nearer is halved). The steps start
+//! from the frame's own posture, then from the last frame's best arm posture, then from the
+//! samples of a grid over the arm's joint ranges whose hands lie nearest the reference
+//! ([`Grid`], computed once), and stop at the first start that brings the hand within
+//! [`REACHED`]. A posture counts only when the caller accepts it (the meter requires the
+//! profile's self-collision margin).
 //!
 //! The least error found, or the frame's own error when nothing found was nearer, is an upper
 //! bound on the error no posture of the arm removes: a multi-start search can miss a better
@@ -34,7 +36,7 @@ use crate::model::{FrameId, Model, ModelData};
 pub(super) const REACHED: f64 = 1e-3;
 
 /// Gauss–Newton steps of one start.
-const ITERATIONS: usize = 40;
+const ITERATIONS: usize = 100;
 
 /// Damping μ of the steps (m): small against an arm, large enough that a near-singular
 /// posture takes bounded steps.
@@ -49,7 +51,7 @@ const MAX_STEP: f64 = 0.3;
 const STALLED: f64 = 1e-7;
 
 /// See [`STALLED`] (m).
-const PROGRESS: f64 = 1e-5;
+const PROGRESS: f64 = 1e-6;
 
 /// See [`ArmPostures::spread_now`] (m).
 const SPREAD_LOSS: f64 = 2e-3;
@@ -69,15 +71,16 @@ pub(super) struct ArmPostures {
     variables: Vec<usize>,
     lower: Vec<f64>,
     upper: Vec<f64>,
-    /// Start values of the arm's variables, one row per start.
-    starts: Vec<Vec<f64>>,
+    /// The arm's joint space sampled on a grid ([`Grid`]): seeds for the search.
+    grid: Grid,
     /// The last frame's best arm posture and its error (m), when it had one.
     last_best: Option<Vec<f64>>,
     last_least: f64,
     /// Searched frames since the spread starts were last tried.
     since_spread: usize,
-    /// The posture being solved (every variable).
+    /// The posture being solved (every variable), and the one before the last step.
     q: Vec<f64>,
+    previous: Vec<f64>,
     /// The best arm posture of this frame.
     best: Vec<f64>,
     jacobian: Mat<f64>,
@@ -123,13 +126,16 @@ impl ArmPostures {
             return None;
         }
         let range = |f: fn(&crate::model::Variable) -> f64| -> Vec<f64> {
-            variables.iter().map(|&k| f(&model.variables()[k])).collect()
+            variables
+                .iter()
+                .map(|&k| f(&model.variables()[k]))
+                .collect()
         };
         let (lower, upper) = (range(|v| v.lower), range(|v| v.upper));
         let k = variables.len();
         Some(Self {
             hand,
-            starts: spread(&lower, &upper),
+            grid: Grid::of(model, stand, upper_body, hand, &variables)?,
             lower,
             upper,
             variables,
@@ -137,6 +143,7 @@ impl ArmPostures {
             last_least: f64::INFINITY,
             since_spread: 0,
             q: stand.to_vec(),
+            previous: stand.to_vec(),
             best: vec![0.0; k],
             jacobian: Mat::zeros(3, model.nv()),
             free: vec![true; k],
@@ -158,7 +165,11 @@ impl ArmPostures {
     ) -> Option<f64> {
         let mut least: Option<f64> = None;
         let had_last = usize::from(self.last_best.is_some());
-        for start in 0..1 + had_last + self.starts.len() {
+        let body = data.frame_placement(self.grid.upper_body);
+        let seeds = self
+            .grid
+            .nearest(&body.inverse_transform_point(&(*target).into()).coords);
+        for start in 0..1 + had_last + seeds.len() {
             if start == 1 + had_last && !self.spread_now(least) {
                 break;
             }
@@ -166,7 +177,7 @@ impl ArmPostures {
             let values = match start {
                 0 => None,
                 1 if had_last == 1 => self.last_best.as_deref(),
-                s => Some(self.starts[s - 1 - had_last].as_slice()),
+                s => Some(self.grid.values(seeds[s - 1 - had_last])),
             };
             for (&k, &v) in self.variables.iter().zip(values.unwrap_or_default()) {
                 self.q[k] = v;
@@ -198,7 +209,7 @@ impl ArmPostures {
         self.last_best = None;
     }
 
-    /// Whether to try the spread starts after the frame's own posture and the last frame's
+    /// Whether to try the grid's seeds after the frame's own posture and the last frame's
     /// best ended at `least`: always without a last best, or when they ended more than
     /// [`SPREAD_LOSS`] farther than the last frame's least (the reference left the basin the
     /// arm was following it in), and otherwise every [`SPREAD_EVERY`] searched frames (a
@@ -214,27 +225,48 @@ impl ArmPostures {
         due
     }
 
-    /// Damped Gauss–Newton steps from `self.q` toward `target`; the hand's final distance
-    /// (m), with `data` at the final posture; `None` when the kinematics fails.
-    fn descend(&mut self, model: &Model, data: &mut ModelData, target: &Vector3<f64>) -> Option<f64> {
-        let mut last = f64::INFINITY;
+    /// Damped Gauss–Newton steps from `self.q` toward `target`, each halved until it brings
+    /// the hand nearer (a full step overshoots where the arm's motion bends away from its
+    /// first-order model); the hand's final distance (m), with `data` at the final posture;
+    /// `None` when the kinematics fails.
+    fn descend(
+        &mut self,
+        model: &Model,
+        data: &mut ModelData,
+        target: &Vector3<f64>,
+    ) -> Option<f64> {
+        let mut error = self.hand_error(model, data, target)?;
+        let mut scale = 1.0;
         for _ in 0..ITERATIONS {
-            let error = self.hand_error(model, data, target)?;
-            if error.norm() <= REACHED || last - error.norm() < PROGRESS {
-                return Some(error.norm());
+            if error.norm() <= REACHED {
+                break;
             }
-            last = error.norm();
             model
                 .point_jacobian(data, self.hand, &Vector3::zeros(), self.jacobian.as_mut())
                 .ok()?;
-            if self.bounded_step(&error) < STALLED {
+            if self.bounded_step(&error) * scale < STALLED {
                 break;
             }
+            self.previous.copy_from_slice(&self.q);
             for (i, &k) in self.variables.iter().enumerate() {
-                self.q[k] = (self.q[k] + self.step[i]).clamp(self.lower[i], self.upper[i]);
+                let moved = self.q[k] + scale * self.step[i];
+                self.q[k] = moved.clamp(self.lower[i], self.upper[i]);
+            }
+            let trial = self.hand_error(model, data, target)?;
+            if trial.norm() < error.norm() {
+                let gain = error.norm() - trial.norm();
+                error = trial;
+                scale = (2.0 * scale).min(1.0);
+                if gain < PROGRESS {
+                    break;
+                }
+            } else {
+                self.q.copy_from_slice(&self.previous);
+                error = self.hand_error(model, data, target)?;
+                scale *= 0.5;
             }
         }
-        Some(self.hand_error(model, data, target)?.norm())
+        Some(error.norm())
     }
 
     /// `target` less the hand's position at `self.q`, with `data` at that posture.
@@ -262,10 +294,16 @@ impl ArmPostures {
                 }
             }
             // The damping keeps `normal` positive definite.
-            let y = normal.cholesky().map_or(Vector3::zeros(), |c| c.solve(error));
+            let y = normal
+                .cholesky()
+                .map_or(Vector3::zeros(), |c| c.solve(error));
             let mut blocked = false;
             for (i, &k) in self.variables.iter().enumerate() {
-                self.step[i] = if self.free[i] { self.column(k).dot(&y) } else { 0.0 };
+                self.step[i] = if self.free[i] {
+                    self.column(k).dot(&y)
+                } else {
+                    0.0
+                };
                 let at_lower = self.q[k] <= self.lower[i] && self.step[i] < 0.0;
                 let at_upper = self.q[k] >= self.upper[i] && self.step[i] > 0.0;
                 if at_lower || at_upper {
@@ -286,26 +324,221 @@ impl ArmPostures {
 
     /// The hand's Jacobian column of variable `k`.
     fn column(&self, k: usize) -> Vector3<f64> {
-        Vector3::new(self.jacobian[(0, k)], self.jacobian[(1, k)], self.jacobian[(2, k)])
+        Vector3::new(
+            self.jacobian[(0, k)],
+            self.jacobian[(1, k)],
+            self.jacobian[(2, k)],
+        )
     }
 }
 
-/// The spread starts over the ranges `[lower, upper]` of an arm's variables: each of the first
-/// three (the shoulder's, in a chain from the body) at a quarter and at three quarters of its
-/// range, the rest at the middle, and the middle of every range: `2^min(k, 3) + 1` starts.
-fn spread(lower: &[f64], upper: &[f64]) -> Vec<Vec<f64>> {
-    let at = |i: usize, t: f64| lower[i] + t * (upper[i] - lower[i]);
-    let varied = lower.len().min(3);
-    let mut starts: Vec<Vec<f64>> = (0..1usize << varied)
-        .map(|corner| {
-            (0..lower.len())
-                .map(|i| match i < varied {
-                    true => at(i, if corner >> i & 1 == 1 { 0.75 } else { 0.25 }),
-                    false => at(i, 0.5),
-                })
-                .collect()
-        })
-        .collect();
-    starts.push((0..lower.len()).map(|i| at(i, 0.5)).collect());
-    starts
+/// The joint space of an arm sampled on a grid: `n` values over each variable's range, ends
+/// included, with `n^k ≤` [`GRID_POINTS`] (at least 2), and the hand's position in the upper
+/// body's frame at each. The arm's variables are all that move the hand relative to that
+/// frame, so the positions hold in every posture of the rest of the body.
+#[derive(Debug, Clone)]
+struct Grid {
+    upper_body: FrameId,
+    /// The hand's position (upper body frame, m) per sample.
+    points: Vec<Vector3<f64>>,
+    /// The arm's variables per sample, `k` a row.
+    values: Vec<f64>,
+    k: usize,
+}
+
+/// Largest number of samples of an arm's joint space ([`Grid`]): 5 values a variable for the
+/// NAO's 5 arm variables, 3 for the G1's 7.
+const GRID_POINTS: usize = 4096;
+
+/// Samples nearest the reference that seed the search ([`Grid::nearest`]).
+const GRID_SEEDS: usize = 4;
+
+impl Grid {
+    fn of(
+        model: &Model,
+        stand: &[f64],
+        upper_body: FrameId,
+        hand: FrameId,
+        variables: &[usize],
+    ) -> Option<Self> {
+        let k = variables.len();
+        let n = (2..)
+            .take_while(|n: &usize| n.checked_pow(k as u32).is_some_and(|c| c <= GRID_POINTS))
+            .last()
+            .unwrap_or(2);
+        let count = n.pow(k as u32);
+        let mut data = model.new_data();
+        let mut q = stand.to_vec();
+        let mut grid = Grid {
+            upper_body,
+            points: Vec::with_capacity(count),
+            values: Vec::with_capacity(count * k),
+            k,
+        };
+        for cell in 0..count {
+            for (j, &v) in variables.iter().enumerate() {
+                let var = &model.variables()[v];
+                let t = (cell / n.pow(j as u32) % n) as f64 / (n - 1) as f64;
+                q[v] = var.lower + t * (var.upper - var.lower);
+                grid.values.push(q[v]);
+            }
+            model.forward_kinematics(&mut data, &q).ok()?;
+            let p = data.frame_placement(hand).translation.vector;
+            let body = data.frame_placement(upper_body);
+            grid.points
+                .push(body.inverse_transform_point(&p.into()).coords);
+        }
+        Some(grid)
+    }
+
+    /// The [`GRID_SEEDS`] samples whose hand lies nearest `target` (upper body frame, m),
+    /// nearest first.
+    fn nearest(&self, target: &Vector3<f64>) -> [usize; GRID_SEEDS] {
+        let mut best = [(f64::INFINITY, 0); GRID_SEEDS];
+        for (i, p) in self.points.iter().enumerate() {
+            let d = (p - target).norm_squared();
+            if d < best[GRID_SEEDS - 1].0 {
+                best[GRID_SEEDS - 1] = (d, i);
+                best.sort_by(|a, b| a.0.total_cmp(&b.0));
+            }
+        }
+        best.map(|(_, i)| i)
+    }
+
+    /// The arm's variables of sample `i`.
+    fn values(&self, i: usize) -> &[f64] {
+        &self.values[i * self.k..(i + 1) * self.k]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::robots::nao;
+
+    /// The planar 3R arm of `tests/data/planar3r.toml` (links 0.3, 0.2, 0.1 m in the x–y
+    /// plane, all axes z) with the given ranges of its three variables, and a frame on its base.
+    fn planar(ranges: [[f64; 2]; 3]) -> (Model, FrameId, FrameId) {
+        let mut text = include_str!("../../../tests/data/planar3r.toml").to_owned();
+        for (i, [lo, hi]) in ranges.iter().enumerate() {
+            let name = format!("name = \"q{}\"\nlower = -3.0\nupper = 3.0", i + 1);
+            let with = format!("name = \"q{}\"\nlower = {lo:?}\nupper = {hi:?}", i + 1);
+            assert!(text.contains(&name));
+            text = text.replace(&name, &with);
+        }
+        text.push_str(
+            "\n[[frames]]\nname = \"base\"\nlink = \"ground\"\nposition = [0.0, 0.0, 0.0]\n",
+        );
+        let model = Model::from_dh_str(&text, "planar test arm").unwrap();
+        let (base, tip) = (
+            model.frame_id("base").unwrap(),
+            model.frame_id("tip").unwrap(),
+        );
+        (model, base, tip)
+    }
+
+    fn least(
+        model: &Model,
+        base: FrameId,
+        tip: FrameId,
+        q: &[f64],
+        target: [f64; 3],
+    ) -> Option<f64> {
+        let mut arm = ArmPostures::of(model, q, base, tip).unwrap();
+        let mut data = model.new_data();
+        arm.least_error(model, &mut data, q, &target.into(), |_, _| true)
+    }
+
+    /// Beyond the stretched arm (0.6 m) a target 0.8 m out is 0.2 m short, whatever the start.
+    #[test]
+    fn a_target_beyond_the_stretched_arm_is_its_distance_short() {
+        let (model, base, tip) = planar([[-3.0, 3.0]; 3]);
+        let found = least(&model, base, tip, &[2.0, 1.0, -1.5], [0.0, -0.8, 0.0]).unwrap();
+        // No posture gets nearer; the straight arm is singular, so the damped steps stop a
+        // hair short of it (the bound is from above).
+        assert!((0.2 - 1e-12..0.2 + 1e-3).contains(&found), "{found}");
+    }
+
+    /// A target the arm reaches only by folding is reached from a start folded the other way.
+    #[test]
+    fn a_reachable_target_is_reached() {
+        let (model, base, tip) = planar([[-3.0, 3.0]; 3]);
+        let found = least(&model, base, tip, &[0.0, 0.0, 0.0], [-0.1, 0.25, 0.0]).unwrap();
+        assert!(found <= REACHED, "{found}");
+    }
+
+    /// With the elbow and the wrist locked straight (ranges of 1e-12 rad move the tip less than
+    /// the arm test sees) and the shoulder kept in [0, 0.5] rad, the tip runs on an arc of
+    /// 0.6 m from 0 to 0.5 rad: a target on that circle at −0.5 rad is nearest the arc's end
+    /// at 0, a chord of `2 · 0.6 · sin(0.25)` away.
+    #[test]
+    fn a_joint_limit_keeps_the_hand_on_its_arc() {
+        let (model, base, tip) = planar([[0.0, 0.5], [0.0, 1e-12], [0.0, 1e-12]]);
+        let arm = ArmPostures::of(&model, &[0.3, 0.0, 0.0], base, tip).unwrap();
+        assert_eq!(arm.variables, [0]);
+        let target = [0.6 * (-0.5f64).cos(), 0.6 * (-0.5f64).sin(), 0.0];
+        let found = least(&model, base, tip, &[0.3, 0.0, 0.0], target).unwrap();
+        let chord = 2.0 * 0.6 * 0.25f64.sin();
+        assert!((found - chord).abs() < 1e-6, "{found} vs {chord}");
+    }
+
+    /// A posture the caller refuses does not count.
+    #[test]
+    fn a_refused_posture_is_not_counted() {
+        let (model, base, tip) = planar([[-3.0, 3.0]; 3]);
+        let q = [0.1, 0.2, 0.3];
+        let mut arm = ArmPostures::of(&model, &q, base, tip).unwrap();
+        let mut data = model.new_data();
+        let target = [0.2, 0.2, 0.0].into();
+        assert_eq!(
+            arm.least_error(&model, &mut data, &q, &target, |_, _| false),
+            None
+        );
+    }
+
+    /// The NAO's left arm: the search ends at most 2 mm farther from each of a set of targets
+    /// around the shoulder than the best posture of an exhaustive grid over the arm's variables
+    /// (8 values each over their ranges), an independent search of the same joint space.
+    #[test]
+    fn the_search_finds_what_a_grid_over_the_nao_arm_finds() {
+        let profile = nao::profile();
+        let model = &profile.models[0];
+        let frame = |name: &str| model.frame_id(name).unwrap();
+        let hand = frame(&profile.hands[0]);
+        let mut arm = ArmPostures::of(model, &profile.stand, frame(&profile.torso), hand).unwrap();
+        assert!(
+            (4..=5).contains(&arm.variables.len()),
+            "{:?}",
+            arm.variables
+        );
+        let mut data = model.new_data();
+        model.forward_kinematics(&mut data, &profile.stand).unwrap();
+        let hand_at_rest = data.frame_placement(hand).translation.vector;
+        let samples = 8usize;
+        for i in 0..10 {
+            let t = i as f64;
+            let offset = Vector3::new((1.3 * t).sin(), (2.1 * t).cos(), (0.7 * t).sin()) * 0.12;
+            let target = hand_at_rest + offset;
+            let mut q = profile.stand.clone();
+            let mut grid = f64::INFINITY;
+            let k = arm.variables.len();
+            for cell in 0..samples.pow(k as u32) {
+                for (j, &v) in arm.variables.iter().enumerate() {
+                    let step = cell / samples.pow(j as u32) % samples;
+                    let frac = step as f64 / (samples - 1) as f64;
+                    q[v] = arm.lower[j] + frac * (arm.upper[j] - arm.lower[j]);
+                }
+                model.forward_kinematics(&mut data, &q).unwrap();
+                grid = grid.min((target - data.frame_placement(hand).translation.vector).norm());
+            }
+            arm.forget();
+            let found = arm
+                .least_error(model, &mut data, &profile.stand, &target, |_, _| true)
+                .unwrap();
+            assert!(
+                found <= grid + 2e-3,
+                "target {i}: search {found} m, grid {grid} m"
+            );
+        }
+    }
 }
