@@ -24,10 +24,18 @@
 //! A hand's error on such a frame is at least its shortfall whatever the arm does. Positions
 //! in the left-rooted model's base frame; the references are moved there from the frame's root.
 //!
-//! The distance test cannot see the joint ranges: [`posture`] finds, per frame, the least
-//! error any posture of the arm within its joint ranges (and the profile's self-collision
-//! margin) gets, which splits a hand's error into what no arm posture removes and the rest,
-//! lateness or an arm caught in a posture it cannot follow the reference from.
+//! The distance test cannot see the joint ranges. Per frame whose hand is more than 2 mm off,
+//! the meter also looks for the least error any posture of the arm gets: the arm's variables
+//! (those that move the hand relative to the chest, or the torso, found in the model) are
+//! solved for the reference by damped Gauss–Newton steps kept inside the joint ranges,
+//! `δq = Jᵀ(JJᵀ + μ²I)⁻¹(p_ref − p_hand)` with `μ` = 5 mm, each step halved until it brings the
+//! hand nearer, the rest of the body at the frame's posture; from the frame's posture, from
+//! the last frame's best, and from the samples nearest the reference of a grid over the arm's
+//! joint ranges (at most 4 096, computed once). A posture counts when it keeps the profile's
+//! self-collision pairs at their margin. The least error found, or the frame's own, is an upper
+//! bound on the error no arm posture removes (a search can miss a better posture, never invent
+//! one): the rest of the hand's error is lateness, or an arm caught in a posture it cannot
+//! follow the reference from.
 //!
 //! Poubel's method aims each hand at its reference pulled along the line to the shoulder until
 //! the arm reaches it with its elbow `MIN_ELBOW_BEND` (0.3 rad) from straight
@@ -70,7 +78,7 @@ pub struct HandReach {
     /// Mean over the frames measured of the least distance from the reference to which some
     /// posture of the arm within its joint ranges (the rest of the body at the frame's posture,
     /// the profile's self-collision margin kept) brings the hand, as far as a multi-start
-    /// search finds ([`posture`]): an upper bound on the error no arm posture removes (m);
+    /// search finds (module docs): an upper bound on the error no arm posture removes (m);
     /// `None` without any frame. `mean_error_m` less this is error some posture removes.
     pub mean_least_error_m: Option<f64>,
     /// The largest of those least distances (m); `None` without any frame.
