@@ -414,7 +414,8 @@ impl ReachMeter {
         let base_t_root: IsometryMatrix3<f64> = *data.frame_placement(soles[frame.root.index()]);
         let mut searches = [None; 2];
         for (k, (arm, tally)) in arms.iter().zip(tallies.iter_mut()).enumerate() {
-            let Some(reference) = frame.reference[arm.hand.index()] else {
+            let reference = frame.reference[arm.hand.index()];
+            let Some(reference) = reference.filter(|r| r.iter().all(|v| v.is_finite())) else {
                 postures[k].forget();
                 continue;
             };

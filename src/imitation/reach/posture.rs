@@ -154,7 +154,7 @@ impl ArmPostures {
     /// The least distance (m) from `target` (model base frame, m) to which some posture of
     /// the arm brings the hand, the other variables at `frame_q`, among the postures that
     /// `accept` (called with the forward kinematics of the posture in `data`) accepts; `None`
-    /// when the search found none. Leaves `data` at an arbitrary posture.
+    /// when the search found none or the kinematics failed. Overwrites `data`.
     pub(super) fn least_error(
         &mut self,
         model: &Model,
@@ -165,6 +165,7 @@ impl ArmPostures {
     ) -> Option<f64> {
         let mut least: Option<f64> = None;
         let had_last = usize::from(self.last_best.is_some());
+        model.forward_kinematics(data, frame_q).ok()?;
         let body = data.frame_placement(self.grid.upper_body);
         let seeds = self
             .grid
