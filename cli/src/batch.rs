@@ -193,8 +193,16 @@ fn print_table(text: &mut String, done: &[Done], report: Report, jobs: usize, se
     }
     let _ = writeln!(
         text,
-        "{:<48} {:>7} {:>7} {:>9} {:>13} {:>8} {:>6} {:>7}",
-        "clip", "frames", "clip s", "supports", "hands cm L/R", "CoM out", "limits", "wall s"
+        "{:<48} {:>7} {:>7} {:>9} {:>13} {:>13} {:>8} {:>6} {:>7}",
+        "clip",
+        "frames",
+        "clip s",
+        "supports",
+        "hands cm L/R",
+        "of it reach",
+        "CoM out",
+        "limits",
+        "wall s"
     );
     let cm = |v: Option<f64>| v.map_or("-".to_owned(), |v| format!("{:.1}", v * 100.0));
     for d in done {
@@ -206,7 +214,7 @@ fn print_table(text: &mut String, done: &[Done], report: Report, jobs: usize, se
             Ok(m) => {
                 let _ = writeln!(
                     text,
-                    "{:<48} {:>7} {:>7.1} {:>9} {:>13} {:>8} {:>6} {:>7.1}",
+                    "{:<48} {:>7} {:>7.1} {:>9} {:>13} {:>13} {:>8} {:>6} {:>7.1}",
                     name,
                     m.clip_frames,
                     m.clip_duration,
@@ -216,6 +224,7 @@ fn print_table(text: &mut String, done: &[Done], report: Report, jobs: usize, se
                         cm(hand_mean(m, "l_hand")),
                         cm(hand_mean(m, "r_hand"))
                     ),
+                    unremovable(m).map_or("-".to_owned(), |[l, r]| format!("{}/{}", cm(l), cm(r))),
                     m.frames_com_outside,
                     m.joint_limit_violations + m.velocity_limit_violations,
                     d.seconds
@@ -229,9 +238,15 @@ fn print_table(text: &mut String, done: &[Done], report: Report, jobs: usize, se
     let ok = done.iter().filter(|d| d.result.is_ok()).count();
     let _ = writeln!(
         text,
-        "{ok} of {} clips imitated in {seconds:.1} s on {jobs} threads; supports = human → robot support changes, CoM out = frames with the CoM outside the support polygon, limits = joint × frame violations",
+        "{ok} of {} clips imitated in {seconds:.1} s on {jobs} threads; supports = human → robot support changes, of it reach = the part of the hand error no arm posture within the joint limits removes, CoM out = frames with the CoM outside the support polygon, limits = joint × frame violations",
         done.len()
     );
+}
+
+/// Each hand's mean error over the clip that no arm posture within the joint limits removes
+/// (`[left, right]`, m; [`taskstack::imitation::reach`]); `None` when the profile maps no arms.
+fn unremovable(m: &ImitationMetrics) -> Option<[Option<f64>; 2]> {
+    m.hand_reach.map(|arms| arms.map(|a| a.mean_least_error_m))
 }
 
 fn batch_json(done: &[Done], jobs: usize, seconds: f64) -> serde_json::Value {

@@ -139,6 +139,18 @@ fn imitate_writes_every_output_and_reports_clip_and_hold_apart() {
         "{}",
         run.stdout
     );
+    // The summary's split of each hand's error is metrics.json's.
+    let reach = &metrics["hand_reach"];
+    let cm = |v: &Value| format!("{:.1}", v.as_f64().unwrap() * 100.0);
+    for hand in ["l_hand", "r_hand"] {
+        let told = format!(
+            "{hand} {} cm, {} cm of it ({} frames over 1 cm)",
+            cm(&reach[hand]["error_m"]),
+            cm(&reach[hand]["least_error_m"]["mean"]),
+            reach[hand]["posture_unreachable_frames"]
+        );
+        assert!(run.stdout.contains(&told), "{told}\n{}", run.stdout);
+    }
 }
 
 #[test]
