@@ -51,7 +51,10 @@ const CHECK_HOLD: f64 = 1.0;
 ///                  root_pos (m) and root_quat (x y z w) of the floating base (NAO torso, G1
 ///                  pelvis; world: z up, the first right sole at the origin), contacts (left,
 ///                  right sole on the floor); resampled to the clip's own rate or --fps
-///   metrics.json   tracking errors (m), balance margins (m), limits, slip, travel, step times (µs)
+///   metrics.json   tracking errors (m), balance margins (m), limits, slip, travel, step times (µs);
+///                  hand_reach: per hand the error over the clip and the part of it no arm
+///                  posture within the joint limits removes (m); the rest is lateness or a
+///                  poor arm posture
 ///   view.html      a 3D viewer of the robot and the scaled human (opens in any browser, offline)
 ///   effectors.svg  each hand's and ankle's distance to the scaled human over time, phases shaded
 ///   com.svg        the CoM ground path inside the footprints, seen from above
