@@ -334,8 +334,9 @@ impl ArmPostures {
 }
 
 /// The joint space of an arm sampled on a grid: `n` values over each variable's range, ends
-/// included, with `n^k ≤` [`GRID_POINTS`] (at least 2), and the hand's position in the upper
-/// body's frame at each. The arm's variables are all that move the hand relative to that
+/// included, with `n^k ≤` [`GRID_POINTS`] (at least 2; beyond 12 variables, the ends of the
+/// first 12 and the middle of the others), and the hand's position in the upper body's frame
+/// at each. The arm's variables are all that move the hand relative to that
 /// frame, so the positions hold in every posture of the rest of the body.
 #[derive(Debug, Clone)]
 struct Grid {
@@ -363,11 +364,12 @@ impl Grid {
         variables: &[usize],
     ) -> Option<Self> {
         let k = variables.len();
-        let n = (2..)
-            .take_while(|n: &usize| n.checked_pow(k as u32).is_some_and(|c| c <= GRID_POINTS))
-            .last()
-            .unwrap_or(2);
-        let count = n.pow(k as u32);
+        let fits = |n: usize, m: usize| n.checked_pow(m as u32).is_some_and(|c| c <= GRID_POINTS);
+        // `n` values over each of the first `varied` variables, the rest at mid-range: an arm
+        // of more than log2(GRID_POINTS) variables is sampled at the ends of its first ones.
+        let varied = (0..=k).take_while(|&m| fits(2, m)).last().unwrap_or(0);
+        let n = (2..).take_while(|&n| fits(n, varied)).last().unwrap_or(2);
+        let count = n.pow(varied as u32);
         let mut data = model.new_data();
         let mut q = stand.to_vec();
         let mut grid = Grid {
@@ -379,7 +381,10 @@ impl Grid {
         for cell in 0..count {
             for (j, &v) in variables.iter().enumerate() {
                 let var = &model.variables()[v];
-                let t = (cell / n.pow(j as u32) % n) as f64 / (n - 1) as f64;
+                let t = match j < varied {
+                    true => (cell / n.pow(j as u32) % n) as f64 / (n - 1) as f64,
+                    false => 0.5,
+                };
                 q[v] = var.lower + t * (var.upper - var.lower);
                 grid.values.push(q[v]);
             }
@@ -481,6 +486,43 @@ mod tests {
         let found = least(&model, base, tip, &[0.3, 0.0, 0.0], target).unwrap();
         let chord = 2.0 * 0.6 * 0.25f64.sin();
         assert!((found - chord).abs() < 1e-6, "{found} vs {chord}");
+    }
+
+    /// An arm of 20 revolute joints (a planar chain of 0.05 m links): the grid keeps to its
+    /// size, the ends of the first 12 variables (4 096 samples), and the search still reaches
+    /// a target in the chain's plane.
+    #[test]
+    fn a_long_arm_is_sampled_within_the_grid_size() {
+        let mut text = String::from(
+            "format = \"taskstack-dh/1\"\nname = \"chain\"\n[units]\nlength = \"m\"\nangle = \"rad\"\nmass = \"kg\"\n[base]\nlink = \"L0\"\nmass = 0.0\ncom = [0.0, 0.0, 0.0]\n",
+        );
+        for i in 1..=20 {
+            text.push_str(&format!(
+                "[[variables]]\nname = \"q{i}\"\nlower = -1.0\nupper = 1.0\nvelocity = 1.0\n\
+                 [[joints]]\nname = \"J{i}\"\nantecedent = \"L{}\"\nlink = \"L{i}\"\n\
+                 type = \"revolute\"\ngamma = 0.0\nb = 0.0\nalpha = 0.0\nd = {}\ntheta = 0.0\n\
+                 r = 0.0\nvariable = \"q{i}\"\nmass = 0.1\ncom = [0.0, 0.0, 0.0]\n",
+                i - 1,
+                if i == 1 { 0.0 } else { 0.05 }
+            ));
+        }
+        text.push_str("[[frames]]\nname = \"tip\"\nlink = \"L20\"\nposition = [0.05, 0.0, 0.0]\n");
+        text.push_str("[[frames]]\nname = \"base\"\nlink = \"L0\"\nposition = [0.0, 0.0, 0.0]\n");
+        let model = Model::from_dh_str(&text, "chain test arm").unwrap();
+        let (base, tip) = (
+            model.frame_id("base").unwrap(),
+            model.frame_id("tip").unwrap(),
+        );
+        let q = vec![0.0; 20];
+        let mut arm = ArmPostures::of(&model, &q, base, tip).unwrap();
+        assert_eq!(arm.variables.len(), 20);
+        assert_eq!(arm.grid.points.len(), GRID_POINTS);
+        let mut data = model.new_data();
+        let target = [0.6, 0.4, 0.0].into();
+        let found = arm
+            .least_error(&model, &mut data, &q, &target, |_, _| true)
+            .unwrap();
+        assert!(found <= REACHED, "{found}");
     }
 
     /// A posture the caller refuses does not count.
