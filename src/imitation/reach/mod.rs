@@ -342,12 +342,38 @@ pub struct ReachMeter {
     soles: [FrameId; 2],
     arms: [Arm; 2],
     postures: [ArmPostures; 2],
-    /// The profile's self-collision pairs and margin, and the pairs' distances at the frame's
-    /// own posture.
+    apart: KeptApart,
+    tallies: [Tally; 2],
+}
+
+/// The profile's self-collision pairs, and the distance each must keep in a searched posture:
+/// its margin, or as far as the frame's own posture had it where that was nearer, less
+/// [`MARGIN_SLACK`].
+#[derive(Debug, Clone)]
+struct KeptApart {
     pairs: Vec<[Capsule; 2]>,
     margin: f64,
-    frame_distances: Vec<f64>,
-    tallies: [Tally; 2],
+    floors: Vec<f64>,
+}
+
+impl KeptApart {
+    /// Sets the floors from the frame whose forward kinematics is in `data`.
+    fn at_frame(&mut self, model: &Model, data: &ModelData) {
+        for (floor, pair) in self.floors.iter_mut().zip(&self.pairs) {
+            *floor = self.margin.min(pair_distance(pair, model, data)) - MARGIN_SLACK;
+        }
+    }
+
+    /// Whether the posture whose forward kinematics is in `data` keeps every pair at its floor.
+    fn keeps(&self, model: &Model, data: &ModelData) -> bool {
+        let mut pairs = self.pairs.iter().zip(&self.floors);
+        pairs.all(|(pair, &floor)| pair_distance(pair, model, data) >= floor)
+    }
+}
+
+/// The distance between a pair of capsules (m; −∞ when the kinematics is missing).
+fn pair_distance([a, b]: &[Capsule; 2], model: &Model, data: &ModelData) -> f64 {
+    a.distance_to(b, model, data).unwrap_or(f64::NEG_INFINITY)
 }
 
 /// One hand's sums over the frames measured.
@@ -387,9 +413,11 @@ impl ReachMeter {
             ],
             arms,
             postures,
-            frame_distances: vec![0.0; pairs.len()],
-            pairs,
-            margin: profile.self_collision.margin,
+            apart: KeptApart {
+                floors: vec![0.0; pairs.len()],
+                pairs,
+                margin: profile.self_collision.margin,
+            },
             model,
             tallies: [Tally::default(); 2],
         })
@@ -403,9 +431,7 @@ impl ReachMeter {
             soles,
             arms,
             postures,
-            pairs,
-            margin,
-            frame_distances,
+            apart,
             tallies,
         } = self;
         if model.forward_kinematics(data, &frame.q).is_err() {
@@ -430,30 +456,21 @@ impl ReachMeter {
             let hand = data.frame_placement(arm.hand_frame).translation.vector;
             searches[k] = Some((reference, (reference - hand).norm()));
         }
-        let distance = |[a, b]: &[Capsule; 2], model: &Model, data: &ModelData| {
-            a.distance_to(b, model, data).unwrap_or(f64::NEG_INFINITY)
-        };
-        for (d, pair) in frame_distances.iter_mut().zip(pairs.iter()) {
-            *d = distance(pair, model, data);
+        // The floors only for a frame with a hand to search: most frames have none.
+        if searches
+            .iter()
+            .flatten()
+            .any(|&(_, error)| error > SEARCH_FROM)
+        {
+            apart.at_frame(model, data);
         }
-        // A posture counts when it brings no pair nearer than the margin, or than the
-        // frame's own posture had it where that was nearer.
-        let keeps_apart = |model: &Model, data: &ModelData| {
-            let floors = frame_distances
-                .iter()
-                .map(|&d| margin.min(d) - MARGIN_SLACK);
-            pairs
-                .iter()
-                .zip(floors)
-                .all(|(pair, floor)| distance(pair, model, data) >= floor)
-        };
         for (k, search) in searches.iter().enumerate() {
             let Some((reference, error)) = *search else {
                 continue;
             };
             let least = match error > SEARCH_FROM {
                 true => postures[k]
-                    .least_error(model, data, &frame.q, &reference, keeps_apart)
+                    .least_error(model, data, &frame.q, &reference, |m, d| apart.keeps(m, d))
                     .map_or(error, |found| found.min(error)),
                 false => error,
             };

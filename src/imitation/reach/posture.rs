@@ -164,36 +164,21 @@ impl ArmPostures {
         mut accept: impl FnMut(&Model, &ModelData) -> bool,
     ) -> Option<f64> {
         let mut least: Option<f64> = None;
-        let had_last = usize::from(self.last_best.is_some());
-        model.forward_kinematics(data, frame_q).ok()?;
-        let body = data.frame_placement(self.grid.upper_body);
-        let seeds = self
-            .grid
-            .nearest(&body.inverse_transform_point(&(*target).into()).coords);
-        for start in 0..1 + had_last + seeds.len() {
-            if start == 1 + had_last && !self.spread_now(least) {
-                break;
+        let reached = |least: Option<f64>| least.is_some_and(|l| l <= REACHED);
+        for start in [Start::Own, Start::LastBest] {
+            if !reached(least) {
+                self.try_start(model, data, frame_q, target, start, &mut least, &mut accept);
             }
-            self.q.copy_from_slice(frame_q);
-            let values = match start {
-                0 => None,
-                1 if had_last == 1 => self.last_best.as_deref(),
-                s => Some(self.grid.values(seeds[s - 1 - had_last])),
-            };
-            for (&k, &v) in self.variables.iter().zip(values.unwrap_or_default()) {
-                self.q[k] = v;
-            }
-            let Some(error) = self.descend(model, data, target) else {
-                continue;
-            };
-            if least.is_none_or(|l| error < l) && accept(model, data) {
-                least = Some(error);
-                for (b, &k) in self.best.iter_mut().zip(&self.variables) {
-                    *b = self.q[k];
+        }
+        if !reached(least) && self.spread_now(least) {
+            model.forward_kinematics(data, frame_q).ok()?;
+            let body = data.frame_placement(self.grid.upper_body);
+            let in_body = body.inverse_transform_point(&(*target).into()).coords;
+            for seed in self.grid.nearest(&in_body) {
+                if !reached(least) {
+                    let start = Start::Seed(seed);
+                    self.try_start(model, data, frame_q, target, start, &mut least, &mut accept);
                 }
-            }
-            if least.is_some_and(|l| l <= REACHED) {
-                break;
             }
         }
         match (least, &mut self.last_best) {
@@ -203,6 +188,43 @@ impl ArmPostures {
         }
         self.last_least = least.unwrap_or(f64::INFINITY);
         least
+    }
+
+    /// One descent from `start` (the arm's variables; every other at `frame_q`); a result
+    /// nearer than `least` that `accept` accepts becomes `least` and the frame's best posture.
+    /// Nothing when `start` is the last best and there is none, or when the kinematics fails.
+    #[allow(clippy::too_many_arguments)]
+    fn try_start(
+        &mut self,
+        model: &Model,
+        data: &mut ModelData,
+        frame_q: &[f64],
+        target: &Vector3<f64>,
+        start: Start,
+        least: &mut Option<f64>,
+        accept: &mut impl FnMut(&Model, &ModelData) -> bool,
+    ) {
+        self.q.copy_from_slice(frame_q);
+        let values = match start {
+            Start::Own => &[][..],
+            Start::LastBest => match &self.last_best {
+                Some(values) => values.as_slice(),
+                None => return,
+            },
+            Start::Seed(i) => self.grid.values(i),
+        };
+        for (&k, &v) in self.variables.iter().zip(values) {
+            self.q[k] = v;
+        }
+        let Some(error) = self.descend(model, data, target) else {
+            return;
+        };
+        if least.is_none_or(|l| error < l) && accept(model, data) {
+            *least = Some(error);
+            for (b, &k) in self.best.iter_mut().zip(&self.variables) {
+                *b = self.q[k];
+            }
+        }
     }
 
     /// Forgets the last frame's best posture (a frame without a reference broke the series).
@@ -331,6 +353,17 @@ impl ArmPostures {
             self.jacobian[(2, k)],
         )
     }
+}
+
+/// Where a descent of [`ArmPostures::least_error`] starts.
+#[derive(Debug, Clone, Copy)]
+enum Start {
+    /// The frame's own posture.
+    Own,
+    /// The last frame's best arm posture.
+    LastBest,
+    /// Sample `i` of the [`Grid`].
+    Seed(usize),
 }
 
 /// The joint space of an arm sampled on a grid: `n` values over each variable's range, ends
