@@ -42,6 +42,9 @@ const MAX_STEPS: usize = 1000;
 /// OUT/plan.csv (the plan's CoM, ZMP and sole heights, m), OUT/view.html (the 3D viewer) and
 /// OUT/walk.json (steps, duration, speed, the smallest margins of the plan's ZMP and CoM
 /// inside the support polygon, the solver's largest foot and CoM errors).
+///
+/// Played on the MuJoCo robots of CI's physics check, the NAO's walks stand on both of its
+/// models; the G1's fall a few seconds in (the README's "Physics check").
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]
 pub(crate) struct WalkArgs {
