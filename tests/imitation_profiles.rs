@@ -229,6 +229,25 @@ fn profile_errors_name_the_field() {
     assert!(!untuned.tuning.offset_to_stance_point);
     let err = load(&ends("\"yes\""));
     assert!(err.to_string().contains("offset_to_stance_point"), "{err}");
+    // The hands under the ZMP level: the NAO's scaled without the key, none with `false`, a
+    // speed of the table's own, a bad one refused by name.
+    let balanced = |keys: &str| format!("{toml}\n[tuning]\n{keys}\n");
+    assert!(untuned.tuning.balanced_hands.is_some());
+    let off = BipedProfile::from_toml_str(&balanced("balanced_hands = false"), &urdf).unwrap();
+    assert_eq!(off.tuning.balanced_hands, None);
+    let own = balanced("balanced_tracking_speed = 0.4");
+    let own = BipedProfile::from_toml_str(&own, &urdf).unwrap();
+    let (own, scaled) = (own.tuning.balanced_hands, untuned.tuning.balanced_hands);
+    assert_eq!(own.map(|h| h.tracking_speed), Some(0.4));
+    assert_eq!(
+        own.map(|h| h.tracking_acceleration),
+        scaled.map(|h| h.tracking_acceleration)
+    );
+    let err = load(&balanced("balanced_tracking_acceleration = -1.0"));
+    assert!(
+        err.to_string().contains("balanced_tracking_acceleration"),
+        "{err}"
+    );
 
     // The servos' stiffness, a key before the first table.
     let servos = |saturation: f64| format!("servo_saturation = {saturation}\n{toml}");

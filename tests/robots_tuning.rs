@@ -120,6 +120,19 @@ fn the_scaling_rules_keep_the_invariants_they_state() {
         a.tracking_acceleration / from.arm_length
     );
     assert_relative_eq!(b.damping / to.arm_length, a.damping / from.arm_length);
+    // The hands under the ZMP level likewise: the NAO's 1 m/s and 10 m/s² per arm length.
+    let (ha, hb) = (a.balanced_hands.unwrap(), b.balanced_hands.unwrap());
+    assert_relative_eq!(ha.tracking_speed, 1.0);
+    assert_relative_eq!(ha.tracking_acceleration, 10.0);
+    assert_relative_eq!(
+        hb.tracking_speed / to.arm_length,
+        ha.tracking_speed / from.arm_length
+    );
+    assert_relative_eq!(
+        hb.tracking_acceleration / to.arm_length,
+        ha.tracking_acceleration / from.arm_length
+    );
+    assert_eq!(g1::TUNING.balanced_hands, None);
     // Faster motors: the same joint speeds, never a larger fraction.
     assert!(b.upper_body_velocity_fraction <= a.upper_body_velocity_fraction);
     // The legs: joint speeds (fraction × rated) in the ratio √(h/h') of a motion of the same

@@ -66,8 +66,10 @@ pub(crate) struct ImitationOptions {
     /// Experimental (Poubel's method): balance that sees the whole body's dynamics. A level
     /// below the feet and the CoM keeps the whole body's ZMP (the arms' acceleration
     /// included) inside the support polygon and the floor's vertical moment on the feet below
-    /// what friction holds, so faster hands (--tracking-speed) are held back only when they
-    /// would tip the robot or turn a foot.
+    /// what friction holds, so faster hands are held back only when they would tip the robot
+    /// or turn a foot. The hands then move at the robot profile's balanced speeds (NAO 1 m/s,
+    /// 10 m/s², in every phase; the G1 keeps its own) unless --tracking-speed and
+    /// --tracking-acceleration say otherwise.
     #[arg(long)]
     pub(crate) zmp_balance: bool,
     /// Poubel's method: the solver's damping of near-singular levels (μ in task units per

@@ -199,6 +199,7 @@ pub const TUNING: MotionTuning = MotionTuning {
     offset_rate: 1.0,
     offset_acceleration: 1.0,
     offset_to_stance_point: true,
+    balanced_hands: None,
     damping: 0.039,
 };
 

@@ -17,4 +17,4 @@ pub use profile::{
     JointAnglesFactory, LIGHT_FOOT_SHARE, ProfileError, RobotPoint, SolePlacement, outline_bounds,
 };
 pub use self_collision::{BodyCapsule, FramePoint, SelfCollision};
-pub use tuning::{BipedSize, MotionTuning};
+pub use tuning::{BalancedHands, BipedSize, MotionTuning};

@@ -64,6 +64,9 @@
 //! offset_rate = 1.5                  # 1/s, Koenemann's CoM offset between the feet
 //! offset_acceleration = 6.0          # 1/s²
 //! offset_to_stance_point = false     # Koenemann's offset ends where Poubel's CoM stands on a foot
+//! balanced_hands = true              # with the ZMP level (--zmp-balance), the hands at:
+//! balanced_tracking_speed = 1.0      # m/s, in every phase
+//! balanced_tracking_acceleration = 10.0  # m/s²
 //! damping = 0.02                     # m/rad, the solver's damping of near-singular levels
 //! ```
 //!
@@ -80,7 +83,7 @@ use serde::Deserialize;
 use super::nao;
 use super::profile::{BipedProfile, FootArea, FootFrames, ProfileError, RobotPoint};
 use super::self_collision::SelfCollision;
-use super::tuning::MotionTuning;
+use super::tuning::{BalancedHands, MotionTuning};
 use crate::human::{HumanJoint, Side};
 use crate::model::{Model, UrdfError, UrdfFrame, UrdfOptions};
 
@@ -126,6 +129,9 @@ struct Tuning {
     offset_rate: Option<f64>,
     offset_acceleration: Option<f64>,
     offset_to_stance_point: Option<bool>,
+    balanced_hands: Option<bool>,
+    balanced_tracking_speed: Option<f64>,
+    balanced_tracking_acceleration: Option<f64>,
     damping: Option<f64>,
 }
 
@@ -370,8 +376,28 @@ fn tuning(file: Option<Tuning>, scaled: MotionTuning) -> MotionTuning {
         offset_rate: t.offset_rate.unwrap_or(scaled.offset_rate),
         offset_acceleration: t.offset_acceleration.unwrap_or(scaled.offset_acceleration),
         offset_to_stance_point: (t.offset_to_stance_point).unwrap_or(scaled.offset_to_stance_point),
+        balanced_hands: balanced_hands(&t, &scaled),
         damping: t.damping.unwrap_or(scaled.damping),
     }
+}
+
+/// The `[tuning]` table's hands under the ZMP level over `scaled`'s: none with
+/// `balanced_hands = false`; else `scaled`'s, or with `balanced_hands = true` and none there
+/// its ordinary speeds, each overridden where the table gives it.
+fn balanced_hands(t: &Tuning, scaled: &MotionTuning) -> Option<BalancedHands> {
+    let base = match (t.balanced_hands, scaled.balanced_hands) {
+        (Some(false), _) | (None, None) => return None,
+        (_, Some(balanced)) => balanced,
+        (Some(true), None) => BalancedHands {
+            tracking_speed: scaled.tracking_speed,
+            tracking_acceleration: scaled.tracking_acceleration,
+        },
+    };
+    Some(BalancedHands {
+        tracking_speed: t.balanced_tracking_speed.unwrap_or(base.tracking_speed),
+        tracking_acceleration: (t.balanced_tracking_acceleration)
+            .unwrap_or(base.tracking_acceleration),
+    })
 }
 
 /// The standing posture: the named joints at their values, the others at 0.

@@ -22,6 +22,7 @@
 //! | `torso_lowering`, `single_support_lowering` | `× l'/l` | the same fraction of the leg |
 //! | `tracking_speed`, `stance_tracking_speed` | `× a'/a` | the hands cover the same fraction of the arm per second |
 //! | `tracking_acceleration` | `× a'/a` | the hands' speed changes by the same fraction of the arm per second, per second |
+//! | `balanced_hands` (speed, acceleration) | `× a'/a` | as the hands' other speeds |
 //! | `upper_body_velocity_fraction` | `× ω/ω'`, at most its value | the same joint speeds (rad/s) on faster motors |
 //! | `leg_velocity_fraction` | `× (ω_l/ω_l') √(h/h')`, at most its value | the same Froude number: a leg motion of the same shape takes `√(h'/h)` times as long, so its joints turn `√(h/h')` times as fast |
 //! | `damping` | `× a'/a` | a hand's Jacobian (m/rad) scales with the arm: the same near-singular poses damped |
@@ -101,6 +102,12 @@ pub struct MotionTuning {
     /// from the sole's inner edge, where Poubel et al.'s method puts the CoM on one foot)
     /// instead of at the sole's centre (the paper). Not a size: the scaling keeps it.
     pub offset_to_stance_point: bool,
+    /// The hands' speeds in every phase of Poubel et al.'s method when its ZMP level holds the
+    /// balance (`ImitatorConfig::zmp_balance`: a level that sees the arms' acceleration and
+    /// bounds their vertical moment on the feet), instead of `tracking_speed`,
+    /// `stance_tracking_speed` and `tracking_acceleration`; `None`: the level keeps those.
+    /// Koenemann et al.'s method (no ZMP level) and the dynamic walk always use them.
+    pub balanced_hands: Option<BalancedHands>,
     /// The solver's damping of near-singular levels in Poubel et al.'s method (m/rad: the
     /// damping threshold and the largest damping of
     /// [`Settings`](crate::solver::Settings), in the units of the hands' Jacobian): a level
@@ -110,6 +117,15 @@ pub struct MotionTuning {
     /// 0.02, the G1's arms reversed at speed on 285 of 3 099 frames of CMU 09_12 and 175 of
     /// 994 of 131_01; at the scaled 0.039 on 2 and 0, the hands as near or nearer.
     pub damping: f64,
+}
+
+/// The hands' speeds when the ZMP level holds the balance ([`MotionTuning::balanced_hands`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BalancedHands {
+    /// Largest speed of the hand targets toward the human, in every phase (m/s).
+    pub tracking_speed: f64,
+    /// Largest change of that speed (m/s²).
+    pub tracking_acceleration: f64,
 }
 
 impl MotionTuning {
@@ -132,6 +148,12 @@ impl MotionTuning {
             ("offset_acceleration", self.offset_acceleration),
             ("damping", self.damping),
         ];
+        let balanced = self.balanced_hands.map(|b| {
+            [
+                ("balanced_tracking_speed", b.tracking_speed),
+                ("balanced_tracking_acceleration", b.tracking_acceleration),
+            ]
+        });
         let non_negative = [
             ("torso_lowering", self.torso_lowering),
             ("single_support_lowering", self.single_support_lowering),
@@ -143,7 +165,7 @@ impl MotionTuning {
                 (!(v.is_finite() && ok(v))).then_some((name, v, need))
             }
         };
-        (positive.into_iter())
+        (positive.into_iter().chain(balanced.into_iter().flatten()))
             .find_map(bad(|v| v > 0.0, "finite and > 0"))
             .or_else(|| {
                 non_negative
@@ -182,6 +204,10 @@ impl MotionTuning {
             offset_acceleration: self.offset_acceleration
                 * ((from.half_stance * from.com_height) / (to.half_stance * to.com_height)),
             offset_to_stance_point: self.offset_to_stance_point,
+            balanced_hands: self.balanced_hands.map(|b| BalancedHands {
+                tracking_speed: b.tracking_speed * arm,
+                tracking_acceleration: b.tracking_acceleration * arm,
+            }),
             damping: self.damping * arm,
         }
     }

@@ -375,7 +375,7 @@ impl KoenemannImitator {
         let hold = shared.output.left_sole;
         Ok(KoenemannImitator {
             detector: SupportDetector::new(config.support)?,
-            hand_speed: config.hand_speed_for(&tuning),
+            hand_speed: config.hand_speed_for(&tuning, false),
             hand_rates: HandRates::default(),
             human_double_time: 0.0,
             foot_speed: config.max_task_speed.unwrap_or(tuning.task_speed),
