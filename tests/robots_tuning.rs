@@ -107,31 +107,21 @@ fn the_scaling_rules_keep_the_invariants_they_state() {
         low.scaled(&from, &to).single_support_lowering / to.hip_height,
         0.01 / from.hip_height
     );
-    assert_relative_eq!(
-        b.tracking_speed / to.arm_length,
-        a.tracking_speed / from.arm_length
-    );
-    assert_relative_eq!(
-        b.stance_tracking_speed / to.arm_length,
-        a.stance_tracking_speed / from.arm_length
-    );
-    assert_relative_eq!(
-        b.tracking_acceleration / to.arm_length,
-        a.tracking_acceleration / from.arm_length
-    );
-    assert_relative_eq!(b.damping / to.arm_length, a.damping / from.arm_length);
-    // The hands under the ZMP level likewise: the NAO's 1 m/s and 10 m/s² per arm length.
+    // The hands' speeds (under the ZMP level too: the NAO's 1 m/s and 10 m/s²) and the damping
+    // per arm length.
     let (ha, hb) = (a.balanced_hands.unwrap(), b.balanced_hands.unwrap());
     assert_relative_eq!(ha.tracking_speed, 1.0);
     assert_relative_eq!(ha.tracking_acceleration, 10.0);
-    assert_relative_eq!(
-        hb.tracking_speed / to.arm_length,
-        ha.tracking_speed / from.arm_length
-    );
-    assert_relative_eq!(
-        hb.tracking_acceleration / to.arm_length,
-        ha.tracking_acceleration / from.arm_length
-    );
+    for (v, w) in [
+        (a.tracking_speed, b.tracking_speed),
+        (a.stance_tracking_speed, b.stance_tracking_speed),
+        (a.tracking_acceleration, b.tracking_acceleration),
+        (a.damping, b.damping),
+        (ha.tracking_speed, hb.tracking_speed),
+        (ha.tracking_acceleration, hb.tracking_acceleration),
+    ] {
+        assert_relative_eq!(w / to.arm_length, v / from.arm_length);
+    }
     assert_eq!(g1::TUNING.balanced_hands, None);
     // Faster motors: the same joint speeds, never a larger fraction.
     assert!(b.upper_body_velocity_fraction <= a.upper_body_velocity_fraction);

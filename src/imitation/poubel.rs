@@ -263,15 +263,16 @@ impl PoubelImitator {
             // A dynamic walk starts from double support and holds the arms where they are: at
             // the double-support speed they stopped within a frame and the judge's weak NAO
             // fell on CMU 05_02 (16 of 16 runs passed at the stance speed).
-            hand_speed: match (
-                walk.is_some(),
-                config.hand_speed_for(&tuning, config.zmp_balance && walk.is_none()),
-            ) {
-                (true, speed) => HandSpeed {
-                    double: speed.stance,
-                    ..speed
-                },
-                (false, speed) => speed,
+            // Its frames have no ZMP level, so its hands keep the ordinary speeds.
+            hand_speed: match walk.is_some() {
+                true => {
+                    let speed = config.hand_speed_for(&tuning, false);
+                    HandSpeed {
+                        double: speed.stance,
+                        ..speed
+                    }
+                }
+                false => config.hand_speed_for(&tuning, config.zmp_balance),
             },
             hand_rates: HandRates::default(),
             arms,
