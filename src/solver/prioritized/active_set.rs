@@ -146,6 +146,48 @@ fn held_bound(clamped: bool, fixed: f64, hi: f64) -> Option<Bound> {
     })
 }
 
+/// A joint's velocity at a cold start: 0, or the end of its interval nearest 0 when the
+/// interval excludes 0.
+fn cold_start_velocity(lo: f64, hi: f64) -> f64 {
+    if lo > 0.0 {
+        lo
+    } else if hi < 0.0 {
+        hi
+    } else {
+        0.0
+    }
+}
+
+/// The velocity a joint with the interval `lo..=hi` is held at when a run starts, if held: at
+/// its `warm` bound where that is finite, else at the end nearest 0 of an interval that
+/// excludes 0.
+fn start_hold(warm: Option<Bound>, lo: f64, hi: f64) -> Option<f64> {
+    match warm {
+        Some(Bound::Upper) if hi.is_finite() => Some(hi),
+        Some(Bound::Lower) if lo.is_finite() => Some(lo),
+        _ => Some(cold_start_velocity(lo, hi)).filter(|&x| x != 0.0),
+    }
+}
+
+/// The bound of `lower ≤ value ≤ upper` that `value` violates, if any.
+fn violated_bound(value: f64, lower: f64, upper: f64) -> Option<Bound> {
+    if value > upper {
+        Some(Bound::Upper)
+    } else if value < lower {
+        Some(Bound::Lower)
+    } else {
+        None
+    }
+}
+
+/// Whether a row's `bound` side is finite (a side at ±∞ cannot hold).
+fn finite_bound(bound: Bound, lower: f64, upper: f64) -> bool {
+    match bound {
+        Bound::Upper => upper.is_finite(),
+        Bound::Lower => lower.is_finite(),
+    }
+}
+
 /// Why a run of the active-set method ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum End {
@@ -193,7 +235,8 @@ impl Solver {
     /// Solves with the joint intervals in `step_lo`/`step_hi` (±∞ for none) and the inequality
     /// rows by the active-set method; writes `velocity` and the report's joint and iteration
     /// entries. A warm start that does not converge (a damped level's cycle, or the cap) is
-    /// solved again cold: a bound the warm set carried in can keep such a cycle going frame
+    /// solved again cold, unless it began with the very bounds a cold start holds (the cold
+    /// run would take the same steps): a bound the warm set carried in can keep such a cycle going frame
     /// after frame (on the NAO's hand levels it left the hands 15 cm off), where a cold
     /// start's path would not have met it. After a solve that did not converge the next one
     /// starts cold: where the cold method itself cycles (the NAO's lift and landing phases,
@@ -206,7 +249,8 @@ impl Solver {
         let cap = iteration_cap(n, self.stack.total_inequality_rows());
         let budget = self.settings.max_passes;
         let limit = budget.map_or(cap, |b| b.min(cap));
-        let warm = self.settings.warm_start && self.active_set.warm_valid;
+        let warm =
+            self.settings.warm_start && self.active_set.warm_valid && !self.warm_start_is_cold();
         let (mut iterations, mut end) = self.run_active_set(warm, limit);
         // Out of budget, the warm iterate is the answer; otherwise a warm start that did not
         // converge is retried cold with what is left.
@@ -295,19 +339,9 @@ impl Solver {
         ws.seen_count = 0;
         for i in 0..self.stack.dof() {
             let (lo, hi) = (self.step_lo[i], self.step_hi[i]);
-            let x = if lo > 0.0 {
-                lo
-            } else if hi < 0.0 {
-                hi
-            } else {
-                0.0
-            };
-            ws.point[i] = x;
-            let held = match ws.warm_joints[i].filter(|_| warm) {
-                Some(Bound::Upper) if hi.is_finite() => hi,
-                Some(Bound::Lower) if lo.is_finite() => lo,
-                _ if x != 0.0 => x,
-                _ => continue,
+            ws.point[i] = cold_start_velocity(lo, hi);
+            let Some(held) = start_hold(ws.warm_joints[i].filter(|_| warm), lo, hi) else {
+                continue;
             };
             self.clamped[i] = true;
             self.fixed_velocity[i] = held;
@@ -315,21 +349,33 @@ impl Solver {
         for r in 0..self.stack.total_inequality_rows() {
             let (lower, upper) = self.stack.inequality_bounds(r);
             self.inequality_state[r] = if warm {
-                ws.warm_rows[r].filter(|&b| match b {
-                    Bound::Upper => upper.is_finite(),
-                    Bound::Lower => lower.is_finite(),
-                })
+                ws.warm_rows[r].filter(|&b| finite_bound(b, lower, upper))
             } else {
-                let value = dot(self.stack.inequality_row(r), &ws.point);
-                if value > upper {
-                    Some(Bound::Upper)
-                } else if value < lower {
-                    Some(Bound::Lower)
-                } else {
-                    None
-                }
+                violated_bound(dot(self.stack.inequality_row(r), &ws.point), lower, upper)
             };
         }
+    }
+
+    /// Whether a warm start would begin with the very bounds a cold start holds: the two runs
+    /// would then take the same steps, and a warm run that does not converge is not worth
+    /// retrying cold.
+    fn warm_start_is_cold(&mut self) -> bool {
+        let ws = &mut self.active_set;
+        for i in 0..self.stack.dof() {
+            let (lo, hi) = (self.step_lo[i], self.step_hi[i]);
+            let cold = cold_start_velocity(lo, hi);
+            ws.direction[i] = cold;
+            if start_hold(ws.warm_joints[i], lo, hi) != start_hold(None, lo, hi) {
+                return false;
+            }
+        }
+        (0..self.stack.total_inequality_rows()).all(|r| {
+            let (lower, upper) = self.stack.inequality_bounds(r);
+            let value = dot(self.stack.inequality_row(r), &ws.direction);
+            let cold = violated_bound(value, lower, upper);
+            let warm = ws.warm_rows[r].filter(|&b| finite_bound(b, lower, upper));
+            warm == cold
+        })
     }
 
     /// Whether `velocity` keeps every free joint in its interval and every inactive row within
