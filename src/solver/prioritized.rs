@@ -134,7 +134,8 @@ pub struct Settings {
     /// In a control loop, where one tick's active bounds are mostly the last tick's, most of
     /// the passes that add them one at a time are saved. A warm solve that does not converge
     /// (a damped level's cycle, or the cap) is solved again cold and returns the cold
-    /// solve's result, and the solve after one that did not converge starts cold; a damped
+    /// solve's result (a warm start holding what a cold start holds is the cold solve, run
+    /// once), and the solve after one that did not converge starts cold; a damped
     /// level's optimum may still depend on the path, so a converged
     /// warm result can differ a little from the cold one there.
     /// Default off: each solve starts from no active bound. Only the active-set method starts

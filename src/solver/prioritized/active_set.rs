@@ -235,10 +235,10 @@ impl Solver {
     /// Solves with the joint intervals in `step_lo`/`step_hi` (±∞ for none) and the inequality
     /// rows by the active-set method; writes `velocity` and the report's joint and iteration
     /// entries. A warm start that does not converge (a damped level's cycle, or the cap) is
-    /// solved again cold, unless it began with the very bounds a cold start holds (the cold
-    /// run would take the same steps): a bound the warm set carried in can keep such a cycle going frame
+    /// solved again cold: a bound the warm set carried in can keep such a cycle going frame
     /// after frame (on the NAO's hand levels it left the hands 15 cm off), where a cold
-    /// start's path would not have met it. After a solve that did not converge the next one
+    /// start's path would not have met it. A warm start that holds the very bounds a cold
+    /// start holds is run as the cold start, once (the cold run would repeat its steps). After a solve that did not converge the next one
     /// starts cold: where the cold method itself cycles (the NAO's lift and landing phases,
     /// frame after frame), a warm try first only doubled the cost. With a budget
     /// ([`Settings::max_passes`](crate::solver::Settings::max_passes)) the two runs share it; a
@@ -363,8 +363,8 @@ impl Solver {
         let ws = &mut self.active_set;
         for i in 0..self.stack.dof() {
             let (lo, hi) = (self.step_lo[i], self.step_hi[i]);
-            let cold = cold_start_velocity(lo, hi);
-            ws.direction[i] = cold;
+            // `direction` is free until the run starts: it holds the cold start point here.
+            ws.direction[i] = cold_start_velocity(lo, hi);
             if start_hold(ws.warm_joints[i], lo, hi) != start_hold(None, lo, hi) {
                 return false;
             }
