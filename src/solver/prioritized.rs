@@ -425,7 +425,7 @@ impl Solver {
             seg_start,
             used: vec![UsedRow::Equality(0); capacity],
             inequality_state: vec![None; inequalities],
-            active_set: ActiveSetWorkspace::new(n, capacity, inequalities, m_max),
+            active_set: ActiveSetWorkspace::new(n, levels, capacity, inequalities, m_max),
             qr: vec![0.0; n * capacity],
             projections: vec![0.0; n * capacity],
             tau: vec![0.0; capacity],

@@ -53,7 +53,10 @@
 //! each ran to the cap, 20–35× a frame's median time. The method is deterministic and its
 //! iterate at an active set's optimum (`x = x*`, step 3) depends on the set alone, so a set met
 //! there again would only repeat the same steps: the solve **ends** at once with that iterate,
-//! not converged (in the `τ = 0` cycles the iterate the cap would have returned). Keeping the
+//! not converged (in the `τ = 0` cycles the iterate the cap would have returned). When the
+//! bound released at an optimum blocks the very next step at `τ = 0`, the set and the iterate
+//! are that optimum's again before any solve: the run ends there one prioritized solve sooner,
+//! with the same iterate. Keeping the
 //! bound and going on instead changed where other solves ended and let a placed hand sink into
 //! its support in a test. An iteration cap (`4 (n + p) + 8` prioritized solves, `p` the
 //! inequality rows) bounds any other cycle; the report says whether the method converged. The
@@ -63,6 +66,7 @@
 //! more tightly: the iterate it ends at is feasible in the same way.
 
 use super::super::householder::{dot, norm, solve_upper};
+use super::super::report::LevelReport;
 use super::{Bound, Solver, UsedRow, apply_chain, used_row};
 
 /// A multiplier is taken as zero below this fraction of its level's gradient norm (plus one).
@@ -90,6 +94,9 @@ pub(crate) struct ActiveSetWorkspace {
     seen: Vec<u8>,
     /// Slots of `seen` in use.
     seen_count: usize,
+    /// The level reports of the pass at the last optimum, for a run that ends there without
+    /// solving it again ([`Solver::run_active_set`]).
+    optimum_levels: Vec<LevelReport>,
     /// The bound each joint and inequality row was held at when the last solve ended: the
     /// start of the next one with [`Settings::warm_start`](crate::solver::Settings::warm_start).
     warm_joints: Vec<Option<Bound>>,
@@ -99,7 +106,13 @@ pub(crate) struct ActiveSetWorkspace {
 }
 
 impl ActiveSetWorkspace {
-    pub(crate) fn new(dof: usize, capacity: usize, inequalities: usize, level_max: usize) -> Self {
+    pub(crate) fn new(
+        dof: usize,
+        levels: usize,
+        capacity: usize,
+        inequalities: usize,
+        level_max: usize,
+    ) -> Self {
         Self {
             point: vec![0.0; dof],
             direction: vec![0.0; dof],
@@ -110,6 +123,7 @@ impl ActiveSetWorkspace {
             decided_joints: vec![false; dof],
             seen: vec![0; (iteration_cap(dof, inequalities) + 1) * (dof + inequalities)],
             seen_count: 0,
+            optimum_levels: vec![LevelReport::default(); levels],
             warm_joints: vec![None; dof],
             warm_rows: vec![None; inequalities],
             warm_valid: false,
@@ -200,7 +214,7 @@ enum End {
 }
 
 /// A bound that enters or leaves the active set: a joint's interval, or an inequality row.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 enum Constraint {
     Joint(usize, Bound),
     Row(usize, Bound),
@@ -284,6 +298,8 @@ impl Solver {
     fn run_active_set(&mut self, warm: bool, limit: usize) -> (usize, End) {
         let n = self.stack.dof();
         self.start_active_set(warm);
+        // The bound released at the last optimum, until the next step.
+        let mut released = None;
         for iterations in 1..=limit {
             self.prioritized_pass();
             // A warm set's first solution that meets every bound is a feasible iterate
@@ -303,6 +319,11 @@ impl Solver {
                     ws.point[i] += tau * ws.direction[i];
                 }
                 self.activate(blocking);
+                let back = tau == 0.0 && released == Some(blocking) && iterations < limit;
+                if back && self.optimum_repeated() {
+                    return (iterations, End::Cycle);
+                }
+                released = None;
                 continue;
             }
             self.active_set.point.copy_from_slice(&self.velocity);
@@ -311,7 +332,12 @@ impl Solver {
                 return (iterations, End::Cycle);
             }
             match self.release_candidate() {
-                Some(bound) => self.release(bound),
+                Some(bound) => {
+                    let levels = &self.report.levels;
+                    self.active_set.optimum_levels.copy_from_slice(levels);
+                    self.release(bound);
+                    released = Some(bound);
+                }
                 None => return (iterations, End::Converged),
             }
         }
@@ -475,6 +501,20 @@ impl Solver {
     /// Whether the current active set was met at its optimum before in this solve; records it
     /// if not.
     fn met_before(&mut self) -> bool {
+        if self.seen_before() {
+            return true;
+        }
+        // Past the cap's number of slots the loop ends anyway.
+        let ws = &mut self.active_set;
+        if (ws.seen_count + 2) * ws.state_len() <= ws.seen.len() {
+            ws.seen_count += 1;
+        }
+        false
+    }
+
+    /// Whether the current active set was met at its optimum before in this solve; writes it
+    /// into the slot after the recorded ones.
+    fn seen_before(&mut self) -> bool {
         let ws = &mut self.active_set;
         let len = ws.state_len();
         let (seen, slot) = ws.seen.split_at_mut(ws.seen_count * len);
@@ -490,14 +530,24 @@ impl Solver {
         for (code, state) in rows.iter_mut().zip(&self.inequality_state) {
             *code = bound_code(*state);
         }
-        if seen.chunks_exact(len).any(|old| old == slot) {
-            return true;
+        seen.chunks_exact(len).any(|old| old == slot)
+    }
+
+    /// Whether the bound just released at an optimum, crossed again at once (`τ = 0`) and held
+    /// again, brought the run back to that optimum, to end there as the next step would: the
+    /// active set is the optimum's again and `x` its solution unchanged, so the next pass would
+    /// give `x* = x` bit for bit, no bound would block, and the set would be met before (a
+    /// damped level's cycle, see the module docs). Saves that pass; the report's levels are the
+    /// optimum's pass's again. Checks what the next step would: no row blocks at `x`, and the
+    /// set is on record.
+    fn optimum_repeated(&mut self) -> bool {
+        self.active_set.direction.fill(0.0);
+        if self.first_blocking().is_some() || !self.seen_before() {
+            return false;
         }
-        // Past the cap's number of slots the loop ends anyway.
-        if (ws.seen_count + 2) * len <= ws.seen.len() {
-            ws.seen_count += 1;
-        }
-        false
+        let levels = &self.active_set.optimum_levels;
+        self.report.levels.copy_from_slice(levels);
+        true
     }
 
     /// The bound to release at `x = x*`, if any (step 3 of the method in the module docs).
