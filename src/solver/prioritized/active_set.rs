@@ -56,12 +56,11 @@
 //! not converged (in the `τ = 0` cycles the iterate the cap would have returned). When the
 //! bound released at an optimum blocks the very next step at `τ = 0`, the set and the iterate
 //! are that optimum's again before any solve: the run ends there one prioritized solve sooner,
-//! with the same iterate. Keeping the
-//! bound and going on instead changed where other solves ended and let a placed hand sink into
-//! its support in a test. An iteration cap (`4 (n + p) + 8` prioritized solves, `p` the
-//! inequality rows) bounds any other cycle; the report says whether the method converged. The
-//! iterate keeps every joint interval at every step, so even a capped solve never violates a
-//! limit. A budget of passes per solve
+//! with the same iterate. Keeping the bound and going on instead changed where other solves
+//! ended and let a placed hand sink into its support in a test. An iteration cap
+//! (`4 (n + p) + 8` prioritized solves, `p` the inequality rows) bounds any other cycle; the
+//! report says whether the method converged. The iterate keeps every joint interval at every
+//! step, so even a capped solve never violates a limit. A budget of passes per solve
 //! ([`Settings::max_passes`](crate::solver::Settings::max_passes)) bounds a control tick's time
 //! more tightly: the iterate it ends at is feasible in the same way.
 
