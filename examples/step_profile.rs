@@ -30,12 +30,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "usage: step_profile CLIP [g1] [koenemann] [--walk | --dynamic-walk] [--max-passes N]";
     let clip_path = args.first().ok_or(usage)?;
     let has = |s: &str| args.iter().any(|a| a == s);
+    // Koenemann's frames run several IKs of their own and report no solve of the tables.
+    let koenemann = has("koenemann");
     let mut clip = Clip::open(clip_path)?;
     let mut config = ImitatorConfig {
         support: SupportConfig::for_capture(clip.capture()),
         ..ImitatorConfig::default()
     };
-    if has("koenemann") {
+    if koenemann {
         config.method = ImitationMethod::Koenemann(KoenemannConfig::default());
     }
     config.footsteps.follow = has("--walk") || has("--dynamic-walk");
@@ -50,8 +52,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         nao::profile()
     };
     let mut imitator = Imitator::new(profile, config)?;
-    // Koenemann's frames run several IKs of their own and report no solve of the tables.
-    let koenemann = has("koenemann");
 
     let mut per_phase: BTreeMap<String, Vec<f64>> = BTreeMap::new();
     let mut per_passes: BTreeMap<usize, Vec<f64>> = BTreeMap::new();
@@ -84,8 +84,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for (phase, mut times) in per_phase {
         println!("{}", spread(&phase, &mut times));
     }
-    for (passes, mut times) in per_passes.into_iter().filter(|_| !koenemann) {
-        println!("{}", spread(&format!("{passes} solver passes"), &mut times));
+    if !koenemann {
+        for (passes, mut times) in per_passes {
+            println!("{}", spread(&format!("{passes} solver passes"), &mut times));
+        }
     }
     frames.sort_by(|a, b| b.0.total_cmp(&a.0));
     for (micros, index, description) in frames.iter().take(15) {
