@@ -4,11 +4,12 @@
 //! # The footprints
 //!
 //! While a human foot is on the ground its footprint is its ankle's ground point and its heading
-//! (ankle → toe, or the hips' heading when the toe is missing), in the human's world. Each foot's
-//! move since the start, scaled by the leg ratio `k = robot leg / human leg` and turned into the
-//! robot's world, moves the same robot foot from where it started: a human footprint `(p, θ)` of
-//! a foot that started at `(p₀, θ₀)` is the robot footprint `(r₀ + R(Δθ)·k·(p − p₀), ρ₀ + θ − θ₀)`
-//! for the robot foot that started at `(r₀, ρ₀)`, with `Δθ` the difference of the starting
+//! (ankle → toe, or the hips' heading when the toe is missing or the foot stands on its toes:
+//! [`footprint`]), in the human's world. Each foot's move since the start, scaled by the leg
+//! ratio `k = robot leg / human leg` and turned into the robot's world, moves the same robot
+//! foot from where it started: a human footprint `(p, θ)` of a foot that started at `(p₀, θ₀)`
+//! is the robot footprint `(r₀ + R(Δθ)·k·(p − p₀), ρ₀ + θ − θ₀)` for the robot foot that
+//! started at `(r₀, ρ₀)`, with `Δθ` the difference of the starting
 //! stances' headings (robot − human). So the human's stance width and natural toe-out are not
 //! copied, only how the feet move. A robot foot's **target** is its footprint clipped to the
 //! step envelope ([`FootArea`]: forward offset, lateral offset that keeps the feet apart and
@@ -32,7 +33,7 @@
 //! Units: metres, radians. Frames: the human's world and the robot's world (the right sole at
 //! the first frame), both z up.
 
-use nalgebra::{Rotation2, Vector2};
+use nalgebra::{Rotation2, Vector2, Vector3};
 
 use super::look_ahead::{FootLift, FootLookAhead, FootSchedule, MotionTimes};
 use super::phase::SupportPhase;
@@ -664,15 +665,22 @@ impl FootstepPlanner {
     }
 }
 
-/// The footprint of a human foot: ankle ground point and heading.
+/// The footprint of a human foot: ankle ground point and heading. The heading is the ankle's
+/// direction to the toe when the foot is near flat: the toe at least 3 cm ahead of the ankle
+/// and no steeper below (or above) it than 45°. A foot on its toes (relevé, the end of a
+/// push-off) has its toe nearly under the ankle, and the little horizontal distance left points
+/// anywhere: CMU 05_02's left foot in relevé read as pointing backward, 2.2–3.1 rad from the
+/// pelvis, and a walk that started from it turned the robot 84° left while the human turned
+/// 43° right. Such a foot, or one without a toe, takes the pelvis' heading.
 pub(crate) fn footprint(frame: &HumanFrame, foot: Side) -> Option<GroundPose> {
     let (ankle, toe) = match foot {
         Side::Right => (HumanJoint::RAnkle, HumanJoint::RToe),
         Side::Left => (HumanJoint::LAnkle, HumanJoint::LToe),
     };
     let ankle = frame.get(ankle)?;
+    let flat = |d: Vector3<f64>| d.xy().norm() > 0.03 && d.z.abs() <= d.xy().norm();
     let forward = match frame.get(toe) {
-        Some(toe) if (toe - ankle).xy().norm() > 0.03 => (toe - ankle).xy(),
+        Some(toe) if flat(toe - ankle) => (toe - ankle).xy(),
         _ => {
             let left = frame.get(HumanJoint::LHip)? - frame.get(HumanJoint::RHip)?;
             Vector2::new(left.y, -left.x)
@@ -1015,5 +1023,33 @@ mod tests {
             (target.xy - Vector2::new(0.05, 0.1)).norm() < 1e-12,
             "{target:?}"
         );
+    }
+
+    /// A foot's heading is its toe's direction while the foot is near flat, the pelvis' while
+    /// it stands on its toes. The relevé is CMU 05_02's first frame: the left toe 5.7 cm
+    /// behind, 2.5 cm left of and 11.5 cm below the ankle, whose direction, atan2(0.025,
+    /// −0.057) = 2.73 rad, is no heading of that foot.
+    #[test]
+    fn a_foot_on_its_toes_takes_the_pelvis_heading() {
+        let v = |x: f64, y: f64, z: f64| Some(nalgebra::Vector3::new(x, y, z));
+        let mut frame = human([0.0, 0.0], [0.0, 0.1]);
+        // The pelvis faces 0.3 rad: left hip − right hip = 0.2·(−sin 0.3, cos 0.3).
+        let (s, c) = 0.3f64.sin_cos();
+        frame.set(HumanJoint::RHip, v(0.1 * s, -0.1 * c, 0.9));
+        frame.set(HumanJoint::LHip, v(-0.1 * s, 0.1 * c, 0.9));
+        // The right foot flat (toe 6 cm below the ankle, 15 cm ahead), turned out 0.2 rad.
+        let (s, c) = (-0.2f64).sin_cos();
+        frame.set(HumanJoint::RToe, v(0.15 * c, 0.15 * s, 0.02));
+        frame.set(HumanJoint::LToe, v(-0.057, 0.125, 0.08 - 0.115));
+        let heading = |frame: &HumanFrame, foot| footprint(frame, foot).unwrap().yaw;
+        assert!((heading(&frame, Side::Right) + 0.2).abs() < 1e-12);
+        assert!((heading(&frame, Side::Left) - 0.3).abs() < 1e-12);
+        // The toe 8 cm ahead: 40° below the ankle's level (6.7 cm down), its own heading 0;
+        // 50° (9.5 cm down), the pelvis'.
+        let below = |deg: f64| 0.08 * deg.to_radians().tan();
+        frame.set(HumanJoint::LToe, v(0.08, 0.1, 0.08 - below(40.0)));
+        assert!(heading(&frame, Side::Left).abs() < 1e-12);
+        frame.set(HumanJoint::LToe, v(0.08, 0.1, 0.08 - below(50.0)));
+        assert!((heading(&frame, Side::Left) - 0.3).abs() < 1e-12);
     }
 }
