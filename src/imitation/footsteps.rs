@@ -5,13 +5,13 @@
 //!
 //! While a human foot is on the ground its footprint is its ankle's ground point and its heading
 //! (ankle → toe, or the hips' heading when the toe is missing or the foot stands on its toes:
-//! [`footprint`]), in the human's world. Each foot's move since the start, scaled by the leg
-//! ratio `k = robot leg / human leg` and turned into the robot's world, moves the same robot
-//! foot from where it started: a human footprint `(p, θ)` of a foot that started at `(p₀, θ₀)`
-//! is the robot footprint `(r₀ + R(Δθ)·k·(p − p₀), ρ₀ + θ − θ₀)` for the robot foot that
-//! started at `(r₀, ρ₀)`, with `Δθ` the difference of the starting
-//! stances' headings (robot − human). So the human's stance width and natural toe-out are not
-//! copied, only how the feet move. A robot foot's **target** is its footprint clipped to the
+//! [`HumanFrame::foot_heading`]), in the human's world. Each foot's move since the start,
+//! scaled by the leg ratio `k = robot leg / human leg` and turned into the robot's world, moves
+//! the same robot foot from where it started: a human footprint `(p, θ)` of a foot that started
+//! at `(p₀, θ₀)` is the robot footprint `(r₀ + R(Δθ)·k·(p − p₀), ρ₀ + θ − θ₀)` for the robot
+//! foot that started at `(r₀, ρ₀)`, with `Δθ` the difference of the starting stances' headings
+//! (robot − human). So the human's stance width and natural toe-out are not copied, only how
+//! the feet move. A robot foot's **target** is its footprint clipped to the
 //! step envelope ([`FootArea`]: forward offset, lateral offset that keeps the feet apart and
 //! uncrossed, relative yaw) around where the robot's other foot stands.
 //!
@@ -33,13 +33,13 @@
 //! Units: metres, radians. Frames: the human's world and the robot's world (the right sole at
 //! the first frame), both z up.
 
-use nalgebra::{Rotation2, Vector2, Vector3};
+use nalgebra::Rotation2;
 
 use super::look_ahead::{FootLift, FootLookAhead, FootSchedule, MotionTimes};
 use super::phase::SupportPhase;
 use super::support::HumanSupport;
+use crate::human::HumanFrame;
 use crate::human::Side;
-use crate::human::{HumanFrame, HumanJoint};
 use crate::robots::{FootArea, SolePlacement};
 
 /// How long after a human foot lands its footprint is still taken (s): the heel strikes first,
@@ -665,36 +665,24 @@ impl FootstepPlanner {
     }
 }
 
-/// The footprint of a human foot: ankle ground point and heading. The heading is the ankle's
-/// direction to the toe when the foot is near flat: the toe at least 3 cm ahead of the ankle
-/// and no steeper below (or above) it than 45°. A foot on its toes (relevé, the end of a
-/// push-off) has its toe nearly under the ankle, and the little horizontal distance left points
-/// anywhere: CMU 05_02's left foot in relevé read as pointing backward, 2.2–3.1 rad from the
-/// pelvis, and a walk that started from it turned the robot 84° left while the human turned
-/// 43° right. Such a foot, or one without a toe, takes the pelvis' heading.
+/// The footprint of a human foot: ankle ground point and heading, the foot's own while it is
+/// near flat ([`HumanFrame::foot_heading`]: the toe at least 3 cm ahead and at most 45° below
+/// the ankle), else the pelvis'. A walk that started from CMU 05_02's foot in relevé, read as
+/// pointing backward, turned the robot 84° left while the human turned 43° right.
 pub(crate) fn footprint(frame: &HumanFrame, foot: Side) -> Option<GroundPose> {
-    let (ankle, toe) = match foot {
-        Side::Right => (HumanJoint::RAnkle, HumanJoint::RToe),
-        Side::Left => (HumanJoint::LAnkle, HumanJoint::LToe),
-    };
-    let ankle = frame.get(ankle)?;
-    let flat = |d: Vector3<f64>| d.xy().norm() > 0.03 && d.z.abs() <= d.xy().norm();
-    let forward = match frame.get(toe) {
-        Some(toe) if flat(toe - ankle) => (toe - ankle).xy(),
-        _ => {
-            let left = frame.get(HumanJoint::LHip)? - frame.get(HumanJoint::RHip)?;
-            Vector2::new(left.y, -left.x)
-        }
-    };
+    let ankle = frame.get(foot.ankle())?;
+    let yaw = (frame.foot_heading(foot, 0.03, 1.0)).or_else(|| frame.pelvis_heading(0.0))?;
     Some(GroundPose {
         xy: ankle.xy(),
-        yaw: forward.y.atan2(forward.x),
+        yaw,
     })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::human::HumanJoint;
+    use nalgebra::Vector2;
 
     /// A step envelope 5 cm forward, 4 cm back, 9.5–12 cm to the side, ±0.15 rad.
     const AREA: FootArea = FootArea {

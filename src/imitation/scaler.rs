@@ -670,23 +670,13 @@ impl Scaler {
         if let (Some(la), Some(ra)) = (la, ra) {
             self.ankles = Some(la - ra);
         }
-        let pelvis = match (frame.get(LHip), frame.get(RHip)) {
-            (Some(l), Some(r)) => {
-                let h = l - r;
-                let forward = Vector3::new(h.y, -h.x, 0.0);
-                (forward.norm() > min).then(|| forward.y.atan2(forward.x))
-            }
-            _ => None,
-        };
+        // Any slope: a foot on its toes still turns the frame. With the footprints' 45° limit
+        // ([`super::footsteps::footprint`]) the heading jumped between the foot and the pelvis
+        // on the frames where a foot point dips past it: the references of six bundled clips
+        // moved, and Kinect ges02's hands came 0.5–0.8 cm further off.
+        let pelvis = frame.pelvis_heading(min);
         for side in [Side::Left, Side::Right] {
-            let foot = match (frame.get(side.ankle()), frame.get(side.toe())) {
-                (Some(a), Some(t)) => {
-                    let v = t - a;
-                    (v.xy().norm() > min).then(|| v.y.atan2(v.x))
-                }
-                _ => None,
-            };
-            if let Some(h) = foot.or(pelvis) {
+            if let Some(h) = frame.foot_heading(side, min, f64::INFINITY).or(pelvis) {
                 self.headings[side.index()] = h;
             }
         }
