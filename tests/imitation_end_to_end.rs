@@ -277,6 +277,19 @@ fn dynamic_walk_takes_no_step_for_a_standing_human() {
     assert_eq!(m.robot_support_sequence, vec!["DS"]);
 }
 
+/// The dynamic walk turns the way the human turns. CMU 05_02 starts with the left foot in
+/// relevé (its toe 5.7 cm behind and 11.5 cm below the ankle), which once read as a foot
+/// pointing backward and set the walk's starting heading: the robot turned 84° left while the
+/// human's pelvis turned 43° (0.75 rad) right, a heading error of 2.20 rad at the end. The
+/// error must now be below the human's own turn, the error of a robot that did not turn.
+#[test]
+fn dynamic_walk_turns_with_the_human() {
+    let name = "cmu_05_02_stand_arm_gestures_turn_single_leg.bvh";
+    let (m, _) = run_held(name, dynamic(), WALKING_FOOT_TOLERANCE, 60.0);
+    let error = m.travel.heading_error_rad;
+    assert!(error.abs() < 0.75, "{name}: {:?}", m.travel);
+}
+
 /// With `walking_arms` the hands follow the human while the robot walks (CMU 07_04, 60 s
 /// hold): the invariants of `run_held` hold (limits, velocities, the arms clear of the torso,
 /// the CoM over the soles, standing feet still), and the hands' mean error over the clip's
