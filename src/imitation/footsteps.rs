@@ -38,8 +38,7 @@ use nalgebra::Rotation2;
 use super::look_ahead::{FootLift, FootLookAhead, FootSchedule, MotionTimes};
 use super::phase::SupportPhase;
 use super::support::HumanSupport;
-use crate::human::HumanFrame;
-use crate::human::Side;
+use crate::human::{HumanFrame, Side};
 use crate::robots::{FootArea, SolePlacement};
 
 /// How long after a human foot lands its footprint is still taken (s): the heel strikes first,

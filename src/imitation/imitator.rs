@@ -418,12 +418,12 @@ pub(crate) fn ground_pose(sole: &IsometryMatrix3<f64>) -> GroundPose {
     }
 }
 
-/// The human's mid-ankle ground point (xy, m) and hip heading (rad) in `frame`.
+/// The human's mid-ankle ground point (xy, m) and hip heading (rad) in `frame`
+/// ([`HumanFrame::pelvis_heading`]; `None` with the hips on one vertical).
 pub(crate) fn human_stance(frame: &HumanFrame) -> Option<(Vector2<f64>, f64)> {
     let (l, r) = (
         frame.get(HumanJoint::LAnkle)?,
         frame.get(HumanJoint::RAnkle)?,
     );
-    let left = frame.get(HumanJoint::LHip)? - frame.get(HumanJoint::RHip)?;
-    Some(((l + r).xy() * 0.5, (-left.x).atan2(left.y)))
+    Some(((l + r).xy() * 0.5, frame.pelvis_heading(0.0)?))
 }
