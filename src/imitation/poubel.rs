@@ -733,6 +733,13 @@ impl PoubelImitator {
         out.human_stance = human_stance(frame);
         out.leg_ratio = self.scaler.leg_ratio();
         out.pending_steps = self.footsteps.steps_pending();
+        if let Some(walk) = &mut self.walk
+            && self.footsteps.is_idle()
+        {
+            let feet = [ground_pose(&out.left_sole), ground_pose(&out.right_sole)];
+            let goals = self.footsteps.goals(out.leg_ratio);
+            out.pending_steps = walk.feet_to_step(&feet, goals.as_ref());
+        }
         if let Some(hands) = &self.hands {
             out.hand_supports = hands.placements();
             out.awaiting_contact = hands.awaiting(frame.time);

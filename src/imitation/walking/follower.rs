@@ -269,6 +269,31 @@ impl WalkFollower {
         !self.planned.is_empty()
     }
 
+    /// How many feet still have to step (0, 1 or 2): those of the queued steps while walking;
+    /// standing at `feet` (`[left, right]`, world), those the walk would move toward `goals`
+    /// (none without goals). This, not the support phases' distance to the raw footprints, says
+    /// whether the robot has arrived: the walk's goals stand at the robot's own width
+    /// ([`WalkFollower::at_width`]) and within the step envelope. Allocates nothing.
+    pub(in crate::imitation) fn feet_to_step(
+        &mut self,
+        feet: &[GroundPose; 2],
+        goals: Option<&[GroundPose; 2]>,
+    ) -> usize {
+        let mut moves = [false; 2];
+        if self.is_walking() {
+            for step in self.generator.queued_steps().map(|(_, _, step)| step) {
+                moves[step.side.index()] = true;
+            }
+        } else if let Some(goals) = goals {
+            self.plan(feet, goals, None, QUEUE_AHEAD);
+            for step in &self.planned {
+                moves[step.side.index()] = true;
+            }
+            self.planned.clear();
+        }
+        moves.iter().filter(|&&m| m).count()
+    }
+
     /// Queues the steps toward `goals` (`[left, right]`, world) the generator does not have
     /// yet and runs it to robot time `now` (s). Returns whether the walk is over: every step
     /// landed, the CoM at rest, nothing left to step to. Allocates nothing.
