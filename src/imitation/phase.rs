@@ -336,7 +336,7 @@ pub struct PhaseConfig {
     /// Distance (m) between the CoM goal of a single support and the inner edge of the support
     /// foot's contact area (its middle where the area is narrower than twice this) in the
     /// executable tables. `None` (default): the profile's
-    /// [`MotionTuning::support_margin`](crate::robots::MotionTuning::support_margin) (15 mm for
+    /// [`MotionTuning::support_margin`](crate::robots::MotionTuning::support_margin) (20 mm for
     /// the NAO).
     pub support_margin: Option<f64>,
     /// A CoM step also waits until the torso is within this angle (rad) of its target

@@ -1301,16 +1301,16 @@ impl TaskTables {
 
     /// Adapts the executable tables to walking
     /// ([`FootstepConfig::follow`](super::footsteps::FootstepConfig::follow)): in single support
-    /// and while a foot moves the CoM goes over the centre of the support sole's contact
-    /// rectangle ([`BipedProfile::sole_centre`]) instead of near its inner edge, and the
-    /// "collision" level moves above "balance". A walking step carries the swing foot across,
-    /// and with the CoM 15 mm from the inner edge of the NAO's 53 mm-wide contact area the stance
-    /// foot rocked onto that edge: the judge found the CoM outside the real contact area 1–3 % of
-    /// the time and no walk passed; over the centre, 28 of the 32 walking runs of the bundled
-    /// clips pass (the others: a loaded foot turning 2.2–2.5°, 2° allowed). The longer weight
-    /// shift brings the torso nearer the arms, which balance, its goal inside a wide area, can
-    /// make room for; without walking the shorter shift keeps the robot quick to follow short
-    /// one-leg stances.
+    /// and while a foot moves the CoM goes over the centre of the support sole's contact rectangle
+    /// ([`BipedProfile::sole_centre`]) instead of near its inner edge, and the "collision" level
+    /// moves above "balance". A walking step carries the swing foot across, and with the CoM 15 mm
+    /// from the inner edge of the NAO's 53 mm-wide contact area (its margin then) the stance foot
+    /// rocked onto that edge: the judge found the CoM outside the real contact area 1–3 % of the
+    /// time and no walk passed; over the centre, 28 of the 32 walking runs of the bundled clips
+    /// pass (the others: a loaded foot turning 2.2–2.5°, 2° allowed). The longer weight shift
+    /// brings the torso nearer the arms, which balance, its goal inside a wide area, can make room
+    /// for; without walking the shorter shift keeps the robot quick to follow short one-leg
+    /// stances.
     pub fn centre_stances_for_walking(&mut self, profile: &BipedProfile) {
         for table in &mut self.tables {
             let root = table.model_root;

@@ -58,7 +58,7 @@
 //! torso_lowering = 0.02              # m, the torso below its standing height
 //! single_support_lowering = 0.0      # m, the same while a foot is lifted or up
 //! torso_lean = 0.25                  # rad, over the stance foot
-//! support_margin = 0.015             # m, CoM goal from the sole's inner edge
+//! support_margin = 0.020             # m, CoM goal from the sole's inner edge
 //! com_speed = 0.05                   # m/s, the CoM reference
 //! com_acceleration = 0.3             # m/s²
 //! offset_rate = 1.5                  # 1/s, Koenemann's CoM offset between the feet
