@@ -39,6 +39,13 @@ const FOLLOWING_DOUBLE_SUPPORT: f64 = 6.0;
 /// [`FOLLOWING_DOUBLE_SUPPORT`].
 const FOLLOWING_SINGLE_SUPPORT: f64 = 4.0;
 
+/// Share of a following step's single support at each end in which the swing foot moves only
+/// vertically. These steps turn with the human: with the generator's own 5 % (carried over the
+/// whole swing, for its straight walks) a loaded NAO foot turned 2.5° on CMU 09_12 as the swing
+/// foot turned right after its lift-off; with 15 % the bundled walks pass the judge's both
+/// models (turns ≤ 1°).
+const FOLLOWING_LIFT_SHARE: f64 = 0.15;
+
 /// The timing of the steps that follow the human, for a cart-table CoM height `com_height` (m).
 fn following_timing(com_height: f64) -> StepTiming {
     let time_constant = (com_height / GRAVITY).sqrt();
@@ -119,6 +126,7 @@ impl WalkFollower {
     ) -> Result<Self, ImitationError> {
         let mut params = WalkParams::for_profile(profile)?;
         params.timing = following_timing(params.settings.com_height);
+        params.settings.swing.lift_share = FOLLOWING_LIFT_SHARE;
         let stance_width = {
             let model = profile.model(Side::Right);
             let mut data = model.new_data();
