@@ -46,13 +46,23 @@ const FOLLOWING_SINGLE_SUPPORT: f64 = 4.0;
 /// models (turns ≤ 1°).
 const FOLLOWING_LIFT_SHARE: f64 = 0.15;
 
-/// The timing of the steps that follow the human, for a cart-table CoM height `com_height` (m).
-fn following_timing(com_height: f64) -> StepTiming {
-    let time_constant = (com_height / GRAVITY).sqrt();
-    StepTiming {
+/// A walk's start and stop (the ZMP swinging onto the first stance sole, and back between the
+/// feet) when it follows the human, in time constants (NAO: 1.0 s): the generator's own step
+/// time before its single support grew to 3.5/ω. With its 6.5/ω the standing foot of a
+/// following walk was held to 6e-7 m instead of 6e-10 m (CMU 05_02, 09_12, 131_01).
+const FOLLOWING_START_STOP: f64 = 6.0;
+
+/// Sets the timing, swing and start and stop of the steps that follow the human on `params`
+/// (the generator's own, derived from the robot).
+fn follow_the_human(params: &mut WalkParams) {
+    let time_constant = (params.settings.com_height / GRAVITY).sqrt();
+    params.timing = StepTiming {
         double_support: FOLLOWING_DOUBLE_SUPPORT * time_constant,
         single_support: FOLLOWING_SINGLE_SUPPORT * time_constant,
-    }
+    };
+    params.settings.swing.lift_share = FOLLOWING_LIFT_SHARE;
+    params.settings.start_duration = FOLLOWING_START_STOP * time_constant;
+    params.settings.stop_duration = FOLLOWING_START_STOP * time_constant;
 }
 
 /// The joints that move the hands of `profile` but not its torso (standing in `q`): the arms.
@@ -125,8 +135,7 @@ impl WalkFollower {
         bounds: JointBounds,
     ) -> Result<Self, ImitationError> {
         let mut params = WalkParams::for_profile(profile)?;
-        params.timing = following_timing(params.settings.com_height);
-        params.settings.swing.lift_share = FOLLOWING_LIFT_SHARE;
+        follow_the_human(&mut params);
         let stance_width = {
             let model = profile.model(Side::Right);
             let mut data = model.new_data();
