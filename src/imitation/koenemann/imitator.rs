@@ -5,12 +5,12 @@ use std::time::Instant;
 
 use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 
-use super::KoenemannConfig;
 use super::goals::{Distances, Goal, GoalIk, in_torso};
 use super::mapping::{Limbs, Posture, PostureMapping};
 use super::offset::{OffsetSpeed, offset};
 use super::retarget::{FootRetargeting, retarget_double, support_normal};
 use super::support_mode::{SupportMode, target_offset};
+use super::{KoenemannConfig, LEG_STOP_TIME_CONSTANTS};
 use crate::human::{HumanFrame, HumanJoint, Side, centre_of_mass};
 use crate::imitation::config::ImitatorConfig;
 use crate::imitation::error::ImitationError;
@@ -23,6 +23,7 @@ use crate::imitation::reach::Arm;
 use crate::imitation::scaler::reference_points;
 use crate::imitation::shaping::{HandRates, HandSpeed, MotionLimits, SwingHeight};
 use crate::imitation::support::{HumanSupport, SupportDetector};
+use crate::locomotion::preview::GRAVITY;
 use crate::model::{FrameId, ModelData, ModelError};
 use crate::robots::{BipedProfile, FootArea, SolePlacement};
 use crate::solver::driver::DriverSettings;
@@ -131,8 +132,10 @@ pub(crate) struct KoenemannImitator {
     q_start: Vec<f64>,
     /// Each joint's velocity over the last frame (rad/s, model variable order).
     velocity: Vec<f64>,
-    /// [`KoenemannConfig::leg_ramp_time`] resolved (s; 0: the legs are not ramped).
+    /// [`KoenemannConfig::leg_ramp_time`] resolved (s; 0: the legs start at once).
     leg_ramp_time: f64,
+    /// [`KoenemannConfig::leg_stop_time`] resolved (s; 0: the legs stop at once).
+    leg_stop_time: f64,
     mode: SupportMode,
     /// How long the robot has been in double support with the human on one foot and its
     /// offset at that foot, against the settle time.
@@ -371,6 +374,10 @@ impl KoenemannImitator {
             leg_settings,
         )?;
         let tuning = profile.tuning;
+        let size = profile.size()?;
+        let leg_ramp_time = (method.leg_ramp_time)
+            .or(profile.sway_period)
+            .unwrap_or(0.0);
         // The left sole in the right-rooted model (the root at the start).
         let hold = shared.output.left_sole;
         Ok(KoenemannImitator {
@@ -383,9 +390,11 @@ impl KoenemannImitator {
             step_envelope: config.step_envelope.unwrap_or(profile.step_envelope),
             q_start: shared.q.clone(),
             velocity: vec![0.0; shared.q.len()],
-            leg_ramp_time: (method.leg_ramp_time)
-                .or(profile.sway_period)
-                .unwrap_or(0.0),
+            leg_ramp_time,
+            leg_stop_time: (method.leg_stop_time).unwrap_or_else(|| {
+                let time_constant = (size.com_height / GRAVITY).sqrt();
+                leg_ramp_time.max(LEG_STOP_TIME_CONSTANTS * time_constant)
+            }),
             offset_speed: (method.offset_speed).unwrap_or_else(|| OffsetSpeed::of_robot(&tuning)),
             config: method,
             frames,
@@ -845,20 +854,27 @@ impl KoenemannImitator {
 
     /// Leg joint `i`'s `step` this frame (rad) toward its `target` (the legs' IK solution, rad
     /// ahead), ramped: its speed within `√(2 a |target|)`, what stops it there at the
-    /// acceleration `a = v_max / T` ([`KoenemannConfig::leg_ramp_time`] `T`, `v_max` its
-    /// velocity limit), and within `a dt` of its last frame's speed. The legs then start and
-    /// stop smoothly, and so does the CoM they carry. Joint by joint, so the legs leave their
-    /// common line a little; in double support the held sole is put back after
-    /// ([`Self::settle_hold`]).
+    /// deceleration `a = v_max / T` ([`KoenemannConfig::leg_stop_time`] `T`, `v_max` its
+    /// velocity limit), and within `v_max dt / T'` of its last frame's speed
+    /// ([`KoenemannConfig::leg_ramp_time`] `T'`, unbounded at 0). The legs then stop smoothly
+    /// (and start so where `T'` > 0), and so does the CoM they carry. Joint by joint, so the
+    /// legs leave their common line a little; in double support the held sole is put back
+    /// after ([`Self::settle_hold`]).
     fn ramp(&self, i: usize, target: f64, step: f64, dt: f64) -> f64 {
+        let limit = self.shared.bounds.velocity()[i];
+        let step = match self.leg_stop_time > 0.0 {
+            true => {
+                let stop = (2.0 * limit / self.leg_stop_time * target.abs()).sqrt() * dt;
+                step.clamp(-stop, stop)
+            }
+            false => step,
+        };
         if self.leg_ramp_time <= 0.0 {
             return step;
         }
-        let acceleration = self.shared.bounds.velocity()[i] / self.leg_ramp_time;
-        let stop = (2.0 * acceleration * target.abs()).sqrt() * dt;
         let last = self.velocity[i] * dt;
-        let change = acceleration * dt * dt;
-        step.clamp(-stop, stop).clamp(last - change, last + change)
+        let change = limit / self.leg_ramp_time * dt * dt;
+        step.clamp(last - change, last + change)
     }
 
     /// In double support, the held sole put back where it stands, within the frame's velocity

@@ -42,8 +42,9 @@
 //! a foot coming down after single support lands flat at the touchdown speed of
 //! [`MotionLimits`](super::shaping::MotionLimits) before the offset leaves its end; on a
 //! robot whose commands are shaped, a foot lifts only once the offset has stayed at the other
-//! foot for [`KoenemannConfig::settle_time`], and each leg joint speeds up and slows down over
-//! [`KoenemannConfig::leg_ramp_time`]; the offset may end at each foot's stance point rather
+//! foot for [`KoenemannConfig::settle_time`], and each leg joint speeds up over
+//! [`KoenemannConfig::leg_ramp_time`]; on every robot each leg joint slows down before its
+//! target over [`KoenemannConfig::leg_stop_time`]; the offset may end at each foot's stance point rather
 //! than its sole's centre
 //! ([`MotionTuning::offset_to_stance_point`](crate::robots::MotionTuning::offset_to_stance_point));
 //! the legs' share of their rated speed is the
@@ -116,14 +117,30 @@ pub struct KoenemannConfig {
     /// wait as Poubel's [`PhaseConfig::settle_time`](crate::imitation::phase::PhaseConfig::settle_time)).
     pub settle_time: Option<f64>,
     /// The time (s) in which each leg joint may go from rest to its velocity limit, and back:
-    /// its acceleration is bounded by that limit over this time, and it slows down before its
-    /// target as that acceleration allows. `None` (default): the profile's sway period
+    /// its change of speed is bounded by that limit over this time (and it slows down before
+    /// its target over [`Self::leg_stop_time`], at least this). `None` (default): the profile's sway period
     /// ([`BipedProfile::sway_period`](crate::robots::BipedProfile::sway_period)), no ramp for a
     /// robot whose commands are not shaped (0 likewise). The legs otherwise start and stop at
     /// their velocity limit within a frame: on the G1 the CoM crossed to a foot at 0.18 m/s
     /// and stopped within 0.2 s over it, a ZMP beyond the sole's edge.
     pub leg_ramp_time: Option<f64>,
+    /// The time (s) in which each leg joint may slow down from its velocity limit to rest
+    /// before its target, at least `leg_ramp_time` (it only bounds the slowing down: a leg
+    /// still starts at once when `leg_ramp_time` is 0). `None` (default): the larger of the
+    /// resolved `leg_ramp_time` and [`LEG_STOP_TIME_CONSTANTS`] time constants `√(h/g)` of
+    /// the linear inverted pendulum at the robot's standing CoM height `h` (NAO 0.50 s; G1
+    /// its 1.1 s ramp, above its 0.80 s). Without it a leg joint on the NAO reached its IK target at its
+    /// velocity limit and, when the target crossed it, turned back at that limit within one
+    /// frame: the body bobbed, the feet unloaded and the contact area collapsed (judge, NAO,
+    /// automatic hold: 8 of 16 runs passed, 15 with it).
+    pub leg_stop_time: Option<f64>,
 }
+
+/// The default [`KoenemannConfig::leg_stop_time`] in time constants of the linear inverted
+/// pendulum at the robot's CoM height. Measured on the NAO (judge, bundled clips, automatic
+/// hold, runs passing of 16): 0.3, 0.6, 1.2, 2.1, 3.0 and 4.0 time constants give 8, 10, 14,
+/// 14, 15 and 14.
+pub const LEG_STOP_TIME_CONSTANTS: f64 = 3.0;
 
 impl Default for KoenemannConfig {
     fn default() -> Self {
@@ -139,6 +156,7 @@ impl Default for KoenemannConfig {
             arm_posture_gain: 0.01,
             settle_time: None,
             leg_ramp_time: None,
+            leg_stop_time: None,
         }
     }
 }
@@ -166,6 +184,7 @@ impl KoenemannConfig {
         let times = [
             ("koenemann.settle_time", self.settle_time),
             ("koenemann.leg_ramp_time", self.leg_ramp_time),
+            ("koenemann.leg_stop_time", self.leg_stop_time),
         ];
         if let Some((name, t)) = (times.into_iter()).find_map(|(name, t)| {
             t.filter(|t| !(t.is_finite() && *t >= 0.0))
