@@ -10,7 +10,7 @@ use super::mapping::{Limbs, Posture, PostureMapping};
 use super::offset::{OffsetSpeed, offset};
 use super::retarget::{FootRetargeting, retarget_double, support_normal};
 use super::support_mode::{SupportMode, target_offset};
-use super::{KoenemannConfig, LEG_STOP_TIME_CONSTANTS};
+use super::{ARM_STOP_TIME_CONSTANTS, KoenemannConfig, LEG_STOP_TIME_CONSTANTS};
 use crate::human::{HumanFrame, HumanJoint, Side, centre_of_mass};
 use crate::imitation::config::ImitatorConfig;
 use crate::imitation::error::ImitationError;
@@ -136,6 +136,8 @@ pub(crate) struct KoenemannImitator {
     leg_ramp_time: f64,
     /// [`KoenemannConfig::leg_stop_time`] resolved (s; 0: the legs stop at once).
     leg_stop_time: f64,
+    /// [`KoenemannConfig::arm_stop_time`] resolved (s; 0: the other joints stop at once).
+    arm_stop_time: f64,
     mode: SupportMode,
     /// How long the robot has been in double support with the human on one foot and its
     /// offset at that foot, against the settle time.
@@ -394,6 +396,10 @@ impl KoenemannImitator {
             leg_stop_time: (method.leg_stop_time).unwrap_or_else(|| {
                 let time_constant = (size.com_height / GRAVITY).sqrt();
                 leg_ramp_time.max(LEG_STOP_TIME_CONSTANTS * time_constant)
+            }),
+            arm_stop_time: (method.arm_stop_time).unwrap_or(match profile.sway_period {
+                Some(_) => 0.0,
+                None => ARM_STOP_TIME_CONSTANTS * (size.com_height / GRAVITY).sqrt(),
             }),
             offset_speed: (method.offset_speed).unwrap_or_else(|| OffsetSpeed::of_robot(&tuning)),
             config: method,
@@ -830,7 +836,8 @@ impl KoenemannImitator {
     }
 
     /// §V.D: every joint within its velocity limit for `dt`; the legs scaled together, then
-    /// ramped ([`Self::ramp`]).
+    /// ramped ([`Self::ramp`]); the other joints slowed down before their targets over
+    /// [`KoenemannConfig::arm_stop_time`].
     fn limit_velocities(&mut self, dt: f64) {
         let velocity = self.shared.bounds.velocity();
         let mut legs = 1.0_f64;
@@ -846,7 +853,13 @@ impl KoenemannImitator {
             self.shared.q[i] = self.q_start[i]
                 + match self.shared.legs[i] {
                     true => self.ramp(i, delta, delta * legs, dt),
-                    false => delta.clamp(-reach, reach),
+                    false => stop_before(
+                        delta,
+                        delta.clamp(-reach, reach),
+                        velocity[i],
+                        self.arm_stop_time,
+                        dt,
+                    ),
                 };
         }
         self.shared.bounds.clamp_position(&mut self.shared.q);
@@ -862,13 +875,7 @@ impl KoenemannImitator {
     /// after ([`Self::settle_hold`]).
     fn ramp(&self, i: usize, target: f64, step: f64, dt: f64) -> f64 {
         let limit = self.shared.bounds.velocity()[i];
-        let step = match self.leg_stop_time > 0.0 {
-            true => {
-                let stop = (2.0 * limit / self.leg_stop_time * target.abs()).sqrt() * dt;
-                step.clamp(-stop, stop)
-            }
-            false => step,
-        };
+        let step = stop_before(target, step, limit, self.leg_stop_time, dt);
         if self.leg_ramp_time <= 0.0 {
             return step;
         }
@@ -1004,6 +1011,17 @@ fn step_toward(from: Vector3<f64>, to: Vector3<f64>, reach: f64) -> Vector3<f64>
         true => to,
         false => from + step * (reach / distance),
     }
+}
+
+/// A joint's `step` this frame (rad) toward its `target` (rad ahead) within `√(2 a |target|)
+/// dt`, the speed that stops it there at the deceleration `a = v_max / T` (`v_max` its velocity
+/// limit, rad/s; `stop_time` `T`, s; 0: `step` unchanged).
+fn stop_before(target: f64, step: f64, limit: f64, stop_time: f64, dt: f64) -> f64 {
+    if stop_time <= 0.0 {
+        return step;
+    }
+    let stop = (2.0 * limit / stop_time * target.abs()).sqrt() * dt;
+    step.clamp(-stop, stop)
 }
 
 /// `p` (torso frame, m) pushed along the line from arm `k`'s shoulder until it lies
