@@ -83,7 +83,7 @@ fn arm_stops(clip: &str, arm_stop_time: Option<f64>) -> usize {
 fn koenemanns_nao_legs_slow_down_before_their_targets_and_do_not_turn_back_at_speed() {
     // CMU 09_12 (walking forward, backward and sideways): with the legs stopping at once
     // (leg_stop_time 0, the NAO's behaviour before the stop time), a knee reached its target at
-    // its velocity limit and reversed within a frame when the target crossed it (2 frames on this clip).
+    // its velocity limit and reversed within a frame when the target crossed it (2 frames).
     let clip = "cmu_09_12_walk_forward_backward_sideways.bvh";
     let abrupt = leg_reversals(clip, Some(0.0));
     let slowed = leg_reversals(clip, None);

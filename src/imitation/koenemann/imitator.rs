@@ -376,7 +376,7 @@ impl KoenemannImitator {
             leg_settings,
         )?;
         let tuning = profile.tuning;
-        let size = profile.size()?;
+        let time_constant = (profile.size()?.com_height / GRAVITY).sqrt();
         let leg_ramp_time = (method.leg_ramp_time)
             .or(profile.sway_period)
             .unwrap_or(0.0);
@@ -393,13 +393,11 @@ impl KoenemannImitator {
             q_start: shared.q.clone(),
             velocity: vec![0.0; shared.q.len()],
             leg_ramp_time,
-            leg_stop_time: (method.leg_stop_time).unwrap_or_else(|| {
-                let time_constant = (size.com_height / GRAVITY).sqrt();
-                leg_ramp_time.max(LEG_STOP_TIME_CONSTANTS * time_constant)
-            }),
+            leg_stop_time: (method.leg_stop_time)
+                .unwrap_or(leg_ramp_time.max(LEG_STOP_TIME_CONSTANTS * time_constant)),
             arm_stop_time: (method.arm_stop_time).unwrap_or(match profile.sway_period {
                 Some(_) => 0.0,
-                None => ARM_STOP_TIME_CONSTANTS * (size.com_height / GRAVITY).sqrt(),
+                None => ARM_STOP_TIME_CONSTANTS * time_constant,
             }),
             offset_speed: (method.offset_speed).unwrap_or_else(|| OffsetSpeed::of_robot(&tuning)),
             config: method,

@@ -45,8 +45,8 @@
 //! foot for [`KoenemannConfig::settle_time`], and each leg joint speeds up over
 //! [`KoenemannConfig::leg_ramp_time`]; on every robot each leg joint slows down before its
 //! target over [`KoenemannConfig::leg_stop_time`], and on a robot whose commands are not
-//! shaped every other joint over [`KoenemannConfig::arm_stop_time`]; the offset may end at each foot's stance point rather
-//! than its sole's centre
+//! shaped every other joint over [`KoenemannConfig::arm_stop_time`]; the offset may end at
+//! each foot's stance point rather than its sole's centre
 //! ([`MotionTuning::offset_to_stance_point`](crate::robots::MotionTuning::offset_to_stance_point));
 //! the legs' share of their rated speed is the
 //! profile's ([`MotionTuning::leg_velocity_fraction`](crate::robots::MotionTuning::leg_velocity_fraction)),
@@ -119,7 +119,8 @@ pub struct KoenemannConfig {
     pub settle_time: Option<f64>,
     /// The time (s) in which each leg joint may go from rest to its velocity limit, and back:
     /// its change of speed is bounded by that limit over this time (and it slows down before
-    /// its target over [`Self::leg_stop_time`], at least this). `None` (default): the profile's sway period
+    /// its target over [`Self::leg_stop_time`], at least this). `None` (default): the
+    /// profile's sway period
     /// ([`BipedProfile::sway_period`](crate::robots::BipedProfile::sway_period)), no ramp for a
     /// robot whose commands are not shaped (0 likewise). The legs otherwise start and stop at
     /// their velocity limit within a frame: on the G1 the CoM crossed to a foot at 0.18 m/s
@@ -130,10 +131,10 @@ pub struct KoenemannConfig {
     /// still starts at once when `leg_ramp_time` is 0). `None` (default): the larger of the
     /// resolved `leg_ramp_time` and [`LEG_STOP_TIME_CONSTANTS`] time constants `√(h/g)` of
     /// the linear inverted pendulum at the robot's standing CoM height `h` (NAO 0.50 s; G1
-    /// its 1.1 s ramp, above its 0.80 s). Without it a leg joint on the NAO reached its IK target at its
-    /// velocity limit and, when the target crossed it, turned back at that limit within one
-    /// frame: the body bobbed, the feet unloaded and the contact area collapsed (judge, NAO,
-    /// automatic hold: 8 of 16 runs passed, 15 with it).
+    /// its 1.1 s ramp, above its 0.80 s). Without it a leg joint on the NAO reached its IK
+    /// target at its velocity limit and, when the target crossed it, turned back at that
+    /// limit within one frame: the body bobbed, the feet unloaded and the contact area
+    /// collapsed (judge, NAO, automatic hold: 8 of 16 runs passed, 15 with it).
     pub leg_stop_time: Option<f64>,
     /// The time (s) in which every other joint (arms, head, waist) may slow down from its
     /// velocity limit to rest before its target (it still starts at once). `None` (default):
