@@ -1,9 +1,10 @@
 //! A whole robot walking: the footstep planner toward a goal and the walker's joint angles,
 //! checked through forward kinematics (independent of the walker's own task errors): soles on
 //! the floor still to 1e-6 m and rad, the CoM where the generator put it, the joint limits kept,
-//! the ZMP of the realised CoM inside the support.
+//! the ZMP of the realised CoM inside the support, the torso within its lean and a chest
+//! leaning with it.
 
-use nalgebra::Vector2;
+use nalgebra::{Vector2, Vector3};
 use taskstack::Side;
 use taskstack::locomotion::{
     Footstep, GroundPose, StepPlan, StepTiming, SupportPolygon, WalkParams, WholeBodyWalker,
@@ -30,6 +31,16 @@ fn sole_in_world(
         [xy.x, xy.y, sole.translation.z],
         root_pose.yaw + r[(1, 0)].atan2(r[(0, 0)]),
     )
+}
+
+/// The z axis of `frame` in the model rooted at `root` (its root sole is level, so the model's
+/// z axis is the world's).
+fn z_axis(profile: &BipedProfile, q: &[f64], root: Side, frame: &str) -> Vector3<f64> {
+    let model = profile.model(root);
+    let mut data = model.new_data();
+    model.forward_kinematics(&mut data, q).unwrap();
+    let r = data.frame_placement(model.frame_id(frame).unwrap()).rotation;
+    r.matrix().column(2).into_owned()
 }
 
 fn com_in_world(profile: &BipedProfile, q: &[f64], root: Side, root_pose: &GroundPose) -> [f64; 3] {
@@ -122,6 +133,16 @@ fn walk_and_check(profile: &BipedProfile, motion: GroundPose) -> f64 {
         }
         previous = Some(soles);
         previous_on_floor = on_floor;
+        // The torso leans no further than the lean; on a robot with a waist the chest leans
+        // with it (the waist does not carry the CoM).
+        let torso = z_axis(profile, q, frame.root, &profile.torso);
+        let tilt = torso.z.clamp(-1.0, 1.0).acos();
+        assert!(tilt <= params.torso_lean + 1e-3, "the torso tilts {tilt} rad");
+        if let Some(chest) = &profile.chest {
+            let chest = z_axis(profile, q, frame.root, chest);
+            let bend = chest.angle(&torso);
+            assert!(bend < 1e-4, "the chest bends {bend} rad at t = {}", frame.walk.time);
+        }
         let com = com_in_world(profile, q, frame.root, &root_pose);
         assert!(
             (Vector2::new(com[0], com[1]) - frame.walk.com.xy()).norm() < 1e-4,

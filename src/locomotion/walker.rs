@@ -4,9 +4,15 @@
 //! Each tick the model is rooted at the stance sole (at the sole that last stood alone while both
 //! stand), placed where the generator put it in the world, and the driver solves, in priority
 //! order: the other sole's pose (held on the floor, or on its swing path), the CoM's ground
-//! point, the torso's tilt (upright, leaning over the stance hip), the CoM's height; the
-//! standing posture pulls the remaining freedom (the arms, the waist, the torso's heading). A
-//! sole on the floor is the model's root or a top-level task, so it does not move in the plan.
+//! point, the torso's tilt (upright, leaning over the stance hip) and the chest's on a robot with
+//! a waist ([`BipedProfile::chest`]), the CoM's height; the standing posture pulls the remaining
+//! freedom (the arms, the torso's heading). A sole on the floor is the model's root or a
+//! top-level task, so it does not move in the plan.
+//!
+//! The chest is held as the imitation's tables hold it: left to the posture pull, the G1's waist
+//! carried the CoM sideways (waist roll at its 0.52 rad limit before the first lift with the CoM
+//! 10 cm lower, 0.28 rad at the lift at the standing height), and the upper body swung over the
+//! stance foot as the swing foot rose.
 
 use nalgebra::{IsometryMatrix3, Rotation3, Translation3, Vector2, Vector3};
 
@@ -24,7 +30,7 @@ use crate::robots::BipedProfile;
 use crate::robots::servo::{LoadedSoles, ServoSag, other_sole_load};
 use crate::solver::driver::{DriverSettings, PositionDriver};
 use crate::solver::{JointBounds, Solver};
-use crate::tasks::{ComTask, PoseTask, TaskSet, UprightTask};
+use crate::tasks::{ComTask, PoseTask, Task, TaskSet, UprightTask};
 
 /// Gain of the pull toward the standing posture (per driver iteration).
 const POSTURE_GAIN: f64 = 0.05;
@@ -181,6 +187,9 @@ impl<'p> WholeBodyWalker<'p> {
         stack.set.task_mut::<ComTask>("com height")?.target = com_target;
         let up = walk.torso_up(self.params.torso_lean, self.half_span, root_pose.yaw);
         stack.set.task_mut::<UprightTask>("torso")?.set_up(up)?;
+        if self.profile.chest.is_some() {
+            stack.set.task_mut::<UprightTask>("chest")?.set_up(up)?;
+        }
         let report =
             stack
                 .driver
@@ -236,7 +245,7 @@ impl<'p> WholeBodyWalker<'p> {
 }
 
 /// The task stack of the model rooted at `root`: the other sole, the CoM's ground point, the
-/// torso's tilt, the CoM's height. The torso's heading is left free: held too, it took a
+/// torso's tilt (and the chest's, when the profile has one), the CoM's height. The torso's heading is left free: held too, it took a
 /// freedom the NAO's coupled hips need, the CoM task then swung the arms, and turning walks
 /// fell in physics. The height comes last: the legs alone cannot always keep it.
 fn rooted_stack(profile: &BipedProfile, root: Side) -> Result<RootedStack<'_>, Error> {
@@ -248,11 +257,15 @@ fn rooted_stack(profile: &BipedProfile, root: Side) -> Result<RootedStack<'_>, E
     )?;
     let com = ComTask::ground(model, [0.0, 0.0])?;
     let height = ComTask::new(model, Vector3::zeros())?.named("com height");
-    let torso = UprightTask::new(model, &profile.torso)?.named("torso");
+    let mut posture: Vec<Box<dyn Task>> =
+        vec![Box::new(UprightTask::new(model, &profile.torso)?.named("torso"))];
+    if let Some(chest) = &profile.chest {
+        posture.push(Box::new(UprightTask::new(model, chest)?.named("chest")));
+    }
     let set = TaskSet::new(model)
         .level("foot", vec![Box::new(other)])
         .level("com", vec![Box::new(com)])
-        .level("torso", vec![Box::new(torso)])
+        .level("torso", posture)
         .level("com height", vec![Box::new(height)])
         .posture_gradient(POSTURE_GAIN, &profile.stand)?;
     let solver = Solver::new(&set.shape())?;
