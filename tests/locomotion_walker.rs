@@ -39,7 +39,9 @@ fn z_axis(profile: &BipedProfile, q: &[f64], root: Side, frame: &str) -> Vector3
     let model = profile.model(root);
     let mut data = model.new_data();
     model.forward_kinematics(&mut data, q).unwrap();
-    let r = data.frame_placement(model.frame_id(frame).unwrap()).rotation;
+    let r = data
+        .frame_placement(model.frame_id(frame).unwrap())
+        .rotation;
     r.matrix().column(2).into_owned()
 }
 
@@ -137,11 +139,18 @@ fn walk_and_check(profile: &BipedProfile, motion: GroundPose) -> f64 {
         // with it (the waist does not carry the CoM).
         let torso = z_axis(profile, q, frame.root, &profile.torso);
         let tilt = torso.z.clamp(-1.0, 1.0).acos();
-        assert!(tilt <= params.torso_lean + 1e-3, "the torso tilts {tilt} rad");
+        assert!(
+            tilt <= params.torso_lean + 1e-3,
+            "the torso tilts {tilt} rad"
+        );
         if let Some(chest) = &profile.chest {
             let chest = z_axis(profile, q, frame.root, chest);
             let bend = chest.angle(&torso);
-            assert!(bend < 1e-4, "the chest bends {bend} rad at t = {}", frame.walk.time);
+            assert!(
+                bend < 1e-4,
+                "the chest bends {bend} rad at t = {}",
+                frame.walk.time
+            );
         }
         let com = com_in_world(profile, q, frame.root, &root_pose);
         assert!(

@@ -245,9 +245,10 @@ impl<'p> WholeBodyWalker<'p> {
 }
 
 /// The task stack of the model rooted at `root`: the other sole, the CoM's ground point, the
-/// torso's tilt (and the chest's, when the profile has one), the CoM's height. The torso's heading is left free: held too, it took a
-/// freedom the NAO's coupled hips need, the CoM task then swung the arms, and turning walks
-/// fell in physics. The height comes last: the legs alone cannot always keep it.
+/// torso's tilt (and the chest's, when the profile has one), the CoM's height. The torso's
+/// heading is left free: held too, it took a freedom the NAO's coupled hips need, the CoM task
+/// then swung the arms, and turning walks fell in physics. The height comes last: the legs
+/// alone cannot always keep it.
 fn rooted_stack(profile: &BipedProfile, root: Side) -> Result<RootedStack<'_>, Error> {
     let model = profile.model(root);
     let other = PoseTask::new(
@@ -257,8 +258,9 @@ fn rooted_stack(profile: &BipedProfile, root: Side) -> Result<RootedStack<'_>, E
     )?;
     let com = ComTask::ground(model, [0.0, 0.0])?;
     let height = ComTask::new(model, Vector3::zeros())?.named("com height");
-    let mut posture: Vec<Box<dyn Task>> =
-        vec![Box::new(UprightTask::new(model, &profile.torso)?.named("torso"))];
+    let mut posture: Vec<Box<dyn Task>> = vec![Box::new(
+        UprightTask::new(model, &profile.torso)?.named("torso"),
+    )];
     if let Some(chest) = &profile.chest {
         posture.push(Box::new(UprightTask::new(model, chest)?.named("chest")));
     }
