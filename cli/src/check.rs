@@ -11,14 +11,19 @@ use crate::Report;
 
 /// Check runs in physics: play each OUT_DIR's joints.csv on a MuJoCo model of its robot.
 ///
-/// The robot (NAO or G1, told by the joint names, or --robot) starts standing in the first posture, holds it
-/// 1 s, plays the run, holds the last posture --hold s. A run passes when the robot does not fall
-/// (base under 60 % of its height or tilted over 45°), no sole on the floor tilts over 5°, no
-/// loaded sole (≥ 20 % of the weight) slides over 5 mm or turns over 2°, the CoM ground point is
-/// inside the soles' contact hull ≥ 99 % of the time, nothing but the soles touches the floor,
-/// and no target is outside the joint limits. Writes OUT_DIR/physics.svg (tilt, CoM margin and
-/// sole forces over time). The models (nominal and weak: half the servo stiffness, 80 % of the
-/// torque, floor friction 0.7) are generated from the robots' URDFs; see `taskstack.sim.model`.
+/// The robot (NAO or G1, told by the joint names, or --robot) starts standing in the first
+/// posture, holds it 1 s, plays the run (at most 5 s of a final stretch of constant targets: a
+/// robot at rest under constant targets stays at rest), holds the last posture --hold s. A run passes when the robot
+/// does not fall (base under 60 % of its height or tilted over 45°), no sole on the floor tilts
+/// over 5°, no loaded sole (≥ 20 % of the weight) slides over 5 mm or turns over 2°, the measured
+/// ZMP (the centre of pressure of the floor's forces on the soles) is at least 2 mm inside the
+/// soles in contact ≥ 99 % of the time (a dynamic walk may carry the CoM outside the support;
+/// the floor pushes only inside it), the CoM ground point is inside the soles' contact hull
+/// ≥ 99 % of the final hold (the robot ends standing), nothing but the soles touches the floor,
+/// and no target is outside the joint limits: the checks and thresholds of the physics judge of
+/// the project's CI. Writes OUT_DIR/physics.svg (tilt, ZMP and CoM margins and sole forces over
+/// time). The models (nominal and weak: half the servo stiffness, 80 % of the torque, floor
+/// friction 0.7) are generated from the robots' URDFs; see `taskstack.sim.model`.
 ///
 /// Runs Python: the interpreter in TASKSTACK_PYTHON, else python3, with the package installed
 /// with its simulation extra: `pip install './python[sim]'` from the repository.

@@ -47,6 +47,25 @@ def smooth(s):
     return s * s * (3 - 2 * s)
 
 
+def test_the_hull_and_the_signed_distance_on_hand_checked_shapes():
+    from taskstack.sim.geometry import convex_hull, signed_distance
+
+    # A 2 x 1 rectangle given with an inner point and a repeated corner: its four corners,
+    # counter-clockwise (positive shoelace area 2).
+    hull = convex_hull(np.array([[0, 0], [2, 0], [2, 1], [0, 1], [1, 0.5], [2, 1]], dtype=float))
+    assert len(hull) == 4
+    x, y = hull[:, 0], hull[:, 1]
+    assert abs(0.5 * np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y) - 2.0) < 1e-12
+    assert abs(signed_distance(hull, np.array([1.0, 0.5])) - 0.5) < 1e-12  # nearest edges y = 0, 1
+    assert abs(signed_distance(hull, np.array([1.9, 0.5])) - 0.1) < 1e-12
+    assert abs(signed_distance(hull, np.array([3.0, 2.0])) + np.sqrt(2.0)) < 1e-12  # corner (2, 1)
+    # A segment (a foot on an edge) has no inside; a point is its distance away.
+    segment = convex_hull(np.array([[0.0, 0.0], [1.0, 0.0]]))
+    assert abs(signed_distance(segment, np.array([0.5, 0.0]))) < 1e-12
+    assert abs(signed_distance(segment, np.array([0.5, 0.3])) + 0.3) < 1e-12
+    assert signed_distance(np.zeros((0, 2)), np.array([0.0, 0.0])) == -np.inf
+
+
 @pytest.mark.parametrize("robot", ROBOTS + [TINY])
 def test_the_physics_model_has_the_rust_models_masses_and_frames(tmp, robot):
     pm = sim.build(robot)
@@ -90,6 +109,38 @@ def test_a_standing_pose_stands(tmp, robot):
         v = sim.check_run(run, weak=weak, robot=robot)
         assert v.passed, v.summary()
         assert v.playback.com_inside_share == 1.0
+
+
+@pytest.mark.parametrize("robot", ROBOTS)
+def test_a_standing_robots_measured_zmp_is_under_its_com(tmp, robot):
+    # Standing still, the floor's centre of pressure is the CoM's ground point (statics): over
+    # the last second the ZMP margin (from the contact forces and the soles' outlines) matches
+    # the CoM's (from the bodies' masses and the contact points, which sit on those outlines)
+    # to a millimetre on average (the G1's stiff servos keep it swaying a few millimetres).
+    pm = sim.build(robot)
+    times = np.linspace(0.0, 2.0, 201)
+    run = write_run(tmp / "stand", pm.columns, times, np.tile(stand(pm), (len(times), 1)))
+    v = sim.check_run(run, robot=robot)
+    end = np.array(v.playback.series[-100:])
+    assert abs(np.mean(end[:, 6]) - np.mean(end[:, 3])) < 1e-3, end[:, [3, 6]]
+    assert v.playback.zmp_inside_share == 1.0 and v.playback.min_zmp_margin_m > 0.01
+
+
+def test_a_long_constant_tail_is_played_for_five_seconds(tmp):
+    pm = sim.build("nao")
+    q0 = stand(pm)
+    times = np.arange(0.0, 33.0 + 1e-9, 0.01)
+    q = np.tile(q0, (len(times), 1))
+    # The head turns 0.3 rad over the first 3 s, then the posture is held for 30 s.
+    head = pm.columns.index("HeadYaw")
+    q[:, head] += 0.3 * smooth(times / 3.0)
+    run = write_run(tmp / "tail", pm.columns, times, q)
+    v = sim.check_run(run, weak=False)
+    assert v.passed, v.summary()
+    assert abs(v.playback.tail_left_out_s - 25.0) < 0.02, v.playback.tail_left_out_s
+    assert abs(v.playback.duration - 8.0) < 0.02, v.playback.duration
+    # The check's own hold (1 s) follows the 5 s kept: the series ends 1 s after them.
+    assert abs(v.playback.series[-1][0] - 9.0) < 0.02, v.playback.series[-1][0]
 
 
 def one_leg_trajectory(robot):

@@ -1,9 +1,10 @@
 """``python -m taskstack.sim OUT_DIR...``: play runs on the physics model and judge them.
 
 Each OUT_DIR is an output folder of ``taskstack imitate``/``batch``/``walk`` (its
-``joints.csv``) or a ``joints.csv``; the robot is told by the joint names. Prints one line per
-run and model (``--json``: one JSON document), writes ``OUT_DIR/physics.svg`` (base tilt, CoM
-margin, sole forces over time) for a folder and adds the simulated robot (the first model's) to
+``joints.csv``) or a ``joints.csv``; the robot is told by the joint names. The checks are
+:mod:`taskstack.sim.checks`'. Prints one line per run and model (``--json``: one JSON
+document), writes ``OUT_DIR/physics.svg`` (base tilt, ZMP and CoM margins, sole forces over
+time) for a folder and adds the simulated robot (the first model's) to
 its ``view.html``, drawn in gray beside the plan. Exit status: 0 every run passes, 1 one fails,
 2 bad input.
 """

@@ -1,21 +1,34 @@
 """The checks of a playback, their thresholds, and the verdict of a run.
 
-A run passes when, over the trajectory and the hold after it:
+A run is played with at most ``TAIL_KEPT_S`` of a final stretch of constant targets (a run's
+hold: a robot at rest under constant targets stays at rest, and a long hold would only dilute
+the shares below), then the check's own hold. It passes when, over the trajectory and the
+holds:
 
-=======================  ======================================================================
-``fall``                 the base stays above 60 % of its standing height and within 45° of
-                         upright
-``foot_tilt_deg``        a sole touching the floor tilts at most 5° (more is a foot rocking on
-                         an edge)
-``slip_m``               a loaded sole (≥ 20 % of the weight) slides at most 5 mm under its
-                         centre of pressure
-``turn_deg``             a loaded sole turns at most 2° about the vertical
-``com_inside_share``     the CoM ground projection is inside the hull of the soles' floor
-                         contacts at least 99 % of the time
-``non_foot_contact``     nothing but the soles touches the floor
-``limit_violations``     no target outside the URDF's joint limits (by more than the 1e-6 rad
-                         of joints.csv's rounding)
-=======================  ======================================================================
+==========================  ====================================================================
+``fall``                    the base stays above 60 % of its standing height and within 45° of
+                            upright
+``foot_tilt_deg``           a sole touching the floor tilts at most 5° (more is a foot rocking
+                            on an edge)
+``slip_m``                  a loaded sole (≥ 20 % of the weight) slides at most 5 mm under its
+                            centre of pressure
+``turn_deg``                a loaded sole turns at most 2° about the vertical
+``zmp_inside_share``        the measured ZMP (the centre of pressure of the floor's forces on
+                            the soles) is at least 2 mm inside the outline of the soles in
+                            contact at least 99 % of the time: a dynamic motion may carry the
+                            CoM outside the support, but the floor can only push inside it, and
+                            a foot rolling onto an edge brings the ZMP to that edge
+``com_inside_share_hold``   the CoM ground projection is inside the hull of the soles' floor
+                            contacts at least 99 % of the final hold: the robot ends standing
+                            still
+``non_foot_contact``        nothing but the soles touches the floor
+``limit_violations``        no target outside the URDF's joint limits (by more than the 1e-6 rad
+                            of joints.csv's rounding)
+==========================  ====================================================================
+
+The same checks and thresholds as the physics judge of the project's CI; the CoM's share of
+the whole run inside the contact hull is measured and reported (``com_inside_share``), not
+judged: it is a criterion for standing still, which a dynamic walk fails by design.
 """
 
 from __future__ import annotations
@@ -30,15 +43,19 @@ import numpy as np
 
 from .. import _taskstack
 from .model import PhysicsModel, build
-from .player import Playback, play
+from .player import ZMP_EDGE_M, Playback, play
 
 #: Every check's threshold (units in the names).
 THRESHOLDS = {
     "foot_tilt_deg": 5.0,
     "slip_m": 0.005,
     "turn_deg": 2.0,
-    "com_inside_share": 0.99,
+    "zmp_inside_share": 0.99,
+    "zmp_edge_m": ZMP_EDGE_M,
+    "com_inside_share_hold": 0.99,
 }
+#: Seconds of a final stretch of constant targets that are played (see :func:`shorten_tail`).
+TAIL_KEPT_S = 5.0
 
 
 @dataclass
@@ -56,7 +73,8 @@ class Verdict:
         p = self.playback
         head = f"{'PASS' if self.passed else 'FAIL'} {self.out_dir} {self.robot} {self.model:7}"
         measures = (f"tilt {p.max_foot_tilt_deg:4.1f}° slip {p.max_slip_m * 1000:5.1f} mm "
-                    f"turn {p.max_turn_deg:4.1f}° CoM inside {p.com_inside_share * 100:5.1f} %")
+                    f"turn {p.max_turn_deg:4.1f}° ZMP inside {p.zmp_inside_share * 100:5.1f} % "
+                    f"CoM inside {p.com_inside_share * 100:5.1f} %")
         return f"{head} {measures}" + (f"; {'; '.join(self.failures)}" if self.failures else "")
 
     def to_json(self) -> Dict:
@@ -78,8 +96,10 @@ def judge(p: Playback) -> List[str]:
         failures.append(f"a loaded sole slid {p.max_slip_m * 1000:.1f} mm (> 5 mm)")
     if p.max_turn_deg > THRESHOLDS["turn_deg"]:
         failures.append(f"a loaded sole turned {p.max_turn_deg:.1f}° (> 2°)")
-    if p.com_inside_share < THRESHOLDS["com_inside_share"]:
-        failures.append(f"CoM inside the contact hull {p.com_inside_share * 100:.1f} % of the time (< 99 %)")
+    if p.zmp_inside_share < THRESHOLDS["zmp_inside_share"]:
+        failures.append(f"ZMP inside the soles {p.zmp_inside_share * 100:.1f} % of the time (< 99 %)")
+    if p.fell_at is None and p.com_inside_share_hold < THRESHOLDS["com_inside_share_hold"]:
+        failures.append(f"CoM inside the contact hull {p.com_inside_share_hold * 100:.1f} % of the final hold (< 99 %)")
     if p.non_foot_contact is not None:
         failures.append(f"{p.non_foot_contact} touched the floor at {p.non_foot_contact_at:.2f} s")
     if p.limit_violations:
@@ -126,6 +146,17 @@ def robot_of(columns: List[str], robot: Optional[str] = None) -> str:
     raise InputError(f"joints {columns[:3]}…: neither the NAO's nor the G1's (a profile's run: --robot PROFILE.toml)")
 
 
+def shorten_tail(times: np.ndarray, q: np.ndarray, keep: float = TAIL_KEPT_S):
+    """``times`` and ``q`` with at most ``keep`` seconds of their final stretch of constant
+    targets, and the seconds left out."""
+    moving = np.nonzero(np.any(np.abs(q - q[-1]) > 1e-12, axis=1))[0]
+    start = float(times[moving[-1] + 1]) if len(moving) else float(times[0])
+    if float(times[-1]) - start <= keep:
+        return times, q, 0.0
+    kept = times <= start + keep + 1e-9
+    return times[kept], q[kept], float(times[-1] - times[kept][-1])
+
+
 _MODELS: Dict[tuple, PhysicsModel] = {}
 
 
@@ -137,6 +168,7 @@ def check_run(out_dir, weak: bool = False, settle: float = 1.0, hold: float = 1.
     path = Path(out_dir)
     csv_path = path / "joints.csv" if path.is_dir() else path
     columns, times, q = read_trajectory(csv_path)
+    times, q, left_out = shorten_tail(times, q)
     robot = robot_of(columns, robot)
     key = (robot, weak)
     if key not in _MODELS:
@@ -144,5 +176,6 @@ def check_run(out_dir, weak: bool = False, settle: float = 1.0, hold: float = 1.
     pm = _MODELS[key]
     order = [columns.index(c) for c in pm.columns]
     playback = play(pm, times, q[:, order], settle=settle, hold=hold)
+    playback.tail_left_out_s = left_out
     failures = judge(playback)
     return Verdict(str(out_dir), robot, "weak" if weak else "nominal", not failures, failures, playback)

@@ -3,8 +3,9 @@
 The robot starts standing in the trajectory's first posture: its soles flat on the floor
 (those within 5 mm and 2° of the lower one are both put down, the rest hang), the right sole's
 origin over the world origin. It holds that posture for ``settle`` seconds, plays the
-trajectory (targets interpolated linearly at every 1 ms step, each target's speed limited to
-its joint's URDF velocity), then holds the last posture for ``hold`` seconds.
+trajectory (targets interpolated linearly at every 1 ms step; a target faster than its joint
+can follow is played as written, the servo's torque limit and damping slow the joint), then
+holds the last posture for ``hold`` seconds.
 
 Measured at every step (see :mod:`taskstack.sim.checks` for what is judged):
 
@@ -13,7 +14,12 @@ Measured at every step (see :mod:`taskstack.sim.checks` for what is judged):
   turn while it carries at least 20 % of the weight (the sliding of the contact point under it
   since the load came on: the world motion of the sole-fixed point that was the centre of
   pressure then; the yaw change since then);
-* the CoM's signed distance to the convex hull of the soles' floor contact points;
+* the measured ZMP (the centre of pressure of the floor's forces on the soles) and its signed
+  distance to the convex hull of the outlines of the soles in contact: where the floor pushes,
+  which a dynamic motion keeps inside the support while its CoM may pass outside it, and which
+  a foot rolling onto an edge brings to that edge;
+* the CoM's signed distance to the convex hull of the soles' floor contact points, over the
+  whole run and during the final hold (where a robot standing still has it inside);
 * the first body other than a sole touching the floor.
 """
 
@@ -26,6 +32,7 @@ from typing import Dict, List, Optional, Sequence
 import mujoco
 import numpy as np
 
+from .geometry import convex_hull, signed_distance
 from .model import PhysicsModel
 
 #: A foot carrying at least this share of the weight is loaded (slip and turn are measured).
@@ -34,6 +41,8 @@ LOADED_SHARE = 0.2
 CONTACT_FORCE = 1.0
 #: Soles within this height (m) and tilt (rad) of the lower one start on the floor together.
 BOTH_FEET_HEIGHT, BOTH_FEET_TILT = 0.005, math.radians(2.0)
+#: A measured ZMP closer than this (m) to the edge of the soles in contact counts as on the edge.
+ZMP_EDGE_M = 0.002
 #: Period of the recorded time series (s).
 SERIES_PERIOD = 0.01
 #: A target this far (rad) beyond a joint limit is not a violation: joints.csv rounds to six
@@ -48,13 +57,22 @@ class Playback:
     """What a playback measured (SI units; angles in degrees where named ``_deg``)."""
 
     duration: float
+    #: Seconds of the run's constant final stretch beyond the ones played (``checks.shorten_tail``).
+    tail_left_out_s: float = 0.0
     fell_at: Optional[float] = None
     fall_reason: str = ""
     max_tilt_deg: float = 0.0
     max_foot_tilt_deg: float = 0.0
     max_slip_m: float = 0.0
     max_turn_deg: float = 0.0
+    #: Share of the play and the hold with the measured ZMP at least ``ZMP_EDGE_M`` inside the
+    #: soles in contact (of the steps with a sole in contact); its smallest margin (m).
+    zmp_inside_share: float = 1.0
+    min_zmp_margin_m: float = math.inf
+    #: Share of the play and the hold with the CoM ground point inside the contact hull, and
+    #: the same share over the final hold alone (the robot ends standing still).
     com_inside_share: float = 1.0
+    com_inside_share_hold: float = 1.0
     min_com_margin_m: float = math.inf
     non_foot_contact: Optional[str] = None
     non_foot_contact_at: Optional[float] = None
@@ -65,7 +83,7 @@ class Playback:
     max_tracking_joint: str = ""
     max_tracking_time: float = 0.0
     #: Rows every 10 ms: time, base height, base tilt (deg), CoM margin (m), left and right
-    #: sole normal force (N).
+    #: sole normal force (N), measured ZMP margin (m; -inf without a sole on the floor).
     series: List[Sequence[float]] = field(default_factory=list)
     #: The simulated robot for a viewer, ``DRAW_RATE`` frames a second from ``draw_t0`` (s):
     #: per frame the drawn bodies' origins (x y z in integer mm, world), and the segments
@@ -80,45 +98,23 @@ def _tilt_deg(xmat: np.ndarray) -> float:
     return math.degrees(math.acos(max(-1.0, min(1.0, float(xmat[8])))))
 
 
-def _hull(points: np.ndarray) -> np.ndarray:
-    """Convex hull (counter-clockwise) of 2-D points (monotone chain)."""
-    pts = sorted(set(map(tuple, np.round(points, 9))))
-    if len(pts) < 3:
-        return np.array(pts)
-
-    def cross(o, a, b):
-        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
-
-    lower, upper = [], []
-    for p in pts:
-        while len(lower) >= 2 and cross(lower[-2], lower[-1], p) <= 0:
-            lower.pop()
-        lower.append(p)
-    for p in reversed(pts):
-        while len(upper) >= 2 and cross(upper[-2], upper[-1], p) <= 0:
-            upper.pop()
-        upper.append(p)
-    return np.array(lower[:-1] + upper[:-1])
-
-
-def _margin(hull: np.ndarray, p: np.ndarray) -> float:
-    """Signed distance of ``p`` to the hull's boundary (> 0 inside); -inf without a hull."""
-    if len(hull) == 0:
+def _zmp_margin(pm: PhysicsModel, data: mujoco.MjData, force: List[float], cop: List[np.ndarray]) -> float:
+    """Signed distance (m, > 0 inside) of the measured ZMP (the centre of pressure of the soles'
+    floor forces) to the hull of the outlines of the soles in contact; -inf with none."""
+    on = [side for side in range(2) if force[side] > 0]
+    if not on:
         return -math.inf
-    if len(hull) < 3:  # a point or a segment: never inside
-        if len(hull) == 1:
-            return -float(np.linalg.norm(p - hull[0]))
-        a, b = hull
-        t = np.clip(np.dot(p - a, b - a) / max(np.dot(b - a, b - a), 1e-18), 0, 1)
-        return -float(np.linalg.norm(p - (a + t * (b - a))))
-    inside, dist = True, math.inf
-    for a, b in zip(hull, np.roll(hull, -1, axis=0)):
-        edge = b - a
-        cross = edge[0] * (p[1] - a[1]) - edge[1] * (p[0] - a[0])
-        inside &= cross >= 0
-        t = np.clip(np.dot(p - a, edge) / max(np.dot(edge, edge), 1e-18), 0, 1)
-        dist = min(dist, float(np.linalg.norm(p - (a + t * edge))))
-    return dist if inside else -dist
+    zmp = sum(cop[side] for side in on)[:2] / sum(force[side] for side in on)
+    corners = []
+    for side in on:
+        body = pm.sole_bodies[side]
+        # The outline lies in the sole's x-y plane: its world x, y take the rotation's top-left
+        # 2 x 2 block.
+        R = data.xmat[body].reshape(3, 3)[:2, :2]
+        corners.append(pm.sole_outlines[side] @ R.T + data.xpos[body][:2])
+    # One sole: its outline, kept counter-clockwise (``model.build``), is its hull.
+    hull = corners[0] if len(corners) == 1 else convex_hull(np.vstack(corners))
+    return signed_distance(hull, zmp)
 
 
 def drawing(pm: PhysicsModel, data: mujoco.MjData):
@@ -192,11 +188,11 @@ def play(
     steps = steps_settle + steps_play + int(round(hold / dt))
     weight = pm.total_mass * 9.81
     h0 = float(data.xpos[pm.base_body][2])
-    ctrl = targets[0].copy()
-    max_step = pm.velocity * dt
     force6 = np.zeros(6)
     anchor: List[Optional[tuple]] = [None, None]  # (sole-local CoP, its world start, start yaw)
-    inside = 0
+    # Steps of the play and the hold: CoM inside, ZMP inside, with a sole in contact; the hold's.
+    inside = zmp_inside = zmp_steps = hold_inside = hold_steps = 0
+    hold_from = steps_settle + steps_play
     every = int(round(SERIES_PERIOD / dt))
     drawn, out.draw_segments = drawing(pm, data)
     draw_every = int(round(1.0 / DRAW_RATE / dt))
@@ -206,7 +202,7 @@ def play(
     goals = np.column_stack([np.interp(tau, times, targets[:, c]) for c in range(targets.shape[1])])
     for k in range(steps):
         t = float(clock[k])
-        ctrl += np.clip(goals[k] - ctrl, -max_step, max_step)
+        ctrl = goals[k]
         data.ctrl[:] = ctrl
         mujoco.mj_step(m, data)
         base_tilt = _tilt_deg(data.xmat[pm.base_body])
@@ -261,13 +257,23 @@ def play(
                 out.max_tracking_joint, out.max_tracking_time = pm.columns[worst], t
         # Body 1 is the floating root: its subtree is the whole robot.
         com = data.subtree_com[1][:2]
-        margin = _margin(_hull(np.array(points)) if points else np.zeros((0, 2)), com)
+        margin = signed_distance(convex_hull(np.array(points)) if points else np.zeros((0, 2)), com)
+        zmp_margin = _zmp_margin(pm, data, force, cop)
         if k >= steps_settle:
             inside += margin >= 0
             out.min_com_margin_m = min(out.min_com_margin_m, margin)
+            if math.isfinite(zmp_margin):
+                zmp_steps += 1
+                zmp_inside += zmp_margin >= ZMP_EDGE_M
+                out.min_zmp_margin_m = min(out.min_zmp_margin_m, zmp_margin)
+        if k >= hold_from:
+            hold_steps += 1
+            hold_inside += margin >= 0
         if k % draw_every == 0:
             out.draw_frames.append(np.round(data.xpos[drawn] * 1000).astype(int).ravel().tolist())
         if k % every == 0:
-            out.series.append((t, height, base_tilt, margin, force[0], force[1]))
+            out.series.append((t, height, base_tilt, margin, force[0], force[1], zmp_margin))
     out.com_inside_share = inside / max(1, k + 1 - steps_settle)
+    out.zmp_inside_share = zmp_inside / zmp_steps if zmp_steps else 0.0
+    out.com_inside_share_hold = hold_inside / hold_steps if hold_steps else 0.0
     return out

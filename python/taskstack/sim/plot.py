@@ -1,6 +1,6 @@
-"""``physics.svg``: a playback over time, three panels sharing the time axis: the base's tilt
-(°), the CoM's margin inside the soles' contact hull (mm; below 0 it is outside), and each
-sole's normal force (N). One line style per model (nominal solid, weak dashed); the verdicts in
+"""``physics.svg``: a playback over time, four panels sharing the time axis: the base's tilt
+(°), the measured ZMP's margin inside the soles in contact and the CoM's inside the soles'
+contact hull (mm; below 0 it is outside), and each sole's normal force (N). One line style per model (nominal solid, weak dashed); the verdicts in
 the title. Plain SVG, no plotting library."""
 
 from __future__ import annotations
@@ -16,6 +16,7 @@ MAX_POINTS = 1500
 #: (title, series column, scale to the plotted unit, colours per sole or one)
 PANELS = [
     ("base tilt (°)", [2], 1.0),
+    ("measured ZMP margin in the soles in contact (mm)", [6], 1000.0),
     ("CoM margin in the contact hull (mm)", [3], 1000.0),
     ("sole force (N): left blue, right orange", [4, 5], 1.0),
 ]
