@@ -35,8 +35,8 @@ pub(crate) struct ImitationOptions {
     /// Experimental: walk with the walking pattern generator (implies `--walk`): dynamic steps
     /// of the robot's own timing (NAO: 1.0 s double + 0.67 s single support) instead of one
     /// quasi-static step at a time; the arms hold still while the robot walks. Not yet the
-    /// default: on the bundled clips the physics judge's NAO passes every check (60 s hold or
-    /// the automatic one), but the walk is slow (about 2 cm/s) and the G1 falls.
+    /// default: on the bundled clips the physics judge's NAO passes every check on both
+    /// models, but the walk is slow (about 2 cm/s) and the G1 falls.
     #[arg(long)]
     pub(crate) dynamic_walk: bool,
     /// Experimental, with --dynamic-walk: the hands follow the human while the robot walks

@@ -52,7 +52,7 @@ pub struct ImitatorConfig {
     /// bound the legs by the CoM's and the feet's speeds; the profile's
     /// [`MotionTuning::leg_velocity_fraction`] in Koenemann et al.'s, whose legs copy the
     /// human's and are slowed by this bound alone (at 10 % of the G1's fast motors its legs
-    /// turned at up to 2.6 rad/s and it fell on 8 of 16 judge runs).
+    /// turned at up to 2.6 rad/s and it fell in the physics judge).
     pub velocity_fraction: Option<f64>,
     /// Fraction of the rated velocity of every joint off the sole-to-sole chain (arms, head);
     /// `None` (default): the profile's [`MotionTuning::upper_body_velocity_fraction`](crate::robots::MotionTuning::upper_body_velocity_fraction) (0.5 for
@@ -111,7 +111,7 @@ pub struct ImitatorConfig {
     /// bounds a frame's solve (default: the method's own cap). Measured on the NAO over the
     /// bundled clips: most frames take one pass (about 6 µs of a 16 µs step), one frame in a
     /// hundred 7–11 (arm limits, lifts, landings), the slowest 21–31. A budget of 8
-    /// cuts the p99 step by 20–40 % and the judge passes every clip on both models, but a
+    /// cuts the p99 step by 20–40 % and the robot still stands in the physics judge, but a
     /// solve cut short leaves the higher levels part of their motion: on CMU 07_04 with
     /// `--walk` the robot, its lifts cut frame after frame, walked 0.07 of 0.88 m (0.55 m
     /// unbounded), and with 6 a loaded foot turned 2.6° on CMU 09_12. Hence no budget by
@@ -143,10 +143,9 @@ pub struct ImitatorConfig {
     /// profile's [`MotionTuning::balanced_hands`](crate::robots::MotionTuning::balanced_hands)
     /// speeds where it has them (the NAO: 1 m/s, 10 m/s²; not in a dynamic walk) unless
     /// `max_tracking_speed` / `max_tracking_acceleration` say otherwise. Default `false`. With
-    /// hands at 1 m/s (`max_tracking_speed`, 10 m/s²) the judge's NAO (hold 60 s, both models,
-    /// every check) passes 16 of 16 runs on the bundled clips with it and 14 of 16 without
-    /// (CMU 131_01: loaded feet turning 2.3–2.8°); at 1.5 m/s and 20 m/s², 13 of 16 with it.
-    /// The price at 1 m/s: the arms turn back at speed on 4–86 frames a clip (0–14 at the
+    /// hands at 1 m/s (`max_tracking_speed`, 10 m/s²), the level is what keeps the arms'
+    /// reaction from turning the NAO's loaded feet in the physics judge (CMU 131_01 without
+    /// it: 2.3–2.8°); at 1.5 m/s and 20 m/s² it no longer does. The price at 1 m/s: the arms turn back at speed on 4–86 frames a clip (0–14 at the
     /// default speeds) and the step is slower. Refused with Koenemann's method (no task
     /// tables).
     pub zmp_balance: bool,

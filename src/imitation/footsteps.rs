@@ -52,26 +52,25 @@ pub struct FootstepConfig {
     /// robot then only stands on one leg when the human does, for as long, lifting the foot in
     /// place and putting it back where it was. Walking (`imitate --walk`; the imitator then
     /// uses [`TaskTables::centre_stances_for_walking`](super::tables::TaskTables::centre_stances_for_walking))
-    /// passes the physics judge on 13 of the NAO's 16 runs of the bundled clips online (hold
-    /// 60, both models; a loaded foot turning 2.0–3.6° on the weak model, 2° allowed) and on
-    /// 14 of 16 offline (07_04's loaded foot turning 2.3–2.4°); the G1's walking steps fall on
-    /// the judge's weak model: not yet the default.
+    /// is not yet the default: in the physics judge the NAO's loaded feet turn over 2° in some
+    /// of the quasi-static steps it takes, and the G1's walking steps fall on the judge's weak
+    /// model (the CHANGELOG has the runs).
     pub follow: bool,
     /// With `follow`, walk with the pattern generator ([`super::walking`]): dynamic steps
     /// (NAO: 1.0 s double + 0.67 s single support while following the human) instead of
     /// quasi-static ones (the CoM moved over the stance foot before each lift). Off by
-    /// default: the judge's NAO passes every bundled clip with a 60 s hold (both models, online
-    /// and offline), but the steps are slow (about 0.02 m/s), the arms hold still while the
-    /// robot walks (unless `walking_arms`), a pivot turn is not followed, and the G1 falls at
-    /// its first steps (see the changelog and [`super::walking`]).
+    /// default: the NAO's walks stand in the physics judge, but the steps are slow (about
+    /// 0.02 m/s), the arms hold still while the robot walks (unless `walking_arms`), a pivot
+    /// turn is not followed, and the G1 falls at its first steps (see the changelog and
+    /// [`super::walking`]).
     pub dynamic: bool,
     /// With `dynamic`, the hands follow the scaled human while the robot walks: after each
     /// walking frame an arm step moves the arm joints alone, the hands toward their targets
     /// at their single-support speed, the arms clear of the torso and head
     /// ([`super::walking::walking_arms_table`]). Off by default: on the bundled walks the
-    /// hands come 4–8 cm nearer the human over the clip, but the physics judge's NAO passes 9
-    /// of the 16 runs instead of 16 (the weak model falls on every walking clip): the walk's
-    /// plan keeps the CoM's ZMP in the support and does not see the arms' momentum.
+    /// hands come 4–8 cm nearer the human over the clip, but the walk's plan keeps the CoM's
+    /// ZMP in the support and does not see the arms' momentum, and the physics judge's weak
+    /// NAO falls on the walking clips with it.
     pub walking_arms: bool,
     /// A foot farther than this from its target (m) is moved by a step. Default 0.02.
     pub distance: f64,

@@ -262,7 +262,7 @@ impl PoubelImitator {
             walking_arms: config.footsteps.walking_arms,
             // A dynamic walk starts from double support and holds the arms where they are: at
             // the double-support speed they stopped within a frame and the judge's weak NAO
-            // fell on CMU 05_02 (16 of 16 runs passed at the stance speed).
+            // fell on CMU 05_02 (not at the stance speed).
             // Its frames have no ZMP level, so its hands keep the ordinary speeds.
             hand_speed: match walk.is_some() {
                 true => {

@@ -41,7 +41,7 @@
 //! grows with the hands' acceleration, not their speed: a speed clip alone starts and stops a
 //! hand within a frame (0.45 m/s in 1/120 s is 54 m/s²). On the judge's NAO, shaped at
 //! 2 m/s², the hands may go 0.8 m/s on both feet and 0.3 m/s on one (0.45 and 0.15 unshaped),
-//! every bundled clip passing on both models (see [`crate::robots::nao::TUNING`]).
+//! every bundled clip standing on both models (see [`crate::robots::nao::TUNING`]).
 //!
 //! # Start ramp
 //!

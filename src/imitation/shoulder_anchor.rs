@@ -30,7 +30,7 @@
 //! clip, cm): the NAO 4.5 / 8.5 / 4.5 / 4.6 / 4.9 / 11.6 / 3.5 / 2.5 → 4.8 / 8.0 / 3.7 / 1.9 /
 //! 2.4 / 7.8 / 3.1 / 3.5 (CMU 02_10, 05_02, 05_12, 07_04, 09_12, 131_01, Kinect ges01, ges02),
 //! the G1 5.1 / 14.1 / 6.7 / 10.5 / 11.6 / 17.9 / 7.4 / 5.0 → 4.6 / 12.2 / 5.5 / 2.8 / 4.4 /
-//! 9.0 / 7.6 / 4.8; the physics judge passes every run on both models as before.
+//! 9.0 / 7.6 / 4.8; the runs stand in the physics judge as before.
 //!
 //! Units: metres; positions in the model root's frame.
 

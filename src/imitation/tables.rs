@@ -1277,8 +1277,8 @@ impl TaskTables {
     /// The rows see the arms' joints only (those that turn a hand but not the torso). Seeing
     /// every joint, the legs' frame-to-frame steps (contact settling, the active set's
     /// switches) read as large accelerations at 1/Δt², the level fought them, and the NAO's
-    /// hands and steps came out later (CMU 07_04: hand lag 0.11 → 1.6 s; judge 12 of 16 runs
-    /// at the default speeds).
+    /// hands and steps came out later (CMU 07_04: hand lag 0.11 → 1.6 s), and fewer runs
+    /// stood in the physics judge.
     pub fn add_zmp_balance(&mut self, profile: &BipedProfile) {
         let zmp = Constraint::Zmp {
             margin: 0.0,
@@ -1305,9 +1305,8 @@ impl TaskTables {
     /// ([`BipedProfile::sole_centre`]) instead of near its inner edge, and the "collision" level
     /// moves above "balance". A walking step carries the swing foot across, and with the CoM 15 mm
     /// from the inner edge of the NAO's 53 mm-wide contact area (its margin then) the stance foot
-    /// rocked onto that edge: the judge found the CoM outside the real contact area 1–3 % of the
-    /// time and no walk passed; over the centre, 28 of the 32 walking runs of the bundled clips
-    /// pass (the others: a loaded foot turning 2.2–2.5°, 2° allowed). The longer weight shift
+    /// rocked onto that edge in the physics judge; over the centre it does not. The longer
+    /// weight shift
     /// brings the torso nearer the arms, which balance, its goal inside a wide area, can make room
     /// for; without walking the shorter shift keeps the robot quick to follow short one-leg
     /// stances.

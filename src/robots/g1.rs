@@ -118,70 +118,48 @@ pub const STAND: [f64; 29] = [
     0.2, -0.2, 0.0, 0.6, 0.0, 0.0, 0.0, // right arm
 ];
 
-/// How fast the imitation may move the G1. The hands follow the human at up to 1.2 m/s on both
-/// feet and 0.6 m/s on one foot or while the weight shifts, their speed changing by at most
-/// 5 m/s². Measured in the judge (hold 60, every bundled clip, both models, both methods), with
-/// the chest held ([`BipedProfile::chest`]): 0.3 m/s unshaped, the speed tuned before the chest
-/// was held, left the hands 0.16–0.37 s late and 9–21 cm off; 0.8 m/s shaped at 4.4 m/s² (the
-/// arm-length rule's value) passes every run with a loaded foot turning up to 1.0°, the rule's
-/// own 1.76 / 0.66 m/s at 4.4 m/s² up to 1.4° (2° allowed), 1.0 m/s at 4.4 m/s² fails CMU
-/// 131_01 (2.4°), and 1.2 / 0.6 m/s at 3 m/s² passes with at most 0.8° and 1.7 mm of loaded
-/// slip. Shaped at 5 m/s² instead, the hands lag less (0.03–0.15 s, was 0.05–0.16) and come
-/// closer on every bundled clip (Poubel's method 2.8–12.2 → 2.3–11.9 cm over the clip,
-/// Koenemann's 2.4–10.8 → 1.6–10.3), and every run still passes (loaded feet turning at most
-/// 1.0° and 0.7°). At 6 m/s² the judge passed too (1.2°), but Kinect ges01's right arm, held
-/// at the shoulder roll's limit by its IK (a local minimum: from other arm postures the arm
-/// alone reaches every one of that clip's targets within 2 mm), turned back at speed on 5 of
-/// its 154 frames, more than the 2 % the crate's tests allow; at 10 m/s² and 3 m/s on both
-/// feet the hands came within 1.4–8.9 cm but three nominal runs failed (feet tilting 3.7° on
-/// CMU 05_12, turning 2.9° on 09_12 and 131_01), and 1.2 m/s on one foot too turned 131_01's
-/// loaded foot 2.9°. Without the chest held, 0.5 m/s failed 6 runs (loaded feet sliding
-/// 7–8 mm). The URDF's velocity limits are the motors' no-load speeds (20–37 rad/s): 10 % of them
-/// is already more than the NAO's arms get at 50 %. The torso is carried 0.05 m below its standing
-/// height, not the NAO's 0.02 m: with legs three times as long, at 0.02 m the free leg ended
-/// straight 22 µm above the floor on CMU 05_02 and the landing never finished.
+/// How fast the imitation may move the G1, tuned in physics (the judge's MuJoCo G1, nominal
+/// and weak servos; the runs measured are in the CHANGELOG).
 ///
-/// The lean, the support margin and the CoM reference's bounds are the NAO's, not what the
-/// scaling rules of [`crate::robots::tuning`] give (0.23 rad, 14 mm, 0.08 m/s, 0.12 m/s²):
-/// measured in the judge (hold 60, every bundled clip, both models) the rules' values pass the
-/// same 6 of 16 runs as the NAO's, and with the Froude-scaled 0.08 m/s the falls come earlier
-/// (07_04 at 5.0 s instead of 9.4 s). The G1 falls for what the rules cannot see: its servos
-/// sag under the weight on one leg (the judge's README).
-///
-/// Koenemann's CoM offset moves at the rules' 1.0 /s and 1.0 /s² (0.24 m/s², ZMP 17 mm from the
-/// CoM): at the NAO's 1.5 /s and 6 /s² (1.4 m/s² of the CoM on the G1's 0.23 m stance) every
-/// bundled clip fell at 1.0–1.7 s in the judge; at the rules' values the falls come at 1.7–5.5 s
-/// and ges02 passes on both models (2 of 16 runs).
-///
-/// The G1 stays lowered on one foot (`single_support_lowering` = `torso_lowering`, 0.05 m):
-/// rising by it while the foot lifts, as the NAO does, moved its CoM 4 cm up and down within each
-/// step, and the judge's G1 rocked on its stance foot (hold 60, every bundled clip, both models,
-/// with the weight shift's wait of [`SWAY_PERIOD`]: 11 of 16 runs pass rising, 15 lowered).
-///
-/// Koenemann's legs move at the rules' 1.2 % of their rated speed (0.1 × 5.38 / 27.33 rad/s,
-/// the NAO's and the G1's mean leg ratings, × √(0.27 / 0.69 m), their CoM heights): the same
-/// joint speeds at the same Froude number. At the NAO's 10 % the G1's legs copied the human's
-/// knee bends and pelvis turns at up to 2.6 rad/s (hip yaw, CMU 02_10) and 8 of 16 judge runs
-/// fell (hold 60, every bundled clip, both models); at the rules' value 3 (with the weight
-/// shift's wait of [`SWAY_PERIOD`] before a lift, `KoenemannConfig::settle_time`).
-/// Koenemann's offset ends at the stance points (`offset_to_stance_point`), where Poubel's
-/// method puts the CoM on one foot: with the CoM parked over a sole's centre the weak model
-/// rolled outward over it (the uncompensated half of its servos' sag), and with the legs
-/// also ramped over a sway period (`KoenemannConfig::leg_ramp_time`) every bundled clip
-/// passes the judge on both models (hold 60; the stance points alone 12 of 16, the ramp alone
-/// 13; with margins of 10 or 20 mm, or every leg joint ramped at 0.15 or 0.6 rad/s², 15 or 16).
-///
-/// A lifted foot leaves the ground as slowly as it lands (`soft_liftoff`): lifted at once, the
-/// foot's last 20–30 N went to the stance foot within a few hundredths of a second and the G1
-/// tipped onto the stance sole's inner edge (CMU 131_01, the CoM outside the contact area
-/// 2.7 % of the time); with it every bundled clip passes the judge on both models (hold 60).
-/// The NAO keeps its quick lift: with a soft one it passes the same judge runs, but at full
-/// joint speed its single supports meet a stance knee at its limit that the crate's stress
-/// test catches (the closing note of issue 30).
-///
-/// The solver's damping is the rules' 0.039 m/rad (the NAO's 0.02 × the arm lengths' ratio,
-/// 0.375 / 0.191 m): at the NAO's value the G1's arms and waist reversed at speed on 285 of
-/// 3 099 frames of CMU 09_12 (hold 0), at this one on 2, the hands as near.
+/// * The hands follow the human at up to 1.2 m/s on both feet and 0.6 m/s on one foot or while
+///   the weight shifts, their speed changing by at most 5 m/s², with the chest held
+///   ([`BipedProfile::chest`]; without it the hands' reaction slid the loaded feet). Faster
+///   (1 m/s on one foot, 10 m/s², 3 m/s on both feet) the arms' reaction turned or tilted loaded
+///   feet; at 6 m/s² Kinect ges01's right arm, held at the shoulder roll's limit by its IK (a
+///   local minimum), turned back at speed on more frames than the crate's tests allow. The
+///   URDF's velocity limits are the motors' no-load speeds (20–37 rad/s): 10 % of them is
+///   already more than the NAO's arms get at 50 %.
+/// * The torso is carried 0.05 m below its standing height, not the NAO's 0.02 m: with legs
+///   three times as long, at 0.02 m the free leg ended straight 22 µm above the floor on CMU
+///   05_02 and the landing never finished.
+/// * The lean, the support margin and the CoM reference's bounds are the NAO's, not what the
+///   scaling rules of [`crate::robots::tuning`] give (0.23 rad, 14 mm, 0.08 m/s, 0.12 m/s²):
+///   the rules' values did no better in the judge, and with the Froude-scaled 0.08 m/s the
+///   falls came earlier. The G1 falls for what the rules cannot see: its servos sag under the
+///   weight on one leg (the judge's README).
+/// * Koenemann's CoM offset moves at the rules' 1.0 /s and 1.0 /s² (0.24 m/s², ZMP 17 mm from
+///   the CoM): at the NAO's 1.5 /s and 6 /s² (1.4 m/s² of the CoM on the G1's 0.23 m stance)
+///   every bundled clip fell within 2 s.
+/// * The G1 stays lowered on one foot (`single_support_lowering` = `torso_lowering`, 0.05 m):
+///   rising by it while the foot lifts, as the NAO does, moved its CoM 4 cm up and down within
+///   each step, and the G1 rocked on its stance foot.
+/// * Koenemann's legs move at the rules' 1.2 % of their rated speed (0.1 × 5.38 / 27.33 rad/s,
+///   the NAO's and the G1's mean leg ratings, × √(0.27 / 0.69 m), their CoM heights): the same
+///   joint speeds at the same Froude number. At the NAO's 10 % the G1's legs copied the human's
+///   knee bends and pelvis turns at up to 2.6 rad/s (hip yaw, CMU 02_10) and it fell. With the
+///   weight shift's wait of [`SWAY_PERIOD`] before a lift (`KoenemannConfig::settle_time`),
+///   Koenemann's offset ending at the stance points (`offset_to_stance_point`, where Poubel's
+///   method puts the CoM on one foot: with the CoM over a sole's centre the weak model rolled
+///   outward over it, the uncompensated half of its servos' sag) and the legs ramped over a
+///   sway period (`KoenemannConfig::leg_ramp_time`), every bundled clip stands in the judge.
+/// * A lifted foot leaves the ground as slowly as it lands (`soft_liftoff`): lifted at once,
+///   the foot's last 20–30 N went to the stance foot within a few hundredths of a second and
+///   the G1 tipped onto the stance sole's inner edge (CMU 131_01). The NAO keeps its quick
+///   lift: at full joint speed its single supports with a soft one meet a stance knee at its
+///   limit that the crate's stress test catches (the closing note of issue 30).
+/// * The solver's damping is the rules' 0.039 m/rad (the NAO's 0.02 × the arm lengths' ratio,
+///   0.375 / 0.191 m): at the NAO's value the G1's arms and waist reversed at speed on 285 of
+///   3 099 frames of CMU 09_12 (hold 0), at this one on 2, the hands as near.
 pub const TUNING: MotionTuning = MotionTuning {
     task_speed: 0.15,
     tracking_speed: 1.2,
@@ -219,9 +197,8 @@ pub const SERVO_SATURATION: f64 = 0.035;
 /// stiffness (the physics check's weak model, 70 mrad) the period is 1.4 s. The shaper is
 /// centred between the two (their geometric mean, 1.1 s), where it leaves either mode under
 /// 20 % of the sway an unshaped command excites (module docs of [`crate::robots::sway`]);
-/// measured by shaping `joints.csv` offline and judging the 16 bundled runs (hold 60):
-/// 0.85 s passed 7 of 16, 1.1 s 10, 1.3 s 8 (8 unshaped): a local best, and the verdicts of
-/// single runs jump between neighbouring periods.
+/// shaping `joints.csv` offline with 0.85, 1.1 and 1.3 s and judging the bundled runs, 1.1 s
+/// stood best: a local best, and the verdicts of single runs jump between neighbouring periods.
 pub const SWAY_PERIOD: f64 = 1.1;
 
 /// Where the G1 may put a foot down relative to the other sole: x ∈ [−0.10, 0.15] m, lateral

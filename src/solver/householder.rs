@@ -207,7 +207,7 @@ mod tests {
     fn norm_survives_huge_and_tiny_entries() {
         assert!((norm(&[3e200, 4e200]) / 5e200 - 1.0).abs() < 1e-15);
         assert!((norm(&[3e-200, 4e-200]) - 5e-200).abs() < 1e-212);
-        // Subnormal largest entry (found by tests/hardening_solver.rs: the residual was NaN).
+        // Subnormal largest entry (found by tests/suite/hardening_solver.rs: the residual was NaN).
         assert_eq!(norm(&[0.0, -5e-311]), 5e-311);
         assert_eq!(norm(&[5e-324, 5e-324]), 5e-324 * 2f64.sqrt());
     }

@@ -81,7 +81,7 @@ struct Body {
 /// The joints the hands' IK moves: all but a waist's (those that turn the profile's chest
 /// but not its torso, [`BipedProfile::chest`]). The hands then turn a robot's upper body at
 /// its shoulders, not at a waist that swings the whole trunk: on the G1, with hands at 1.2 m/s
-/// moving its waist, 5 of the 16 judge runs of the bundled clips failed (3 falls; hold 60).
+/// moving its waist, the trunk's swing made it fall in the physics judge.
 fn arm_joints(shared: &Shared) -> Result<Vec<bool>, ImitationError> {
     let profile = &shared.profile;
     let side = Side::Right;

@@ -398,8 +398,8 @@ impl WalkFollower {
     /// `goals` with the soles `stance_width` apart across their mean heading, about their
     /// middle; each keeps its place along the heading and its own heading. The human's stance
     /// width changes from step to step, and steps wider than the robot's standing width left
-    /// its CoM short of the stance sole (the judge's NAO fell on 2 of 16 runs, none at the
-    /// standing width); a side step moves the middle and is kept.
+    /// its CoM short of the stance sole (the judge's NAO fell; not at the standing width); a
+    /// side step moves the middle and is kept.
     fn at_width(&self, goals: &[GroundPose; 2]) -> [GroundPose; 2] {
         let [l, r] = *goals;
         let mid = GroundPose {

@@ -22,8 +22,8 @@
 //! support phases keep Poubel's 10 %).
 //!
 //! Executable on the NAO: with the landing clearance of
-//! [`WalkParams`](crate::locomotion::WalkParams) the physics judge passes all 16 runs of the
-//! bundled clips (both servo models, hold 60 s). Still off by default: its steps are slow
+//! [`WalkParams`](crate::locomotion::WalkParams) its walks stand in the physics judge on both
+//! servo models. Still off by default: its steps are slow
 //! (about 0.02 m/s), pivot turns are not followed, and the G1's walk falls (issue 29's notes).
 //!
 //! [`PatternGenerator`]: crate::locomotion::PatternGenerator

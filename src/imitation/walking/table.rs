@@ -23,7 +23,7 @@ use crate::robots::BipedProfile;
 ///
 /// No self-collision level: an inequality level makes the solver hold a joint at its velocity
 /// bound for every level (the active set) instead of slowing the whole step (scale to fit), and
-/// with it the judge's NAO fell on every walk (16 of 16 runs); without it, 2 of 16 fell. The
+/// with it the judge's NAO fell on every walk. The
 /// step envelope keeps the soles apart, and the arms hold the posture of the walk's start (clear
 /// of the torso then, as the support phases keep them): on the bundled clips the closest pair
 /// stays 9.9 mm apart (margin 10 mm; the metrics report it). At the human's joint angles a

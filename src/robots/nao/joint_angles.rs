@@ -1,6 +1,6 @@
 //! The NAO's human joint angles (Poubel eq. 8): the reference of the joint-tracking gradient,
 //! from the human's segment directions ([`SegmentDirections`]). NAO conventions, checked against
-//! the model's forward kinematics in `tests/imitation_scaler.rs`.
+//! the model's forward kinematics in `tests/suite/imitation_scaler.rs`.
 //!
 //! Directions are taken in the human **torso frame** `T`: `z_T` along MidHip→MidShoulder, `y_T`
 //! the shoulder line (right→left) made orthogonal to `z_T`, `x_T = y_T × z_T`. NAO's torso is

@@ -287,51 +287,29 @@ pub fn self_collision() -> SelfCollision {
 }
 
 /// How the imitation moves the NAO, tuned in physics (the judge's MuJoCo NAO, nominal and weak
-/// servos); the reference the scaling rules of [`crate::robots::tuning`] carry to other bipeds.
+/// servos; the runs measured are in the CHANGELOG); the reference the scaling rules of
+/// [`crate::robots::tuning`] carry to other bipeds.
 ///
 /// * Tasks at up to 0.15 m/s (about what 10 % of the rated joint speeds give at the hands), the
 ///   arms at half their rated speeds (4–8 rad/s).
-/// * The hands at up to 0.45 m/s in double support and 0.15 m/s on one foot and while the
-///   weight shifts. Measured in the judge (hold 60, every bundled clip, both models), the hands
-///   at one speed everywhere: 0.3 and 0.45 m/s passed 16 of 16 runs; 0.4 failed one (CMU
-///   09_12's weak model let its CoM out of the sole's contact area 1.3 % of the time in single
-///   support, 1 % allowed), 0.6 five (loaded feet turning 2.1–4.5° from the arms' reaction, in
-///   double support too), 1.0 eight. Faster hands cost the weak model balance on the stepping
-///   clips even where each run passes (with the automatic hold its CoM was outside the contact
-///   area a third to a half longer), so the hands keep 0.15 m/s on one foot, while the weight
-///   shifts and until the human has stood on both feet for a second (the imitation's
-///   `SETTLED_DOUBLE_SUPPORT`): 16 of 16 pass, the weak model's CoM at least 99.7 % in the
-///   contact area; on the gesture clips the mean hand error drops from 8.6–9.6 cm to
-///   2.8–6.3 cm and the hands' lag from 0.40–0.47 s to 0.07–0.17 s. Koenemann's method with the
-///   same rule: 16 of 16 pass (loaded feet turn at most 1.6°); hands 9.1 / 8.5 → 8.6 / 4.3 cm
-///   on the Kinect clips and 5.1 → 2.8 cm on CMU 02_10, lag 0.40–0.50 → 0.10–0.13 s.
-/// * The hands' speed shaped at 2 m/s² (the imitation's `HandRates`: a hand starts and brakes
-///   instead of reaching its speed within a frame), and then 0.8 m/s on both feet and 0.3 m/s
-///   on one: 16 of 16 pass (hold 60), loaded feet slipping ≤ 1.5 mm and turning ≤ 1.0°, the
-///   weak model's CoM ≥ 99.3 % in the contact area (99.7 % before); the mean hand error over
-///   the clip drops on every clip (2.5–11.5 cm, was 2.8–12.8) and the lag to 0.07–0.22 s (CMU
-///   05_12 was 1.5 s late). Koenemann's method, `--offline` and the dynamic walk pass 16 of 16
-///   too. With 0.15 m/s on one foot Koenemann's method failed a run (CMU 05_02: a loaded foot
-///   turned 2.5°); at 4 m/s² and 0.8 m/s the hands came closer on the balancing clip (1.8 cm)
-///   but a loaded foot slipped 4.4 mm on the weak model (5 allowed); at 1.2 m/s no closer (the
-///   acceleration decides). The cost: with the automatic hold (shorter than 60 s) the weak
-///   model's CoM was outside the contact area 3.1 % of CMU 05_12 (1.4 % unshaped at 0.15 m/s;
-///   14 of 16 pass either way).
+/// * The hands at up to 0.8 m/s on both feet and 0.3 m/s on one foot, while the weight shifts
+///   and until the human has stood on both feet for a second (the imitation's
+///   `SETTLED_DOUBLE_SUPPORT`), their speed shaped at 2 m/s² (the imitation's `HandRates`: a
+///   hand starts and brakes instead of reaching its speed within a frame). The arms' reaction
+///   is what limits them: faster or unshaped hands turned loaded feet by more than 2° and let
+///   the weak model's stance foot roll onto an edge, on one foot most of all; slower ones left
+///   the hands tenths of a second late.
 /// * With the ZMP level (`ImitatorConfig::zmp_balance`) the hands at 1 m/s and 10 m/s² in every
-///   phase (`balanced_hands`): 16 of 16 judge runs pass (hold 60; loaded feet turn at most
-///   1.2°), the hands 0.4–7.0 cm from the human over every clip frame with a lag of at most
-///   0.07 s; at 1.5 m/s and 20 m/s² 13 of 16 (loaded feet turn 2.1–2.4°); at 1 m/s without the
-///   level 14 of 16, and Koenemann's method (no such level) 11 of 16.
+///   phase (`balanced_hands`): the level keeps the arms' reaction inside the support, which the
+///   fixed caps above do without it; faster still (1.5 m/s, 20 m/s²), loaded feet turned.
 /// * The torso 0.02 m low: with 0.1 m shanks both knees end up straight at the standing height.
 /// * A 0.25 rad lean over the stance foot: upright, the stance hip-roll servo holds the upper
 ///   body at 88 % of its rated torque (beyond a weak servo's limit); leaning 0.25 rad lowers the
 ///   static hip-roll torque from 2.55 to 1.7 N·m (0.15 rad was not enough for the weak model).
 /// * The single-support CoM goal 20 mm from the sole's inner edge (6.5 mm inside the centre of
-///   its 53 mm-wide contact area): at the centre the hip-roll servo works at 88 % of its rating.
-///   At 15 mm the weak model's stance foot rolled onto its inner edge in single support (the
-///   CoM 10 mm inside that edge when it did) and, with the automatic hold, the CoM was outside
-///   the contact area 1.7 % of CMU 05_12 and 131_01 (14 of 16 judge runs); at 20 mm, 16 of 16
-///   with the automatic hold, the offline mode's too (14 of 16 before), hands unchanged.
+///   its 53 mm-wide contact area): at the centre the hip-roll servo works at 88 % of its rating;
+///   at 15 mm the weak model's stance foot rolled onto its inner edge in single support (the
+///   CoM 10 mm inside that edge when it did).
 /// * The CoM reference at up to 0.05 m/s and 0.3 m/s²: the ZMP within 8 mm of the CoM at its
 ///   0.27 m height.
 /// * Koenemann's CoM offset at up to 1.5 /s and 6 /s²: a shift from the middle to a foot in
