@@ -1,7 +1,7 @@
 //! The NAO (`robots::nao`): the hand-written DH tables against the URDF (two independent
 //! derivations), hand-checkable facts at q = 0, and the change of support foot.
 
-mod common;
+use crate::common;
 
 use nalgebra::{IsometryMatrix3, Rotation3, Translation3, Vector3};
 use proptest::prelude::*;
@@ -9,7 +9,7 @@ use taskstack::human::Side;
 use taskstack::model::Model;
 use taskstack::robots::nao;
 
-const URDF: &str = include_str!("data/nao.urdf");
+const URDF: &str = include_str!("../data/nao.urdf");
 const TOL: f64 = 1e-9;
 
 /// NAOqi's StandInit posture (radians), other variables 0.

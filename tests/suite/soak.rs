@@ -45,11 +45,8 @@ use taskstack::io::clip::Clip;
 use taskstack::robots::{BipedProfile, g1, nao};
 use taskstack::scene::Scene;
 
-mod alloc_counter;
+use crate::alloc_counter;
 use alloc_counter::{allocations, live_bytes};
-
-#[global_allocator]
-static GLOBAL: alloc_counter::Counting = alloc_counter::Counting;
 
 const ALL: [&str; 8] = [
     "cmu_02_10_wash_self_standing_arm_gestures.bvh",

@@ -5,8 +5,8 @@ use nalgebra::IsometryMatrix3;
 use taskstack::model::{Model, UrdfError, UrdfFrame, UrdfOptions};
 use taskstack::robots::nao;
 
-const TREE: &str = include_str!("data/tree.urdf");
-const NAO: &str = include_str!("data/nao.urdf");
+const TREE: &str = include_str!("../data/tree.urdf");
+const NAO: &str = include_str!("../data/nao.urdf");
 
 fn load(text: &str) -> Result<Model, UrdfError> {
     Model::from_urdf_str(text, &UrdfOptions::default())

@@ -1,6 +1,5 @@
 //! Helpers shared by the model tests: finite-difference checks of the Jacobians and random
 //! configurations within the limits.
-#![allow(dead_code)] // each test binary uses a different subset
 
 use faer::Mat;
 use nalgebra::{IsometryMatrix3, Vector3};

@@ -7,11 +7,8 @@ use taskstack::solver::{
     StackShape, TaskStack,
 };
 
-mod alloc_counter;
+use crate::alloc_counter;
 use alloc_counter::allocations;
-
-#[global_allocator]
-static GLOBAL: alloc_counter::Counting = alloc_counter::Counting;
 
 const N: usize = 23;
 

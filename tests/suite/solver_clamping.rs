@@ -1,6 +1,6 @@
 //! Property tests of the clamping loop: limits always hold; nothing changes when none binds.
 
-mod solver_common;
+use crate::solver_common;
 
 use proptest::prelude::*;
 use solver_common::{Rng, problems, random_bounds};

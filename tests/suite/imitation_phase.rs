@@ -753,7 +753,7 @@ proptest! {
 #[test]
 fn checked_in_table_matches_the_data() {
     assert_eq!(
-        include_str!("../src/imitation/table1.md"),
+        include_str!("../../src/imitation/table1.md"),
         TaskTables::paper(&nao::profile()).to_string(),
         "regenerate with `cargo run --example table1 > src/imitation/table1.md`"
     );

@@ -4,11 +4,8 @@
 use taskstack::locomotion::{GroundPose, WalkParams, WholeBodyWalker, goal_feet, plan_steps};
 use taskstack::robots::{BipedProfile, g1, nao};
 
-mod alloc_counter;
+use crate::alloc_counter;
 use alloc_counter::allocations;
-
-#[global_allocator]
-static GLOBAL: alloc_counter::Counting = alloc_counter::Counting;
 
 #[test]
 fn a_walk_allocates_nothing_after_warm_up() {

@@ -9,7 +9,7 @@
 //! a robot moving at 10 % of its rated speed can finish the step it is taking.
 //! `cargo test --release --test imitation_end_to_end -- --nocapture` prints the per-clip metrics.
 
-mod common;
+use crate::common;
 
 use taskstack::human::{HumanFrame, HumanJoint, Side};
 use taskstack::imitation::config::ImitationMethod;

@@ -1,6 +1,5 @@
 //! Shared test helpers: random stacks and the textbook recursion of eq. 4–6, computed naively with
 //! explicit projectors and SVD pseudo-inverses (faer's SVD, nalgebra matrices), as an independent reference.
-#![allow(dead_code)] // each test binary uses a different subset
 
 use nalgebra::{DMatrix, DVector};
 use proptest::prelude::*;

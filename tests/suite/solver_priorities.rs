@@ -1,7 +1,7 @@
 //! Property tests of the prioritized solve: strict priorities, agreement with the textbook
 //! recursion, gradient tasks in the null space, finite output.
 
-mod solver_common;
+use crate::solver_common;
 
 use nalgebra::DVector;
 use proptest::prelude::*;

@@ -1,7 +1,7 @@
 //! Forward kinematics, Jacobians and CoM of `model`: finite differences, a hand-checked planar
 //! arm, re-rooting consistency, and the typed errors of the algorithms.
 
-mod common;
+use crate::common;
 
 use faer::Mat;
 use nalgebra::Vector3;
@@ -9,8 +9,8 @@ use proptest::prelude::*;
 use taskstack::model::{FrameId, Model, ModelError, UrdfOptions};
 use taskstack::robots::nao;
 
-const TREE: &str = include_str!("data/tree.urdf");
-const PLANAR: &str = include_str!("data/planar3r.toml");
+const TREE: &str = include_str!("../data/tree.urdf");
+const PLANAR: &str = include_str!("../data/planar3r.toml");
 /// Jacobians vs central differences (step 1e-6).
 const FD_TOL: f64 = 1e-6;
 

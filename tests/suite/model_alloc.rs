@@ -6,11 +6,8 @@ use nalgebra::Vector3;
 use taskstack::model::Axis;
 use taskstack::robots::nao;
 
-mod alloc_counter;
+use crate::alloc_counter;
 use alloc_counter::allocations;
-
-#[global_allocator]
-static GLOBAL: alloc_counter::Counting = alloc_counter::Counting;
 
 #[test]
 fn kinematics_do_not_allocate_after_new_data() {

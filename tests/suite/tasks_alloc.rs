@@ -1,10 +1,6 @@
-//! A warmed-up solve of a `TaskSet` (ready-made tasks) allocates nothing on the heap: a counting
-//! global allocator counts the allocations of the test's own thread during the solves (the test
-//! harness's threads allocate now and then while they wait).
-
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
-use std::sync::atomic::{AtomicUsize, Ordering};
+//! A warmed-up solve of a `TaskSet` (ready-made tasks) allocates nothing on the heap: the suite's
+//! counting allocator counts the allocations of the test's own thread during the solves (the
+//! test harness's threads allocate now and then while they wait).
 
 use nalgebra::Vector3;
 use taskstack::robots::nao;
@@ -12,38 +8,7 @@ use taskstack::solver::Solver;
 use taskstack::solver::driver::{DriverSettings, PositionDriver};
 use taskstack::tasks::{ComTask, OrientationTask, PoseTask, PositionTask, TaskSet, joint_bounds};
 
-struct Counting;
-
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
-
-thread_local! {
-    /// Whether this thread's allocations are counted.
-    static COUNTING: Cell<bool> = const { Cell::new(false) };
-}
-
-fn count() {
-    if COUNTING.with(Cell::get) {
-        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
-    }
-}
-
-// SAFETY: forwards to the system allocator; only counts.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        count();
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        count();
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
-
-#[global_allocator]
-static GLOBAL: Counting = Counting;
+use crate::alloc_counter::allocations;
 
 #[test]
 fn a_warmed_up_task_set_solve_does_not_allocate() {
@@ -79,14 +44,12 @@ fn a_warmed_up_task_set_solve_does_not_allocate() {
     let bounds = joint_bounds(&model).unwrap();
     driver.run(&mut solver, &mut set, &mut q, &bounds).unwrap();
 
-    COUNTING.with(|c| c.set(true));
-    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    let before = allocations();
     for k in 0..20 {
         set.task_mut::<PositionTask>("r_hand").unwrap().target.z = 0.25 + 0.005 * k as f64;
         driver.run(&mut solver, &mut set, &mut q, &bounds).unwrap();
     }
-    let after = ALLOCATIONS.load(Ordering::SeqCst);
-    COUNTING.with(|c| c.set(false));
+    let after = allocations();
     assert_eq!(
         after - before,
         0,

@@ -4,7 +4,7 @@
 use taskstack::model::Model;
 use taskstack::model::dh::{DhError, DhProblem};
 
-const PLANAR: &str = include_str!("data/planar3r.toml");
+const PLANAR: &str = include_str!("../data/planar3r.toml");
 const ORIGIN: &str = "tests/data/planar3r.toml";
 
 /// The planar table with the first `from` after `anchor` replaced by `to`.

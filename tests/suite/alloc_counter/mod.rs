@@ -1,15 +1,8 @@
 //! A counting global allocator for the no-allocation tests, per thread: the test harness and
 //! other tests run on threads of their own, and an allocation there (libtest's bookkeeping, a
-//! test running beside) must not count against the code under test. A binary installs it with
-//!
-//! ```ignore
-//! mod alloc_counter;
-//! #[global_allocator]
-//! static GLOBAL: alloc_counter::Counting = alloc_counter::Counting;
-//! ```
-//!
-//! and reads [`allocations`] (and [`live_bytes`]) before and after the code it checks.
-#![allow(dead_code)] // each test binary uses a different subset
+//! test running beside) must not count against the code under test. The suite's binary
+//! installs it (`main.rs`); a test reads [`allocations`] (and [`live_bytes`]) before and after
+//! the code it checks.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;

@@ -3,7 +3,7 @@
 //! holding in a driven solve where the equality stack without it lets the CoM out; the ZMP task
 //! against the links' momentum by differences.
 
-mod common;
+use crate::common;
 
 use faer::Mat;
 use nalgebra::Vector3;
