@@ -19,12 +19,13 @@
 use std::fmt;
 
 use nalgebra::{Rotation3, Vector2, Vector3};
-use thiserror::Error;
 
+/// The old path of [`crate::robots::ProfileError`]; kept for one release.
+pub use super::error::ProfileError;
 use super::self_collision::SelfCollision;
 use super::tuning::MotionTuning;
 use crate::human::{HumanJoint, SegmentDirections, Side};
-use crate::model::{Model, ModelError, UrdfError};
+use crate::model::Model;
 
 /// Sliding friction coefficient assumed of the floor where the profile cannot know it (a
 /// polished floor under a plastic sole; the judge's floors have 0.7 and 1.0).
@@ -150,50 +151,6 @@ impl FootArea {
             yaw: placement.yaw.clamp(-self.yaw_max, self.yaw_max),
         }
     }
-}
-
-/// Errors of a joint-angle map and of a profile.
-#[derive(Debug, Error)]
-#[non_exhaustive]
-pub enum ProfileError {
-    /// A model query failed (names the frame or variable).
-    #[error("robot model: {0}")]
-    Model(#[from] ModelError),
-    /// The robot description could not be loaded.
-    #[error("robot description: {0}")]
-    Urdf(#[from] UrdfError),
-    /// The profile file could not be read.
-    #[error("cannot read {path}: {message}")]
-    Io {
-        /// The file.
-        path: String,
-        /// What went wrong.
-        message: String,
-    },
-    /// The profile TOML is malformed (the message names the line and field).
-    #[error("profile {path}: {message}")]
-    Syntax {
-        /// The file, or `<text>`.
-        path: String,
-        /// The parser's message.
-        message: String,
-    },
-    /// A value of the profile is invalid (names the field).
-    #[error("profile field {field}: {reason}")]
-    Invalid {
-        /// The field, e.g. `feet.left.outline`.
-        field: String,
-        /// Why.
-        reason: String,
-    },
-    /// An output slice does not have one entry per model variable.
-    #[error("joint-angle output has {got} entries, the model has {expected} variables")]
-    WrongLength {
-        /// Number of variables of the model.
-        expected: usize,
-        /// Length of the given slice.
-        got: usize,
-    },
 }
 
 /// A map from the human's segment directions to the robot's joint angles: the reference of the

@@ -80,8 +80,9 @@ use std::path::Path;
 use nalgebra::{IsometryMatrix3, Translation3};
 use serde::Deserialize;
 
+use super::error::ProfileError;
 use super::nao;
-use super::profile::{BipedProfile, FootArea, FootFrames, ProfileError, RobotPoint};
+use super::profile::{BipedProfile, FootArea, FootFrames, RobotPoint};
 use super::self_collision::SelfCollision;
 use super::tuning::{BalancedHands, MotionTuning};
 use crate::human::{HumanJoint, Side};

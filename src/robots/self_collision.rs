@@ -14,7 +14,7 @@
 
 use nalgebra::Vector3;
 
-use super::profile::ProfileError;
+use super::error::ProfileError;
 use crate::model::{Model, ModelData};
 use crate::tasks::Capsule;
 

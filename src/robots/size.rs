@@ -4,7 +4,8 @@
 
 use nalgebra::Vector3;
 
-use super::profile::{BipedProfile, ProfileError, outline_bounds};
+use super::error::ProfileError;
+use super::profile::{BipedProfile, outline_bounds};
 use super::tuning::BipedSize;
 use crate::human::{HumanJoint, Side};
 

@@ -12,7 +12,7 @@
 //! driver after integrating) removes the rest.
 
 use super::SolverError;
-use super::stack::check_len;
+use super::check::check_len;
 
 /// Position limits (rad or m) and velocity limits (rad/s or m/s) per joint.
 #[derive(Debug, Clone, PartialEq)]

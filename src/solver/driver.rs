@@ -12,9 +12,10 @@
 
 use super::SolverError;
 use super::bounds::JointBounds;
+use super::check::{check_finite_slice, check_len};
 use super::householder::norm;
 use super::prioritized::Solver;
-use super::stack::{TaskStack, check_finite_slice, check_len};
+use super::stack::TaskStack;
 
 /// Something that gives task errors and Jacobians for a configuration: a robot model with its
 /// targets, or any other differentiable map.

@@ -7,7 +7,7 @@
 
 use super::SolverError;
 use super::bounds::JointBounds;
-use super::stack::{check_finite_slice, check_len};
+use super::check::{check_finite_slice, check_len};
 
 /// A differentiable scalar criterion `f(q)` whose gradient the solver can follow.
 pub trait GradientFunction {

@@ -85,6 +85,7 @@
 //! | [`HumanFrame::set`](crate::human::HumanFrame::set) → [`Imitator::step`](crate::imitation::imitator::Imitator::step) | NaN or ±∞ joint position | graceful: the joint is missing (a frame cannot hold a non-finite position); the output equals that of the frame with the joint left out, finite | `hardening_entry_points`, `imitator_treats_non_finite_joint_positions_as_missing` |
 
 mod bounds;
+pub(crate) mod check;
 pub mod driver;
 mod error;
 mod gradient;

@@ -44,12 +44,13 @@
 
 use super::SolverError;
 use super::bounds::JointBounds;
+use super::check::{check_finite_slice, check_len};
 use super::householder::{
     apply_qt, apply_reflector, dot, norm, qr_col_pivoting, qr_factor, solve_upper,
     solve_upper_transposed,
 };
 use super::report::{ActiveInequality, Bound, Solution, SolveReport};
-use super::stack::{StackShape, TaskStack, check_finite_slice, check_len, prefix_sums};
+use super::stack::{StackShape, TaskStack, prefix_sums};
 
 pub mod active_set;
 mod weighted_dls;

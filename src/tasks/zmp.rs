@@ -40,7 +40,7 @@ use faer::MatMut;
 
 use super::{ComPolygonTask, TaskError, finite_target};
 use crate::model::{Model, ModelData, ModelError};
-use crate::solver::stack::check_len;
+use crate::solver::check::check_len;
 
 /// Standard gravity (m/s²).
 pub const GRAVITY: f64 = 9.81;

@@ -34,7 +34,8 @@ use nalgebra::{Matrix3, Rotation3, Vector3};
 
 use crate::human::{HumanJoint, SegmentDirections, Side};
 use crate::model::Model;
-use crate::robots::profile::{HumanJointAngles, ProfileError};
+use crate::robots::ProfileError;
+use crate::robots::profile::HumanJointAngles;
 
 /// `v / |v|` if `|v| > min` (and finite).
 fn unit(v: Vector3<f64>, min: f64) -> Option<Vector3<f64>> {
