@@ -22,7 +22,7 @@ use taskstack::scene::Scene;
 use crate::Report;
 use crate::check::PhysicsModel;
 use crate::options::{ImitationOptions, open_clip};
-use crate::run::{Progress, Settings, default_out, imitate_into};
+use crate::run::{Progress, Settings, default_out, imitate_into, output_files};
 
 /// The clip imitated when none is given: CMU 05_02 (standing, arm gestures, small steps, a
 /// stance on the right leg), bundled with the crate.
@@ -170,7 +170,7 @@ pub(crate) fn run(args: ImitateArgs, report: Report) -> Result<ExitCode> {
         let value = json!({
             "clip": clip,
             "out": out,
-            "files": settings.exports.files(),
+            "files": output_files(settings.exports),
             "metrics": taskstack::batch::metrics_value(&metrics, &clip),
         });
         let _ = writeln!(text, "{value}");
@@ -314,7 +314,7 @@ fn print_summary(
         text,
         "wrote {}/{{{}}}",
         out.display(),
-        settings.exports.files().join(", ")
+        output_files(settings.exports).join(", ")
     );
 }
 

@@ -12,8 +12,6 @@ use taskstack::io::clip::Clip;
 use taskstack::io::skeleton_map::SkeletonMap;
 use taskstack::robots::{BipedProfile, g1, nao};
 
-use crate::run::Exports;
-
 #[derive(Debug, Clone, Args)]
 pub(crate) struct ImitationOptions {
     /// The robot: `nao` (NAO H25 V5), `g1` (Unitree G1, 29 DoF) or a biped profile file
@@ -343,4 +341,13 @@ fn hold(text: &str) -> Result<Hold, String> {
     } else {
         Err(format!("{value} s is not within 0–{MAX_HOLD} s"))
     }
+}
+
+/// The motion exports beside `joints.csv`.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Exports {
+    /// Also write `motion_unitree.csv` (Unitree's LAFAN1 layout).
+    pub(crate) unitree_csv: bool,
+    /// Their frame rate (Hz); `None`: motion.npz at the clip's own rate, the Unitree CSV at 30.
+    pub(crate) fps: Option<f64>,
 }

@@ -19,7 +19,7 @@ use taskstack::io::skeleton_map::SkeletonMap;
 use taskstack::robots::BipedProfile;
 use taskstack::{Imitator, ImitatorConfig, RobotFrame};
 
-use crate::options::open_clip;
+use crate::options::{Exports, open_clip};
 use crate::plots::PlotRecorder;
 use crate::view::ViewWriter;
 
@@ -46,21 +46,10 @@ pub(crate) struct Settings {
     pub(crate) exports: Exports,
 }
 
-/// The motion exports beside `joints.csv`.
-#[derive(Debug, Clone, Copy, Default)]
-pub(crate) struct Exports {
-    /// Also write `motion_unitree.csv` (Unitree's LAFAN1 layout).
-    pub(crate) unitree_csv: bool,
-    /// Their frame rate (Hz); `None`: motion.npz at the clip's own rate, the Unitree CSV at 30.
-    pub(crate) fps: Option<f64>,
-}
-
-impl Exports {
-    /// The files a run with these exports writes.
-    pub(crate) fn files(self) -> Vec<&'static str> {
-        let unitree = self.unitree_csv.then_some("motion_unitree.csv");
-        OUTPUT_FILES.into_iter().chain(unitree).collect()
-    }
+/// The files a run with `exports` writes.
+pub(crate) fn output_files(exports: Exports) -> Vec<&'static str> {
+    let unitree = exports.unitree_csv.then_some("motion_unitree.csv");
+    OUTPUT_FILES.into_iter().chain(unitree).collect()
 }
 
 /// The frame rate of Unitree's retargeted LAFAN1 dataset (Hz).

@@ -5,7 +5,7 @@
 //! `ʷT_base = ʷT_sole · ˢᵒˡᵉT_base(q)`, with `ʷT_sole` the frame's placement of that sole
 //! ([`RobotFrame::left_sole`], [`RobotFrame::right_sole`]). A sole is on the floor when every
 //! point of its outline is within
-//! [`CONTACT_HEIGHT`](crate::imitation::metrics::CONTACT_HEIGHT) of it, as the imitation
+//! [`CONTACT_HEIGHT`](crate::imitation::output::CONTACT_HEIGHT) of it, as the imitation
 //! metrics count it ([`sole_on_floor`]).
 //!
 //! Resampling to `fps` frames a second ([`MotionTrack::resampled`]) interpolates positions and
@@ -17,7 +17,7 @@ use thiserror::Error;
 
 use crate::human::Side;
 use crate::imitation::imitator::{Imitator, RobotFrame};
-use crate::imitation::metrics::sole_on_floor;
+use crate::imitation::output::sole_on_floor;
 use crate::model::{FrameId, ModelData, ModelError};
 use crate::robots::BipedProfile;
 

@@ -35,7 +35,7 @@
 
 use nalgebra::Rotation2;
 
-use super::look_ahead::{FootLift, FootLookAhead, FootSchedule, MotionTimes};
+use super::look_ahead::{FootLift, FootLookAhead, FootSchedule, MotionTimes, footprint};
 use super::phase::SupportPhase;
 use super::support::HumanSupport;
 use crate::human::{HumanFrame, Side};
@@ -136,11 +136,6 @@ impl FootstepConfig {
 pub use crate::locomotion::GroundPose;
 use crate::locomotion::footstep::mean_heading;
 pub(crate) use crate::locomotion::footstep::wrap_angle as wrap;
-
-/// Whether `phase` shifts the CoM toward a foot with both feet still down.
-pub(crate) fn shifting(phase: SupportPhase) -> bool {
-    phase.take_off() == Some(super::phase::TakeOff::ComToFoot)
-}
 
 /// What the planner looks ahead with.
 #[derive(Clone, Debug)]
@@ -413,7 +408,9 @@ impl FootstepPlanner {
             // A followed stance that the human ends before the robot's foot is off the ground is
             // given up (the phase machine aborts the weight shift): a foot lifted after the
             // human's is down again would imitate nothing.
-            Step::Swing(..) if shifting(phase) && self.following.is_some_and(|l| l.end <= now) => {
+            Step::Swing(..)
+                if phase.shifts_weight() && self.following.is_some_and(|l| l.end <= now) =>
+            {
                 self.step = Step::Idle;
             }
             // Without walking the robot imitates the human's one-leg stances: if the human now
@@ -424,7 +421,7 @@ impl FootstepPlanner {
             Step::Swing(foot, _)
                 if !self.config.follow
                     && self.ahead.is_none()
-                    && shifting(phase)
+                    && phase.shifts_weight()
                     && matches!(self.stance, Some((lifted, t))
                         if lifted == foot.other() && t >= self.config.stance_time) =>
             {
@@ -661,19 +658,6 @@ impl FootstepPlanner {
             yaw: wrap(r0.yaw + print.yaw - h0.yaw),
         })
     }
-}
-
-/// The footprint of a human foot: ankle ground point and heading, the foot's own while it is
-/// near flat ([`HumanFrame::foot_heading`]: the toe at least 3 cm ahead and at most 45° below
-/// the ankle), else the pelvis'. A walk that started from CMU 05_02's foot in relevé, read as
-/// pointing backward, turned the robot 84° left while the human turned 43° right.
-pub(crate) fn footprint(frame: &HumanFrame, foot: Side) -> Option<GroundPose> {
-    let ankle = frame.get(foot.ankle())?;
-    let yaw = (frame.foot_heading(foot, 0.03, 1.0)).or_else(|| frame.pelvis_heading(0.0))?;
-    Some(GroundPose {
-        xy: ankle.xy(),
-        yaw,
-    })
 }
 
 #[cfg(test)]

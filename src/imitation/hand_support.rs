@@ -44,7 +44,7 @@ use super::error::ImitationError;
 #[cfg(doc)]
 use super::output::RobotFrame;
 use crate::human::{HumanFrame, HumanJoint, Side};
-use crate::scene::{Scene, Surface, SurfaceShape};
+use crate::scene::{Scene, Surface};
 use crate::tasks::convex_hull;
 
 /// One planned hand contact: the human's hand rests on `surface` from `enter` to `leave`.
@@ -245,17 +245,8 @@ impl HandSupportConfig {
     }
 }
 
-/// Where a robot hand is placed: its contact point and the surface under it (robot world
-/// frame, robot scale, m).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct HandPlacement {
-    /// The point the hand goes to and is held at.
-    pub point: Vector3<f64>,
-    /// The surface, mapped to the robot (see the module docs).
-    pub surface: SurfaceShape,
-    /// Whether the contact is on (the hand supports the robot), not still being placed.
-    pub holding: bool,
-}
+/// The old path of `output::HandPlacement`; kept for one release.
+pub use super::output::HandPlacement;
 
 /// What the imitator knows of a hand in the current frame, to map a surface to the robot.
 #[derive(Clone, Copy, Debug)]

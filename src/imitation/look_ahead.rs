@@ -45,10 +45,10 @@
 
 use thiserror::Error;
 
-use super::footsteps::{GroundPose, footprint, shifting};
 use super::phase::{Landing, SupportPhase, TakeOff};
 use super::support::{HumanSupport, SupportConfig, SupportDetector, SupportError};
 use crate::human::{HumanFrame, Side};
+use crate::locomotion::GroundPose;
 
 /// One lift of a human foot: off the ground from `start` to `end` (human clock, s).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -316,10 +316,23 @@ impl MotionTimes {
     /// The planner asked the phase machine for a step with the foot allowed to lift or not.
     pub fn requested(&mut self, lift: bool) {
         self.last_request = self.clock;
-        if lift && self.current.is_some_and(|(p, _)| shifting(p)) {
+        if lift && self.current.is_some_and(|(p, _)| p.shifts_weight()) {
             self.open_since.get_or_insert(self.clock);
         }
     }
+}
+
+/// The footprint of a human foot: ankle ground point and heading, the foot's own while it is
+/// near flat ([`HumanFrame::foot_heading`]: the toe at least 3 cm ahead and at most 45° below
+/// the ankle), else the pelvis'. A walk that started from CMU 05_02's foot in relevé, read as
+/// pointing backward, turned the robot 84° left while the human turned 43° right.
+pub(crate) fn footprint(frame: &HumanFrame, foot: Side) -> Option<GroundPose> {
+    let ankle = frame.get(foot.ankle())?;
+    let yaw = (frame.foot_heading(foot, 0.03, 1.0)).or_else(|| frame.pelvis_heading(0.0))?;
+    Some(GroundPose {
+        xy: ankle.xy(),
+        yaw,
+    })
 }
 
 #[cfg(test)]

@@ -37,8 +37,8 @@
 use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 
 use super::clearance::{ClearanceMeter, SelfClearance};
-use super::hand_support::HandPlacement;
-use super::imitator::{Imitator, RobotFrame};
+use super::imitator::Imitator;
+use super::output::{HandPlacement, RobotFrame};
 use super::phase::{SupportKind, SupportPhase};
 use super::reach::{HandReach, ReachMeter};
 use super::support::HumanSupport;
@@ -49,16 +49,9 @@ use super::walking::{WalkMeter, WalkingSummary};
 use crate::solver::JointBounds;
 use crate::tasks::{convex_hull, hull_margin};
 
-/// A foot is on the ground when its outline points are at most this high (m).
-pub const CONTACT_HEIGHT: f64 = 1e-3;
-
-/// Whether a sole is on the floor: every point of its `outline` (sole frame, m) within
-/// [`CONTACT_HEIGHT`] of the floor with the sole at `sole` (world).
-pub fn sole_on_floor(outline: &[[f64; 2]], sole: &IsometryMatrix3<f64>) -> bool {
-    outline
-        .iter()
-        .all(|&[x, y]| sole.transform_point(&[x, y, 0.0].into()).z.abs() <= CONTACT_HEIGHT)
-}
+/// The old paths of `output::CONTACT_HEIGHT` and `output::sole_on_floor`; kept for one
+/// release.
+pub use super::output::{CONTACT_HEIGHT, sole_on_floor};
 
 /// Frames of a run by the kind of the robot's phase.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

@@ -29,6 +29,7 @@ pub mod reach;
 pub mod scaler;
 pub mod shaping;
 mod shoulder_anchor;
+mod state;
 pub mod support;
 pub mod tables;
 pub mod travel;

@@ -2,15 +2,30 @@
 
 use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 
-use super::hand_support::HandPlacement;
 use super::phase::SupportPhase;
 use super::support::HumanSupport;
-use super::walking::follower::QUEUE_AHEAD;
 use crate::human::{HumanJoint, Side};
 use crate::locomotion::{Footstep, WalkState};
 use crate::robots::BipedProfile;
+use crate::scene::SurfaceShape;
 use crate::solver::driver::{DriverReport, StopReason};
 use crate::solver::{LevelReport, SolveReport};
+
+/// A foot is on the ground when its outline points are at most this high (m).
+pub const CONTACT_HEIGHT: f64 = 1e-3;
+
+/// Whether a sole is on the floor: every point of its `outline` (sole frame, m) within
+/// [`CONTACT_HEIGHT`] of the floor with the sole at `sole` (world).
+pub fn sole_on_floor(outline: &[[f64; 2]], sole: &IsometryMatrix3<f64>) -> bool {
+    outline
+        .iter()
+        .all(|&[x, y]| sole.transform_point(&[x, y, 0.0].into()).z.abs() <= CONTACT_HEIGHT)
+}
+
+/// Steps queued ahead of the robot: the generator previews about one and a half steps, so two
+/// queued steps are all it looks at; more would commit the robot to footprints the human may
+/// still change.
+pub(crate) const QUEUE_AHEAD: usize = 2;
 
 /// The effectors whose positions each [`RobotFrame`] reports and whose tracking the metrics
 /// measure, by role name (the robot frames are the profile's hands and feet's ankles), with the
@@ -196,4 +211,16 @@ impl RobotFrame {
         self.solve_passes = report.active_set_iterations() + report.clamping_iterations();
         self.solve_converged = report.converged();
     }
+}
+
+/// Where a robot hand is placed: its contact point and the surface under it (robot world
+/// frame, robot scale, m).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HandPlacement {
+    /// The point the hand goes to and is held at.
+    pub point: Vector3<f64>,
+    /// The surface, mapped to the robot (see the module docs).
+    pub surface: SurfaceShape,
+    /// Whether the contact is on (the hand supports the robot), not still being placed.
+    pub holding: bool,
 }

@@ -256,6 +256,11 @@ impl SupportPhase {
         }
     }
 
+    /// Whether the CoM shifts toward a foot with both feet still down ("CoM to foot").
+    pub fn shifts_weight(self) -> bool {
+        self.take_off() == Some(TakeOff::ComToFoot)
+    }
+
     /// The landing step, in a transition from a single support to DS.
     pub const fn landing(self) -> Option<Landing> {
         match self {

@@ -29,8 +29,7 @@ use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 
 use super::footsteps::{FootstepPlanner, GroundPose, StepRequest};
 use super::hand_support::{HandSupports, HandView, hand_point};
-use super::imitator::{Shared, effector_ids, ground_pose, human_stance, velocity_bounds};
-use super::metrics::CONTACT_HEIGHT;
+use super::output::CONTACT_HEIGHT;
 use super::phase::{
     Measurements, PhaseConfig, PhaseMachine, Settling, SupportKind, SupportPhase, TakeOff,
 };
@@ -39,6 +38,7 @@ use super::reach::Arm;
 use super::scaler::{RobotSkeleton, ScaleConfig, Scaler};
 use super::shaping::{ComReference, HandRates, HandSpeed, MotionLimits, StartRamp, SwingHeight};
 use super::shoulder_anchor::hang_arms_from_robot_shoulders;
+use super::state::{Shared, effector_ids, ground_pose, human_stance, velocity_bounds};
 use super::support::{HumanSupport, SupportDetector};
 use super::tables::{PointTarget, Task, TaskTable, TaskTables};
 use super::walking::follower::WalkFollower;

@@ -16,7 +16,7 @@ use nalgebra::{IsometryMatrix3, Rotation3, Vector2, Vector3};
 
 use crate::human::Side;
 use crate::imitation::error::ImitationError;
-use crate::imitation::imitator::Shared;
+use crate::imitation::state::Shared;
 use crate::model::{FrameId, Model, ModelData};
 use crate::robots::BipedProfile;
 use crate::solver::driver::{DriverReport, DriverSettings, PositionDriver, TaskModel};

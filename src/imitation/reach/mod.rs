@@ -49,8 +49,8 @@ mod posture;
 use nalgebra::{IsometryMatrix3, Matrix3, Vector3};
 
 use self::posture::ArmPostures;
-use super::imitator::RobotFrame;
 use super::output::EFFECTORS;
+use super::output::RobotFrame;
 use crate::human::{HumanJoint, Side};
 use crate::model::{FrameId, Model, ModelData};
 use crate::robots::{BipedProfile, RobotPoint};

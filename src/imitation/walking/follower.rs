@@ -6,6 +6,7 @@ use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 use crate::human::Side;
 use crate::imitation::error::ImitationError;
 use crate::imitation::footsteps::{FootstepConfig, GroundPose};
+use crate::imitation::output::QUEUE_AHEAD;
 use crate::imitation::phase::{Landing, SupportPhase};
 use crate::imitation::phase_solver::{Criteria, FrameTargets, PhaseSolver, own_joints};
 use crate::locomotion::footstep::{mean_heading, wrap_angle};
@@ -18,11 +19,6 @@ use crate::model::{Model, ModelData};
 use crate::robots::{BipedProfile, FootArea};
 use crate::solver::driver::DriverSettings;
 use crate::solver::{JointBounds, Settings};
-
-/// Steps queued ahead of the robot: the generator previews about one and a half steps, so two
-/// queued steps are all it looks at; more would commit the robot to footprints the human may
-/// still change.
-pub(in crate::imitation) const QUEUE_AHEAD: usize = 2;
 
 /// Most solver iterations per frame: the walk's references move smoothly, so a few Gauss–Newton
 /// steps meet the feet and the CoM to the solver's precision.
@@ -431,7 +427,7 @@ impl WalkFollower {
     ) -> WalkTargets {
         let walk = &self.state;
         let to_root = |p: Vector3<f64>| world_t_root.inverse_transform_point(&p.into()).coords;
-        let root_yaw = crate::imitation::imitator::ground_pose(world_t_root).yaw;
+        let root_yaw = crate::imitation::state::ground_pose(world_t_root).yaw;
         let sole = walk.feet[self.root.other().index()];
         let [x, y, z] = sole.position;
         let up = walk.torso_up(self.params.torso_lean, self.half_span, root_yaw);
