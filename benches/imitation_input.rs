@@ -7,8 +7,8 @@ use std::io::Cursor;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use taskstack::human::HumanFrame;
-use taskstack::imitation::scaler::{RobotSkeleton, ScaleConfig, Scaler};
-use taskstack::imitation::support::{SupportConfig, SupportDetector};
+use taskstack::imitation::reference::scaler::{RobotSkeleton, ScaleConfig, Scaler};
+use taskstack::imitation::reference::support::{SupportConfig, SupportDetector};
 use taskstack::io::bvh::{BvhConfig, BvhReader};
 use taskstack::robots::{HumanJointAngles, nao};
 

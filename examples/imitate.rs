@@ -12,7 +12,7 @@ use std::io::BufWriter;
 use taskstack::batch::JointsWriter;
 use taskstack::human::HumanFrame;
 use taskstack::imitation::metrics::MetricsRecorder;
-use taskstack::imitation::support::SupportConfig;
+use taskstack::imitation::reference::support::SupportConfig;
 use taskstack::io::clip::Clip;
 use taskstack::robots::nao;
 use taskstack::{Imitator, ImitatorConfig};

@@ -24,8 +24,10 @@ use std::process::ExitCode;
 use nalgebra::{Rotation3, Vector3};
 use taskstack::human::Side;
 use taskstack::human::{HumanFrame, HumanJoint};
-use taskstack::imitation::scaler::{RobotSkeleton, ScaleConfig, ScaledSkeleton, Scaler, Stance};
-use taskstack::imitation::support::{HumanSupport, SupportConfig, SupportDetector};
+use taskstack::imitation::reference::scaler::{
+    RobotSkeleton, ScaleConfig, ScaledSkeleton, Scaler, Stance,
+};
+use taskstack::imitation::reference::support::{HumanSupport, SupportConfig, SupportDetector};
 use taskstack::io::clip::Clip;
 use taskstack::robots::nao;
 

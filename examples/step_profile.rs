@@ -16,7 +16,7 @@ use taskstack::human::HumanFrame;
 use taskstack::imitation::config::ImitationMethod;
 use taskstack::imitation::koenemann::KoenemannConfig;
 use taskstack::imitation::output::RobotFrame;
-use taskstack::imitation::support::SupportConfig;
+use taskstack::imitation::reference::support::SupportConfig;
 use taskstack::io::clip::Clip;
 use taskstack::robots::{g1, nao};
 use taskstack::{Imitator, ImitatorConfig};

@@ -1,7 +1,7 @@
 //! Prints the paper's task tables (Poubel Table I) as markdown; this is how
-//! `src/imitation/table1.md` is generated.
+//! `src/imitation/phase/table1.md` is generated.
 
-use taskstack::imitation::tables::TaskTables;
+use taskstack::imitation::phase::tables::TaskTables;
 use taskstack::robots::nao;
 
 fn main() -> std::io::Result<()> {

@@ -31,7 +31,7 @@ use crate::imitation::imitator::{ImitationError, Imitator, ImitatorConfig, Robot
 use crate::imitation::metrics::{
     EffectorError, ImitationMetrics, MeanMax, MetricsRecorder, Spread,
 };
-use crate::imitation::support::SupportConfig;
+use crate::imitation::reference::support::SupportConfig;
 use crate::io::clip::{Clip, ClipError};
 use crate::robots::{BipedProfile, nao};
 

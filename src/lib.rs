@@ -69,7 +69,7 @@
 //! and reachable at the allowed velocities, the support phase, the feet and the CoM.
 //!
 //! ```
-//! use taskstack::imitation::support::SupportConfig;
+//! use taskstack::imitation::reference::support::SupportConfig;
 //! use taskstack::io::clip::Clip;
 //! use taskstack::robots::nao;
 //! use taskstack::{HumanFrame, Imitator, ImitatorConfig};

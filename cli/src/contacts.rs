@@ -7,7 +7,7 @@ use anyhow::{Context, Result};
 use clap::Args;
 use serde_json::json;
 use taskstack::human::HumanFrame;
-use taskstack::imitation::contact_events::{
+use taskstack::imitation::reference::contact_events::{
     ContactChange, ContactConfig, ContactThresholds, contact_events,
 };
 use taskstack::io::clip::Clip;

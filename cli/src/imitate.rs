@@ -11,12 +11,12 @@ use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
 use taskstack::batch::{HOLD_CAP, Hold};
 use taskstack::human::HumanFrame;
-use taskstack::imitation::contact_events::ContactConfig;
-use taskstack::imitation::hand_support::{HandContactPlan, HandSupportConfig};
-use taskstack::imitation::look_ahead::{FootLookAhead, FootSchedule};
 use taskstack::imitation::metrics::ImitationMetrics;
+use taskstack::imitation::poubel::hand_support::{HandContactPlan, HandSupportConfig};
 use taskstack::imitation::reach::POSTURE_UNREACHABLE;
-use taskstack::imitation::support::SupportConfig;
+use taskstack::imitation::reference::contact_events::ContactConfig;
+use taskstack::imitation::reference::support::SupportConfig;
+use taskstack::imitation::walking::look_ahead::{FootLookAhead, FootSchedule};
 use taskstack::scene::Scene;
 
 use crate::Report;

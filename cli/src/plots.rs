@@ -10,7 +10,7 @@
 use taskstack::human::Side;
 use taskstack::imitation::metrics::{CONTACT_HEIGHT, EFFECTORS};
 use taskstack::imitation::phase::SupportPhase;
-use taskstack::imitation::support::HumanSupport;
+use taskstack::imitation::reference::support::HumanSupport;
 use taskstack::model::Model;
 use taskstack::{Imitator, RobotFrame, Vector3};
 

@@ -14,7 +14,7 @@ use serde_json::json;
 use taskstack::batch::{Hold, JointsWriter, imitate_clip, metrics_json};
 use taskstack::export::{MotionRecorder, MotionTrack, write_motion_npz, write_unitree_csv};
 use taskstack::imitation::metrics::ImitationMetrics;
-use taskstack::imitation::support::SupportConfig;
+use taskstack::imitation::reference::support::SupportConfig;
 use taskstack::io::skeleton_map::SkeletonMap;
 use taskstack::robots::BipedProfile;
 use taskstack::{Imitator, ImitatorConfig, RobotFrame};

@@ -12,7 +12,7 @@ use taskstack::batch::JointsWriter;
 use taskstack::human::HumanJoint;
 use taskstack::human::Side;
 use taskstack::imitation::phase::SupportPhase;
-use taskstack::imitation::support::HumanSupport;
+use taskstack::imitation::reference::support::HumanSupport;
 use taskstack::locomotion::footstep::wrap_angle;
 use taskstack::locomotion::{
     Footstep, GroundPose, Support, SupportPolygon, WalkParams, WalkerFrame, WholeBodyWalker,

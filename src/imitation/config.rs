@@ -1,14 +1,14 @@
 //! The imitator's settings ([`ImitatorConfig`]) and their validation.
 
-use super::error::ImitationError;
-use super::footsteps::FootstepConfig;
-use super::hand_support::HandSupportConfig;
-use super::koenemann::KoenemannConfig;
-use super::look_ahead::FootLookAhead;
-use super::phase::PhaseConfig;
-use super::shaping::{HandSpeed, MotionLimits};
-use super::support::SupportConfig;
-use super::tables::TaskTables;
+use crate::imitation::error::ImitationError;
+use crate::imitation::koenemann::KoenemannConfig;
+use crate::imitation::phase::PhaseConfig;
+use crate::imitation::phase::tables::TaskTables;
+use crate::imitation::poubel::hand_support::HandSupportConfig;
+use crate::imitation::reference::support::SupportConfig;
+use crate::imitation::shaping::{HandSpeed, MotionLimits};
+use crate::imitation::walking::footsteps::FootstepConfig;
+use crate::imitation::walking::look_ahead::FootLookAhead;
 use crate::robots::{FootArea, MotionTuning};
 use crate::solver::Settings;
 
@@ -61,12 +61,12 @@ pub struct ImitatorConfig {
     /// the legs cannot compensate). Set it to `velocity_fraction` for one fraction everywhere.
     pub upper_body_velocity_fraction: Option<f64>,
     /// Fraction of each leg joint's rated velocity while the robot walks
-    /// ([`super::walking`]): the walk's timing is the pattern generator's, and a swing leg
+    /// ([`crate::imitation::walking`]): the walk's timing is the pattern generator's, and a swing leg
     /// that lags its plan lands late. Default 1 (the NAO's swing knee reaches 0.97–1.0 of its
     /// rated speed in 5 cm steps of 1 s); `velocity_fraction` still bounds the support phases.
     pub walking_velocity_fraction: f64,
     /// Speed and acceleration bounds of the CoM reference and of the swing foot (see
-    /// [`super::shaping`]); `None` (default): [`MotionLimits::default`] with the profile's
+    /// [`crate::imitation::shaping`]); `None` (default): [`MotionLimits::default`] with the profile's
     /// CoM bounds ([`MotionLimits::with_com_of`]).
     pub motion: Option<MotionLimits>,
     /// Gauss–Newton steps per frame (default 1, as the paper: one IK per time step). Each step
@@ -79,7 +79,7 @@ pub struct ImitatorConfig {
     /// velocities give at its hands).
     pub max_task_speed: Option<f64>,
     /// Largest speed the tasks that follow the human ask for (m/s): the points whose target is
-    /// the scaled human ([`PointTarget::Scaled`](super::tables::PointTarget::Scaled), the hands
+    /// the scaled human ([`PointTarget::Scaled`](crate::imitation::phase::tables::PointTarget::Scaled), the hands
     /// in the default tables), in place of `max_task_speed`, so that the arms can follow the
     /// human more closely while the CoM, the torso and the feet keep their slow, shaped
     /// references (the joint velocity bounds still limit the arms). `Some`: this speed in every
@@ -87,18 +87,18 @@ pub struct ImitatorConfig {
     /// [`MotionTuning::tracking_speed`](crate::robots::MotionTuning::tracking_speed) once both
     /// the human and the robot have stood on both feet for a second, and its
     /// [`stance_tracking_speed`](crate::robots::MotionTuning::stance_tracking_speed) otherwise
-    /// ([`super::shaping::HandSpeed`]; NAO 0.8 and 0.3 m/s, shaped at 2 m/s², G1 1.2 and
+    /// ([`crate::imitation::shaping::HandSpeed`]; NAO 0.8 and 0.3 m/s, shaped at 2 m/s², G1 1.2 and
     /// 0.6 m/s at 5 m/s²; faster hands turned loaded feet in the physics judge, see
     /// [`crate::robots::nao::TUNING`] and [`crate::robots::g1::TUNING`]), in both methods;
     /// Poubel's with the dynamic walk on ([`FootstepConfig::dynamic`]) uses the latter
     /// throughout.
     pub max_tracking_speed: Option<f64>,
     /// Largest change of the hands' speed toward their targets (m/s², > 0) in every phase, both
-    /// methods ([`super::shaping::HandRates`]). `None` (default): the profile's
+    /// methods ([`crate::imitation::shaping::HandRates`]). `None` (default): the profile's
     /// [`MotionTuning::tracking_acceleration`](crate::robots::MotionTuning::tracking_acceleration).
     pub max_tracking_acceleration: Option<f64>,
     /// When and where the robot steps: the human's footprints, scaled, clipped to the step
-    /// envelope, taken one step at a time (see [`super::footsteps`]).
+    /// envelope, taken one step at a time (see [`crate::imitation::walking::footsteps`]).
     pub footsteps: FootstepConfig,
     /// Time step assumed for the first frame, and for a frame with the same time as the previous
     /// one (s). Default 1/120 s.
@@ -128,11 +128,11 @@ pub struct ImitatorConfig {
     /// Initial posture (model variable order, rad); `None` (default): the profile's
     /// [`BipedProfile::stand`](crate::robots::BipedProfile::stand).
     pub initial_q: Option<Vec<f64>>,
-    /// Hands as supports, from a recording's contact list (see [`super::hand_support`]; Poubel
+    /// Hands as supports, from a recording's contact list (see [`crate::imitation::poubel::hand_support`]; Poubel
     /// et al.'s method only). `None` (default): the hands only follow the human.
     pub hand_supports: Option<HandSupportConfig>,
     /// The offline mode's look-ahead for the feet: the recording's foot lifts, known in advance
-    /// (see [`super::look_ahead`]; Poubel et al.'s method only). `None` (default): online, the
+    /// (see [`crate::imitation::walking::look_ahead`]; Poubel et al.'s method only). `None` (default): online, the
     /// robot reacts to the human's feet as it sees them.
     pub look_ahead: Option<FootLookAhead>,
     /// Balance that sees the arms' dynamics (Poubel et al.'s method, its support phases; not

@@ -1,12 +1,12 @@
-//! The imitator's error: everything that can go wrong building an [`Imitator`](super::imitator::Imitator)
+//! The imitator's error: everything that can go wrong building an [`Imitator`](crate::imitation::imitator::Imitator)
 //! or stepping it, each part's error wrapped.
 
 use thiserror::Error;
 
-use super::phase::PhaseError;
-use super::scaler::ScaleError;
-use super::support::SupportError;
-use super::tables::TableError;
+use crate::imitation::phase::PhaseError;
+use crate::imitation::phase::tables::TableError;
+use crate::imitation::reference::scaler::ScaleError;
+use crate::imitation::reference::support::SupportError;
 use crate::locomotion::LocomotionError;
 use crate::model::ModelError;
 use crate::robots::ProfileError;

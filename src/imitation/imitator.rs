@@ -1,24 +1,24 @@
 //! The online imitator: one human frame in, one robot posture out, by either of two methods
-//! ([`ImitationMethod`]): Poubel et al.'s task tables (support phases and [`super::tables`]) or Koenemann et al.'s
-//! posture mapping and stabilization ([`super::koenemann`]). Both give the same
+//! ([`ImitationMethod`]): Poubel et al.'s task tables (support phases and [`crate::imitation::phase::tables`]) or Koenemann et al.'s
+//! posture mapping and stabilization ([`crate::imitation::koenemann`]). Both give the same
 //! [`RobotFrame`], so the outputs and metrics of the two compare directly.
 //!
 //! Everything is allocated in [`Imitator::new`]; [`Imitator::step`] allocates nothing.
 //!
 //! World frame: the right sole's frame at the first frame (x forward, y left, z up, metres).
 
-use super::koenemann::imitator::KoenemannImitator;
-use super::phase::SupportPhase;
-use super::poubel::PoubelImitator;
-use super::state::Shared;
-use super::tables::TaskTable;
 use crate::human::{HumanFrame, Side};
+use crate::imitation::koenemann::imitator::KoenemannImitator;
+use crate::imitation::phase::SupportPhase;
+use crate::imitation::phase::tables::TaskTable;
+use crate::imitation::poubel::PoubelImitator;
+use crate::imitation::state::Shared;
 use crate::robots::BipedProfile;
 use crate::solver::JointBounds;
 
-pub use super::config::{ImitationMethod, ImitatorConfig};
-pub use super::error::ImitationError;
-pub use super::output::{EFFECTORS, RobotFrame};
+pub use crate::imitation::config::{ImitationMethod, ImitatorConfig};
+pub use crate::imitation::error::ImitationError;
+pub use crate::imitation::output::{EFFECTORS, RobotFrame};
 
 /// The online imitator.
 #[derive(Debug)]

@@ -1,37 +1,50 @@
-//! Human-to-robot imitation: the human skeleton frame every motion source is converted
-//! to, and the detection of which of the human's feet support the body.
+//! Human-to-robot imitation: a stream of human frames in, executable robot postures out.
 //!
 //! A motion source (a BVH file, a Kinect stream; see [`crate::io`]) yields one
-//! [`crate::human::HumanFrame`] per time step: named joint positions in metres in a right-handed frame
-//! with z up. [`support::SupportDetector`] turns the stream of frames into a stream of
-//! [`support::HumanSupport`] phases (Poubel §III.A). [`phase::PhaseMachine`] turns those into the
-//! robot's [`phase::SupportPhase`] (DS, RS, LS and the two-step transitions of Table I), ending
-//! each transition step on measured conditions; [`tables::TaskTables`] says, per phase, which
-//! model root, equality levels and gradient tasks the IK solves (Table I as data).
-//! [`imitator::Imitator`] runs the whole pipeline frame by frame; [`crate::batch`] runs it over
-//! many clips in parallel.
+//! [`crate::human::HumanFrame`] per time step: named joint positions in metres in a right-handed
+//! frame with z up. [`imitator::Imitator`] runs the pipeline frame by frame ([`crate::batch`] over
+//! many clips in parallel). The rooms, bottom up (a room imports only rooms before it in this
+//! list, besides the [`config`] and [`error`] every room shares):
+//!
+//! * [`reference`](mod@reference): what is read off the human: which feet support the body
+//!   ([`reference::support::SupportDetector`], Poubel §III.A), the human scaled to the robot
+//!   (eq. 1), a recorded clip's contact events with a scene;
+//! * [`phase`]: the robot's support phase ([`phase::PhaseMachine`]: DS, RS, LS and the two-step
+//!   transitions of Table I, each step ended on measured conditions), the task tables that say
+//!   what is solved in each phase ([`phase::tables::TaskTables`], Table I as data) and the
+//!   prioritized solve of one phase's table; [`shaping`]: the speed of the references that
+//!   decide whether the robot stays up;
+//! * [`output`]: what a frame returns ([`output::RobotFrame`]); [`reach`]: what the robot's arm
+//!   can reach;
+//! * [`walking`]: the robot's own steps where the human steps (footstep planning, the look-ahead
+//!   of an offline clip, the pattern generator inside the imitation);
+//! * the two methods, [`poubel`] (the default) and [`koenemann`], on the robot's state both
+//!   share (a private module);
+//! * [`imitator`]: the dispatcher a user holds; [`metrics`]: what a run did, measured frame by
+//!   frame (hands, balance, travel, walking, clearance).
 
-pub mod clearance;
 pub mod config;
-pub mod contact_events;
 pub mod error;
-pub mod footsteps;
-pub mod hand_support;
 pub mod imitator;
 pub mod koenemann;
-pub mod look_ahead;
 pub mod metrics;
 pub mod output;
 pub mod phase;
-mod phase_solver;
-mod poubel;
+pub mod poubel;
 pub mod reach;
-pub mod scaler;
+pub mod reference;
 pub mod shaping;
-mod shoulder_anchor;
 mod state;
-pub mod support;
-pub mod tables;
-pub mod travel;
 pub mod walking;
-mod zmp_balance;
+
+// The paths of the modules before they moved into their rooms, kept for one release.
+#[doc(hidden)]
+pub use metrics::{clearance, travel};
+#[doc(hidden)]
+pub use phase::tables;
+#[doc(hidden)]
+pub use poubel::hand_support;
+#[doc(hidden)]
+pub use reference::{contact_events, scaler, support};
+#[doc(hidden)]
+pub use walking::{footsteps, look_ahead};

@@ -2,9 +2,9 @@
 
 use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 
-use super::phase::SupportPhase;
-use super::support::HumanSupport;
 use crate::human::{HumanJoint, Side};
+use crate::imitation::phase::SupportPhase;
+use crate::imitation::reference::support::HumanSupport;
 use crate::locomotion::{Footstep, WalkState};
 use crate::robots::BipedProfile;
 use crate::scene::SurfaceShape;
@@ -54,12 +54,12 @@ pub struct RobotFrame {
     /// Time of the human frame (s).
     pub human_time: f64,
     /// Whether the imitator waits for a hand to be placed before its contact (Algorithm 1 of
-    /// [`super::hand_support`]): the caller should feed the same human frame again, so that
+    /// [`crate::imitation::poubel::hand_support`]): the caller should feed the same human frame again, so that
     /// the human's clock pauses while the robot's runs on.
     pub awaiting_contact: bool,
     /// Each hand's support (`[left, right]`, robot world frame) while it is placed or held.
     pub hand_supports: [Option<HandPlacement>; 2],
-    /// Joint angles in the model's variable order (rad); names in [`Imitator::variable_names`](super::imitator::Imitator::variable_names).
+    /// Joint angles in the model's variable order (rad); names in [`Imitator::variable_names`](crate::imitation::imitator::Imitator::variable_names).
     pub q: Vec<f64>,
     /// What to command the robot's position servos (model variable order, rad): `q` plus the
     /// deflection under which servos of the profile's stiffness hold this posture's static load
@@ -122,7 +122,7 @@ pub struct RobotFrame {
     /// Feet not on their targets after this frame: the steps the robot still has to take
     /// (0, 1 or 2).
     pub pending_steps: usize,
-    /// The walking pattern generator's state while the robot walks ([`super::walking`]):
+    /// The walking pattern generator's state while the robot walks ([`crate::imitation::walking`]):
     /// the planned CoM, ZMP and soles (world frame); `None` while it stands.
     pub walk: Option<WalkState>,
     /// The walk's footsteps not yet landed, the one under way first (world frame); empty while

@@ -2,15 +2,15 @@
 //! the profile and its models' forward kinematics at the current posture, the root sole and
 //! its world placement, the joint bounds, the robot's clock and the output frame; and the
 //! helpers both methods build it with. Below both methods, so that neither imports the
-//! dispatcher ([`super::imitator`]).
+//! dispatcher ([`crate::imitation::imitator`]).
 
 use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 
-use super::config::ImitatorConfig;
-use super::error::ImitationError;
-use super::output::{RobotFrame, effector_frames};
-use super::phase::SupportPhase;
 use crate::human::{HumanFrame, HumanJoint, Side};
+use crate::imitation::config::ImitatorConfig;
+use crate::imitation::error::ImitationError;
+use crate::imitation::output::{RobotFrame, effector_frames};
+use crate::imitation::phase::SupportPhase;
 use crate::locomotion::GroundPose;
 use crate::model::{FrameId, Model, ModelData, ModelError};
 use crate::robots::BipedProfile;
@@ -112,7 +112,9 @@ impl Shared {
     /// repeated time, which pauses the human's clock for that long (the robot's runs on).
     pub(crate) fn begin_frame(&mut self, time: f64) -> Result<f64, ImitationError> {
         if !time.is_finite() {
-            return Err(super::scaler::ScaleError::NonFiniteTime(time).into());
+            return Err(
+                crate::imitation::reference::scaler::ScaleError::NonFiniteTime(time).into(),
+            );
         }
         match self.previous_time {
             None => Ok(self.nominal_dt),

@@ -283,7 +283,9 @@ fn a_dynamic_walk_finishes_within_the_automatic_hold() {
     let path = mocap("cmu_131_01_start_walk_stop_maxskel.bvh");
     let source = Clip::open(&path).unwrap();
     let mut config = ImitatorConfig {
-        support: taskstack::imitation::support::SupportConfig::for_capture(source.capture()),
+        support: taskstack::imitation::reference::support::SupportConfig::for_capture(
+            source.capture(),
+        ),
         ..ImitatorConfig::default()
     };
     config.footsteps.follow = true;

@@ -9,7 +9,7 @@ use taskstack::batch::imitate_clip;
 use taskstack::export::{
     ExportError, MotionRecorder, MotionTrack, NpyArray, write_motion_npz, write_npz,
 };
-use taskstack::imitation::support::SupportConfig;
+use taskstack::imitation::reference::support::SupportConfig;
 use taskstack::io::clip::Clip;
 use taskstack::model::Model;
 use taskstack::robots::{BipedProfile, g1, nao};

@@ -5,7 +5,7 @@
 
 use taskstack::human::{HumanFrame, HumanJoint};
 use taskstack::imitation::imitator::{ImitationError, Imitator, ImitatorConfig, RobotFrame};
-use taskstack::imitation::scaler::ScaleError;
+use taskstack::imitation::reference::scaler::ScaleError;
 use taskstack::imitation::shaping::MotionLimits;
 use taskstack::io::clip::Clip;
 use taskstack::model::ModelError;

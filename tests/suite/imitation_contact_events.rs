@@ -3,7 +3,7 @@
 
 use taskstack::Vector3;
 use taskstack::human::{HumanFrame, HumanJoint};
-use taskstack::imitation::contact_events::{
+use taskstack::imitation::reference::contact_events::{
     ContactChange, ContactConfig, ContactError, ContactEvent, ContactLink, contact_events,
 };
 use taskstack::io::clip::Clip;

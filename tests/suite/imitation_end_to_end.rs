@@ -13,14 +13,14 @@ use crate::common;
 
 use taskstack::human::{HumanFrame, HumanJoint, Side};
 use taskstack::imitation::config::ImitationMethod;
-use taskstack::imitation::footsteps::FootstepConfig;
 use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
 use taskstack::imitation::koenemann::KoenemannConfig;
-use taskstack::imitation::look_ahead::{FootLookAhead, FootSchedule};
 use taskstack::imitation::metrics::{ImitationMetrics, MetricsRecorder};
 use taskstack::imitation::phase::SupportPhase;
+use taskstack::imitation::reference::support::SupportConfig;
 use taskstack::imitation::shaping::MotionLimits;
-use taskstack::imitation::support::SupportConfig;
+use taskstack::imitation::walking::footsteps::FootstepConfig;
+use taskstack::imitation::walking::look_ahead::{FootLookAhead, FootSchedule};
 use taskstack::io::clip::Clip;
 use taskstack::locomotion::WalkParams;
 use taskstack::robots::nao;
@@ -457,7 +457,7 @@ fn a_walk_at_full_speed_keeps_the_invariants() {
 fn overridden_tables_are_solved_and_reported_whole() {
     use taskstack::human::HumanJoint;
     use taskstack::imitation::phase::PhaseConfig;
-    use taskstack::imitation::tables::{Axes, PointTarget, Task, TaskTables};
+    use taskstack::imitation::phase::tables::{Axes, PointTarget, Task, TaskTables};
     let mut tables = TaskTables::contact_first(&PhaseConfig::default(), &nao::profile());
     for phase in SupportPhase::ALL {
         let mut table = tables.table(phase).clone();

@@ -10,9 +10,9 @@
 //! * joint and velocity limits hold.
 
 use taskstack::human::{HumanFrame, Side};
-use taskstack::imitation::contact_events::ContactConfig;
-use taskstack::imitation::hand_support::{HandContactPlan, HandSupportConfig};
 use taskstack::imitation::metrics::MetricsRecorder;
+use taskstack::imitation::poubel::hand_support::{HandContactPlan, HandSupportConfig};
+use taskstack::imitation::reference::contact_events::ContactConfig;
 use taskstack::io::clip::Clip;
 use taskstack::nalgebra::{Vector2, Vector3};
 use taskstack::robots::nao;
@@ -314,8 +314,10 @@ fn bad_settings_are_refused_by_name() {
 
 #[test]
 fn a_plan_refuses_events_that_do_not_fit_the_clip_or_the_scene() {
-    use taskstack::imitation::contact_events::{ContactChange, ContactEvent, ContactLink};
-    use taskstack::imitation::hand_support::HandSupportError;
+    use taskstack::imitation::poubel::hand_support::HandSupportError;
+    use taskstack::imitation::reference::contact_events::{
+        ContactChange, ContactEvent, ContactLink,
+    };
     let frames = clip();
     let scene = Scene::from_toml_file(format!("{DIR}/stool_23_19.toml")).unwrap();
     let event = |surface, frame, time| ContactEvent {

@@ -6,7 +6,7 @@ use taskstack::imitation::koenemann::mapping::{Calibration, Limbs, Posture, Post
 use taskstack::imitation::koenemann::offset::{OffsetSpeed, offset};
 use taskstack::imitation::koenemann::retarget::{FootRetargeting, retarget_double, support_normal};
 use taskstack::imitation::koenemann::support_mode::{SupportMode, target_offset};
-use taskstack::imitation::support::HumanSupport as H;
+use taskstack::imitation::reference::support::HumanSupport as H;
 
 fn v(x: f64, y: f64, z: f64) -> Vector3<f64> {
     Vector3::new(x, y, z)

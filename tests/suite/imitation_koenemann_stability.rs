@@ -16,7 +16,7 @@ use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
 use taskstack::imitation::koenemann::KoenemannConfig;
 use taskstack::imitation::output::RobotFrame;
 use taskstack::imitation::phase::SupportPhase;
-use taskstack::imitation::support::SupportConfig;
+use taskstack::imitation::reference::support::SupportConfig;
 use taskstack::io::clip::Clip;
 use taskstack::robots::{BipedProfile, nao};
 

@@ -2,11 +2,13 @@
 
 use proptest::prelude::*;
 use taskstack::human::Side;
+use taskstack::imitation::phase::tables::{
+    ComGoal, Gradient, GradientKind, TableError, Task, TaskTables,
+};
 use taskstack::imitation::phase::{
     Landing, Measurements, PhaseConfig, PhaseError, PhaseMachine, Settling, SupportPhase, TakeOff,
 };
-use taskstack::imitation::support::HumanSupport;
-use taskstack::imitation::tables::{ComGoal, Gradient, GradientKind, TableError, Task, TaskTables};
+use taskstack::imitation::reference::support::HumanSupport;
 use taskstack::robots::nao;
 
 use HumanSupport as H;
@@ -501,7 +503,7 @@ fn walking_tables_centre_the_stance_and_keep_bodies_apart_first() {
     let executable = TaskTables::executable(&PhaseConfig::default(), &profile);
     let mut walking = executable.clone();
     walking.centre_stances_for_walking(&profile);
-    let names = |t: &taskstack::imitation::tables::TaskTable| -> Vec<String> {
+    let names = |t: &taskstack::imitation::phase::tables::TaskTable| -> Vec<String> {
         t.levels.iter().map(|l| l.name.clone()).collect()
     };
     // The left sole's FSRs span x ∈ [−30.25, 70.25] mm, y ∈ [−23.1, 29.9] mm.
@@ -510,13 +512,13 @@ fn walking_tables_centre_the_stance_and_keep_bodies_apart_first() {
         Side::Right => [0.02, -0.0034],
     };
     for (before, after) in executable.iter().zip(walking.iter()) {
-        let level = |t: &taskstack::imitation::tables::TaskTable, name: &str| {
+        let level = |t: &taskstack::imitation::phase::tables::TaskTable, name: &str| {
             names(t).iter().position(|n| n == name)
         };
         assert!(level(before, "collision") > level(before, "balance"));
         assert_eq!(level(after, "collision"), level(before, "balance"));
         assert_eq!(level(after, "balance"), level(before, "collision"));
-        let goal = |t: &taskstack::imitation::tables::TaskTable| {
+        let goal = |t: &taskstack::imitation::phase::tables::TaskTable| {
             t.levels
                 .iter()
                 .flat_map(|l| &l.tasks)
@@ -749,13 +751,13 @@ proptest! {
     }
 }
 
-/// The docs include `src/imitation/table1.md`; it must be exactly the rendering of the data.
+/// The docs include `src/imitation/phase/table1.md`; it must be exactly the rendering of the data.
 #[test]
 fn checked_in_table_matches_the_data() {
     assert_eq!(
-        include_str!("../../src/imitation/table1.md"),
+        include_str!("../../src/imitation/phase/table1.md"),
         TaskTables::paper(&nao::profile()).to_string(),
-        "regenerate with `cargo run --example table1 > src/imitation/table1.md`"
+        "regenerate with `cargo run --example table1 > src/imitation/phase/table1.md`"
     );
 }
 
@@ -765,7 +767,7 @@ fn checked_in_table_matches_the_data() {
 /// margin is refused.
 #[test]
 fn executable_tables_keep_the_bodies_apart_below_balance() {
-    use taskstack::imitation::tables::Constraint;
+    use taskstack::imitation::phase::tables::Constraint;
     let profile = nao::profile();
     let tables = TaskTables::executable(&PhaseConfig::default(), &profile);
     let pairs = profile.self_collision.pairs.len();
@@ -816,7 +818,7 @@ fn executable_tables_keep_the_bodies_apart_below_balance() {
 /// the collision level, with room for both soles' outlines; a bound that is not > 0 is refused.
 #[test]
 fn zmp_balance_sits_below_the_feet_and_the_com() {
-    use taskstack::imitation::tables::Constraint;
+    use taskstack::imitation::phase::tables::Constraint;
     let profile = nao::profile();
     let mut tables = TaskTables::executable(&PhaseConfig::default(), &profile);
     tables.add_zmp_balance(&profile);

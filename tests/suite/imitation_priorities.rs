@@ -9,8 +9,8 @@
 use nalgebra::Vector3;
 use proptest::prelude::*;
 use taskstack::human::Side;
+use taskstack::imitation::phase::tables::{Task, TaskTable, TaskTables};
 use taskstack::imitation::phase::{PhaseConfig, SupportPhase};
-use taskstack::imitation::tables::{Task, TaskTable, TaskTables};
 use taskstack::model::{Axis, Model};
 use taskstack::robots::nao;
 use taskstack::solver::{Solver, StackShape};

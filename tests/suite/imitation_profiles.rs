@@ -7,7 +7,7 @@
 use taskstack::human::HumanFrame;
 use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
 use taskstack::imitation::metrics::{ImitationMetrics, MetricsRecorder};
-use taskstack::imitation::support::SupportConfig;
+use taskstack::imitation::reference::support::SupportConfig;
 use taskstack::io::clip::Clip;
 use taskstack::robots::{BipedProfile, ProfileError, g1};
 

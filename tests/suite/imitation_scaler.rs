@@ -8,10 +8,10 @@ use nalgebra::{Rotation3, Vector3};
 use proptest::prelude::*;
 use taskstack::human::Side;
 use taskstack::human::{HumanFrame, HumanJoint as J};
-use taskstack::imitation::scaler::{
+use taskstack::imitation::reference::scaler::{
     RobotSkeleton, ScaleConfig, ScaleError, ScaledSkeleton, Scaler, Stance,
 };
-use taskstack::imitation::support::{HumanSupport, SupportConfig, SupportDetector};
+use taskstack::imitation::reference::support::{HumanSupport, SupportConfig, SupportDetector};
 use taskstack::io::bvh::{BvhConfig, BvhReader};
 use taskstack::robots::nao;
 use taskstack::robots::{HumanJointAngles, RobotPoint};

@@ -5,7 +5,9 @@ use nalgebra::Vector3;
 use proptest::prelude::*;
 use taskstack::human::Side;
 use taskstack::human::{HumanFrame, HumanJoint as J};
-use taskstack::imitation::support::{HumanSupport, SupportConfig, SupportDetector, SupportError};
+use taskstack::imitation::reference::support::{
+    HumanSupport, SupportConfig, SupportDetector, SupportError,
+};
 use taskstack::io::bvh::{BvhConfig, BvhReader};
 use taskstack::io::kinect::{KinectConfig, KinectReader};
 

@@ -9,9 +9,9 @@ use taskstack::human::HumanFrame;
 use taskstack::imitation::config::ImitationMethod;
 use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
 use taskstack::imitation::koenemann::KoenemannConfig;
+use taskstack::imitation::phase::tables::{OrientationTarget, Task, TaskTables};
 use taskstack::imitation::phase::{PhaseConfig, SupportPhase};
-use taskstack::imitation::support::SupportConfig;
-use taskstack::imitation::tables::{OrientationTarget, Task, TaskTables};
+use taskstack::imitation::reference::support::SupportConfig;
 use taskstack::io::clip::Clip;
 use taskstack::robots::{BipedProfile, g1, nao};
 

@@ -5,7 +5,7 @@
 
 use taskstack::human::HumanFrame;
 use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
-use taskstack::imitation::support::SupportConfig;
+use taskstack::imitation::reference::support::SupportConfig;
 use taskstack::io::clip::Clip;
 use taskstack::robots::{BipedProfile, g1, nao};
 

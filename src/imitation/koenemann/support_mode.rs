@@ -6,7 +6,7 @@
 //! on that foot alone. The target of the offset is the human's own offset in double support,
 //! and the support foot's end (0 or 1) in single support.
 
-use crate::imitation::support::HumanSupport;
+use crate::imitation::reference::support::HumanSupport;
 
 /// The robot's support mode.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

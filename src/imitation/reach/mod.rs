@@ -3,7 +3,7 @@
 //!
 //! A hand's scaled reference is placed from the *scaled* shoulder with the robot's segment
 //! lengths ([`super::scaler`], eq. 1), so it is always within the arm's length of that point;
-//! Poubel's method then hangs the arm from the robot's shoulder (`imitation::shoulder_anchor`),
+//! Poubel's method then hangs the arm from the robot's shoulder (`imitation::poubel::shoulder_anchor`),
 //! which leaves the references the robot's elbow cannot fold to.
 //! The robot's own shoulder is elsewhere whenever its trunk does not follow the scaled one: the
 //! tables hold the torso upright over the stance foot, a robot standing on bent knees carries

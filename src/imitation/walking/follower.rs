@@ -5,10 +5,10 @@ use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 
 use crate::human::Side;
 use crate::imitation::error::ImitationError;
-use crate::imitation::footsteps::{FootstepConfig, GroundPose};
 use crate::imitation::output::QUEUE_AHEAD;
+use crate::imitation::phase::solver::{Criteria, FrameTargets, PhaseSolver, own_joints};
 use crate::imitation::phase::{Landing, SupportPhase};
-use crate::imitation::phase_solver::{Criteria, FrameTargets, PhaseSolver, own_joints};
+use crate::imitation::walking::footsteps::{FootstepConfig, GroundPose};
 use crate::locomotion::footstep::{mean_heading, wrap_angle};
 use crate::locomotion::preview::GRAVITY;
 use crate::locomotion::schedule::smooth;

@@ -1,5 +1,7 @@
-//! Walking where the human walks: the [pattern generator](crate::locomotion) inside the
-//! imitation.
+//! Walking where the human walks: where the robot puts its feet ([`footsteps`]: the human's
+//! footprints scaled to robot steps), what an offline clip tells of the human's steps ahead
+//! ([`look_ahead`]), and the [pattern generator](crate::locomotion) inside the imitation (this
+//! module).
 //!
 //! **Experimental**: with [`FootstepConfig::follow`] and [`FootstepConfig::dynamic`] on, a
 //! robot standing
@@ -27,15 +29,15 @@
 //! (about 0.02 m/s), pivot turns are not followed, and the G1's walk falls (issue 29's notes).
 //!
 //! [`PatternGenerator`]: crate::locomotion::PatternGenerator
-//! [`FootstepConfig::follow`]: super::footsteps::FootstepConfig::follow
-//! [`FootstepConfig::dynamic`]: super::footsteps::FootstepConfig::dynamic
-//! [`long_stance_time`]: super::footsteps::FootstepConfig::long_stance_time
+//! [`FootstepConfig::follow`]: footsteps::FootstepConfig::follow
+//! [`FootstepConfig::dynamic`]: footsteps::FootstepConfig::dynamic
+//! [`long_stance_time`]: footsteps::FootstepConfig::long_stance_time
 //!
 //! Units: metres, radians, seconds; world frame as the imitation's.
 
-pub(super) mod follower;
-mod meter;
+pub(crate) mod follower;
+pub mod footsteps;
+pub mod look_ahead;
 mod table;
 
-pub use meter::{WalkMeter, WalkingSummary};
 pub use table::{walking_arms_table, walking_table};

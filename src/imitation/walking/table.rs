@@ -3,7 +3,7 @@
 
 use crate::human::{HumanJoint, Side};
 use crate::imitation::phase::SupportPhase;
-use crate::imitation::tables::{
+use crate::imitation::phase::tables::{
     Axes, ComGoal, Gradient, Level, OrientationTarget, PointTarget, Task, TaskTable,
     self_collision_level,
 };
@@ -119,7 +119,7 @@ mod tests {
 
     use super::*;
     use crate::human::HumanJoint;
-    use crate::imitation::phase_solver::{Criteria, FrameTargets, PhaseSolver, own_joints};
+    use crate::imitation::phase::solver::{Criteria, FrameTargets, PhaseSolver, own_joints};
     use crate::robots::nao;
     use crate::solver::driver::DriverSettings;
     use crate::solver::{JointLimitAvoidance, JointTracking, Settings};

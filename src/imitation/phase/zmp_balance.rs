@@ -1,9 +1,9 @@
 //! The support polygon of a phase for its ZMP rows
-//! ([`Constraint::Zmp`](super::tables::Constraint::Zmp)): the root sole's contact area, with
+//! ([`Constraint::Zmp`](crate::imitation::phase::tables::Constraint::Zmp)): the root sole's contact area, with
 //! the other sole's where the phase stands on both feet, as their convex hull in the root frame
 //! at the start of each frame.
 
-use super::tables::TaskTable;
+use crate::imitation::phase::tables::TaskTable;
 use crate::model::{FrameId, Model, ModelData};
 use crate::robots::BipedProfile;
 use crate::tasks::{TaskError, ZmpTask, convex_hull};
@@ -11,8 +11,8 @@ use crate::tasks::{TaskError, ZmpTask, convex_hull};
 /// A phase's ZMP rows with the polygon they keep the ZMP in. Buffers are allocated once;
 /// [`SupportZmp::begin_frame`] allocates nothing.
 #[derive(Debug, Clone)]
-pub(super) struct SupportZmp {
-    pub(super) task: ZmpTask,
+pub(crate) struct SupportZmp {
+    pub(crate) task: ZmpTask,
     margin: f64,
     /// The contact areas (sole frame, m): the root's, and the other sole's when it stands.
     root: Vec<[f64; 2]>,
@@ -25,7 +25,7 @@ impl SupportZmp {
     /// The rows of a ZMP constraint of `margin` (m) and `max_yaw_moment` (N·m) with room for
     /// `vertices` polygon corners, for `table`'s phase on `model`, seeing the momentum of the
     /// joints `arms` (one per variable).
-    pub(super) fn new(
+    pub(crate) fn new(
         table: &TaskTable,
         profile: &BipedProfile,
         model: &Model,
@@ -59,7 +59,7 @@ impl SupportZmp {
 
     /// Sets the polygon from the other sole's placement in `data` (the frame's start) and
     /// starts the task's frame (see [`ZmpTask::begin_frame`]).
-    pub(super) fn begin_frame(
+    pub(crate) fn begin_frame(
         &mut self,
         data: &ModelData,
         start: &[f64],
@@ -86,7 +86,7 @@ impl SupportZmp {
 /// frame's step into an acceleration. Zero before the second frame. Allocates nothing after
 /// [`JointVelocity::new`].
 #[derive(Debug, Clone)]
-pub(super) struct JointVelocity {
+pub(crate) struct JointVelocity {
     start: Vec<f64>,
     velocity: Vec<f64>,
     /// The length of the frame that began at `start` (s); `None` before the first.
@@ -95,7 +95,7 @@ pub(super) struct JointVelocity {
 
 impl JointVelocity {
     /// For `nv` variables, at rest.
-    pub(super) fn new(nv: usize) -> Self {
+    pub(crate) fn new(nv: usize) -> Self {
         Self {
             start: vec![0.0; nv],
             velocity: vec![0.0; nv],
@@ -105,7 +105,7 @@ impl JointVelocity {
 
     /// At the start of a frame of `dt` seconds at posture `q`: the velocity of the frame that
     /// ends here becomes [`JointVelocity::get`].
-    pub(super) fn begin(&mut self, q: &[f64], dt: f64) {
+    pub(crate) fn begin(&mut self, q: &[f64], dt: f64) {
         if let Some(previous) = self.dt {
             for ((v, &q), &q0) in self.velocity.iter_mut().zip(q).zip(&self.start) {
                 *v = (q - q0) / previous;
@@ -116,7 +116,7 @@ impl JointVelocity {
     }
 
     /// The joints' velocity over the last frame.
-    pub(super) fn get(&self) -> &[f64] {
+    pub(crate) fn get(&self) -> &[f64] {
         &self.velocity
     }
 }

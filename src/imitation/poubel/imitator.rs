@@ -27,31 +27,33 @@ use std::time::Instant;
 
 use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 
-use super::footsteps::{FootstepPlanner, GroundPose, StepRequest};
-use super::hand_support::{HandSupports, HandView, hand_point};
-use super::output::CONTACT_HEIGHT;
-use super::phase::{
+use crate::human::{HumanFrame, Side};
+use crate::imitation::output::CONTACT_HEIGHT;
+use crate::imitation::phase::solver::{Criteria, FrameTargets, PhaseSolver};
+use crate::imitation::phase::tables::{PointTarget, Task, TaskTable, TaskTables};
+use crate::imitation::phase::{
     Measurements, PhaseConfig, PhaseMachine, Settling, SupportKind, SupportPhase, TakeOff,
 };
-use super::phase_solver::{Criteria, FrameTargets, PhaseSolver};
-use super::reach::Arm;
-use super::scaler::{RobotSkeleton, ScaleConfig, Scaler};
-use super::shaping::{ComReference, HandRates, HandSpeed, MotionLimits, StartRamp, SwingHeight};
-use super::shoulder_anchor::hang_arms_from_robot_shoulders;
-use super::state::{Shared, effector_ids, ground_pose, human_stance, velocity_bounds};
-use super::support::{HumanSupport, SupportDetector};
-use super::tables::{PointTarget, Task, TaskTable, TaskTables};
-use super::walking::follower::WalkFollower;
-use crate::human::{HumanFrame, Side};
+use crate::imitation::poubel::hand_support::{HandSupports, HandView, hand_point};
+use crate::imitation::poubel::shoulder_anchor::hang_arms_from_robot_shoulders;
+use crate::imitation::reach::Arm;
+use crate::imitation::reference::scaler::{RobotSkeleton, ScaleConfig, Scaler};
+use crate::imitation::reference::support::{HumanSupport, SupportDetector};
+use crate::imitation::shaping::{
+    ComReference, HandRates, HandSpeed, MotionLimits, StartRamp, SwingHeight,
+};
+use crate::imitation::state::{Shared, effector_ids, ground_pose, human_stance, velocity_bounds};
+use crate::imitation::walking::follower::WalkFollower;
+use crate::imitation::walking::footsteps::{FootstepPlanner, GroundPose, StepRequest};
 use crate::model::FrameId;
 use crate::robots::{BipedProfile, HumanJointAngles};
 use crate::solver::driver::DriverSettings;
 use crate::solver::{JointBounds, JointLimitAvoidance, JointTracking, Settings, SolverError};
 
-use super::config::ImitatorConfig;
-use super::error::ImitationError;
-use super::output::{EFFECTORS, RobotFrame, effector_frames};
-use super::zmp_balance::JointVelocity;
+use crate::imitation::config::ImitatorConfig;
+use crate::imitation::error::ImitationError;
+use crate::imitation::output::{EFFECTORS, RobotFrame, effector_frames};
+use crate::imitation::phase::zmp_balance::JointVelocity;
 
 /// Poubel et al.'s imitator.
 pub(crate) struct PoubelImitator {
@@ -69,7 +71,7 @@ pub(crate) struct PoubelImitator {
     /// Largest speed of the hand targets.
     hand_speed: HandSpeed,
     /// Whether the hands follow the human while the robot walks
-    /// ([`FootstepConfig::walking_arms`](super::footsteps::FootstepConfig::walking_arms)).
+    /// ([`FootstepConfig::walking_arms`](crate::imitation::walking::footsteps::FootstepConfig::walking_arms)).
     walking_arms: bool,
     /// The hands' speeds toward their targets, shaped frame by frame.
     hand_rates: HandRates,
@@ -96,7 +98,7 @@ pub(crate) struct PoubelImitator {
     start: StartRamp,
     /// Hands as supports, when configured.
     hands: Option<HandSupports>,
-    /// The walk, when the feet follow the human's ([`super::walking`]).
+    /// The walk, when the feet follow the human's ([`crate::imitation::walking`]).
     walk: Option<WalkFollower>,
     /// Whether the next support-phase frame takes its held targets afresh (after a walk).
     rehold: bool,
@@ -144,7 +146,7 @@ fn phase_solvers(
         .collect()
 }
 
-/// `bounds` with each arm's elbow kept in its interval ([`super::reach::Elbow::interval`]),
+/// `bounds` with each arm's elbow kept in its interval ([`crate::imitation::reach::Elbow::interval`]),
 /// widened to include the posture `q`: the hands' IK never straightens an elbow.
 fn elbows_kept_bent(
     bounds: &JointBounds,

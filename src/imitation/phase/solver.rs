@@ -6,14 +6,14 @@
 use faer::MatMut;
 use nalgebra::{Rotation3, Vector2, Vector3};
 
-use super::error::ImitationError;
-use super::footsteps::GroundPose;
-use super::tables::{
+use crate::human::{HumanJoint, Side};
+use crate::imitation::error::ImitationError;
+use crate::imitation::phase::tables::{
     Axes, ComGoal, Constraint, Gradient, GradientKind, OrientationTarget, PointTarget, Task,
     TaskTable,
 };
-use super::zmp_balance::SupportZmp;
-use crate::human::{HumanJoint, Side};
+use crate::imitation::phase::zmp_balance::SupportZmp;
+use crate::imitation::walking::footsteps::GroundPose;
 use crate::model::{Axis, FrameId, Model, ModelData};
 use crate::robots::BipedProfile;
 use crate::solver::driver::{DriverReport, DriverSettings, PositionDriver, TaskModel};
@@ -78,51 +78,51 @@ enum ConstraintRows {
 
 /// What the tasks of a phase aim at in one frame, in the model root's frame.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct FrameTargets<'a> {
+pub(crate) struct FrameTargets<'a> {
     /// The scaled human (m): the targets of the `Scaled` points.
-    pub(super) reference: &'a [Option<Vector3<f64>>; HumanJoint::COUNT],
+    pub(crate) reference: &'a [Option<Vector3<f64>>; HumanJoint::COUNT],
     /// The shaped CoM ground projection (m).
-    pub(super) com: Vector2<f64>,
+    pub(crate) com: Vector2<f64>,
     /// The shaped swing height (m) that replaces the lift of `Held` targets.
-    pub(super) swing_lift: f64,
+    pub(crate) swing_lift: f64,
     /// The swing foot's target footprint, while the robot steps.
-    pub(super) footstep: Option<GroundPose>,
+    pub(crate) footstep: Option<GroundPose>,
     /// The hands' targets (`[left, right]`, m): the scaled human's hands within the arms'
-    /// reach ([`super::reach::Arm::within_reach`]); the targets of the `Scaled` hand points.
-    pub(super) hands: [Option<Vector3<f64>>; 2],
+    /// reach ([`crate::imitation::reach::Arm::within_reach`]); the targets of the `Scaled` hand points.
+    pub(crate) hands: [Option<Vector3<f64>>; 2],
     /// Largest error (m) a task following the scaled human asks for in one iteration, the
     /// hands' excepted.
-    pub(super) tracking_step: f64,
+    pub(crate) tracking_step: f64,
     /// The same for each hand's task (`[left, right]`) following the human (m). A hand placed
     /// on a surface moves at the task speed, as the feet do.
-    pub(super) hand_steps: [f64; 2],
+    pub(crate) hand_steps: [f64; 2],
     /// The hands' contact points (`[left, right]`) while they are placed or held as supports.
-    pub(super) hand_contacts: [Option<Vector3<f64>>; 2],
+    pub(crate) hand_contacts: [Option<Vector3<f64>>; 2],
     /// The walk's up direction of the torso (unit): the target of
     /// [`OrientationTarget::Leaning`].
-    pub(super) up: Vector3<f64>,
+    pub(crate) up: Vector3<f64>,
     /// The CoM's height above the root sole (m): the target of [`Task::ComHeight`].
-    pub(super) com_height: f64,
+    pub(crate) com_height: f64,
     /// The share of [`PointTarget::Standing`]'s lowering asked for, in [0, 1]: below 1 at the
-    /// start ([`super::shaping::StartRamp`]).
-    pub(super) lowering_share: f64,
+    /// start ([`crate::imitation::shaping::StartRamp`]).
+    pub(crate) lowering_share: f64,
     /// The joints' velocity over the frame before (per second, one per model variable): the
     /// start of the frame's acceleration for a [`Constraint::Zmp`]; empty when the table has
     /// none.
-    pub(super) joint_velocity: &'a [f64],
+    pub(crate) joint_velocity: &'a [f64],
 }
 
 /// The gradient criteria of the imitator, shared by every phase.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct Criteria<'a> {
-    pub(super) limits: &'a JointLimitAvoidance,
-    pub(super) tracking: &'a JointTracking,
+pub(crate) struct Criteria<'a> {
+    pub(crate) limits: &'a JointLimitAvoidance,
+    pub(crate) tracking: &'a JointTracking,
 }
 
 /// Everything one phase needs: its table resolved, a solver and a driver sized for it.
 #[derive(Debug)]
-pub(super) struct PhaseSolver {
-    pub(super) table: TaskTable,
+pub(crate) struct PhaseSolver {
+    pub(crate) table: TaskTable,
     tasks: Vec<ResolvedTask>,
     constraints: Vec<ResolvedConstraint>,
     solver: Solver,
@@ -209,7 +209,7 @@ fn axis_list(axes: Axes) -> [Axis; 3] {
 impl PhaseSolver {
     /// `table` resolved against the profile's model rooted at its support sole; standing targets
     /// from `initial_q`.
-    pub(super) fn new(
+    pub(crate) fn new(
         table: &TaskTable,
         profile: &BipedProfile,
         initial_q: &[f64],
@@ -318,7 +318,7 @@ impl PhaseSolver {
     /// model variable): the other columns of every row, and the gradient's entries, are zero
     /// ([`PhaseTasks::evaluate`]), and a constraint between bodies those joints do not move
     /// relative to each other is left out (its rows would be zero).
-    pub(super) fn restricted(
+    pub(crate) fn restricted(
         table: &TaskTable,
         profile: &BipedProfile,
         initial_q: &[f64],
@@ -346,29 +346,29 @@ impl PhaseSolver {
 
     /// Damped levels keep `share` of the last frame's step ([`PhaseSolver::run`]'s step
     /// reference, [`ImitatorConfig::damping_momentum`](super::ImitatorConfig::damping_momentum)).
-    pub(super) fn with_damping_momentum(mut self, share: f64) -> Self {
+    pub(crate) fn with_damping_momentum(mut self, share: f64) -> Self {
         self.damping_momentum = share;
         self
     }
 
     /// Number of tasks (entries of the driver's task errors).
-    pub(super) fn task_count(&self) -> usize {
+    pub(crate) fn task_count(&self) -> usize {
         self.tasks.len()
     }
 
     /// The task names, in stack order.
-    pub(super) fn task_names(&self) -> impl Iterator<Item = String> + '_ {
+    pub(crate) fn task_names(&self) -> impl Iterator<Item = String> + '_ {
         self.tasks.iter().map(|t| t.task.name())
     }
 
     /// The last solve's report (levels, clamped joints).
-    pub(super) fn solve_report(&self) -> &SolveReport {
+    pub(crate) fn solve_report(&self) -> &SolveReport {
         self.solver.report()
     }
 
     /// At the start of a step: the held targets become the points' current positions and the
     /// frames' current headings, from the forward kinematics in `data`.
-    pub(super) fn hold(&mut self, data: &ModelData) {
+    pub(crate) fn hold(&mut self, data: &ModelData) {
         for task in &mut self.tasks {
             if let Some(p) = &task.point {
                 let placement = data.frame_placement(p.frame);
@@ -380,7 +380,7 @@ impl PhaseSolver {
     }
 
     /// The lift (m) of the table's held point, the swing foot's, if it has one.
-    pub(super) fn lift(&self) -> Option<f64> {
+    pub(crate) fn lift(&self) -> Option<f64> {
         self.tasks.iter().find_map(|t| match t.task {
             Task::Point {
                 target: PointTarget::Held { lift },
@@ -392,7 +392,7 @@ impl PhaseSolver {
 
     /// The table's CoM goal in the root frame (m), from the forward kinematics in `data`; `None`
     /// when the table has no CoM task.
-    pub(super) fn com_goal(&self, data: &ModelData) -> Option<Vector2<f64>> {
+    pub(crate) fn com_goal(&self, data: &ModelData) -> Option<Vector2<f64>> {
         self.tasks.iter().find_map(|t| match t.task {
             Task::ComXY(goal) => Some(com_goal(goal, data, self.other_ankle, self.other_sole)),
             _ => None,
@@ -400,7 +400,7 @@ impl PhaseSolver {
     }
 
     /// The CoM task's error in `errors` (stack order, m), 0 without a CoM task.
-    pub(super) fn com_error(&self, errors: &[f64]) -> f64 {
+    pub(crate) fn com_error(&self, errors: &[f64]) -> f64 {
         let com = self
             .tasks
             .iter()
@@ -409,7 +409,7 @@ impl PhaseSolver {
     }
 
     /// The largest error of an upright-posture task in `errors` (stack order, rad), 0 without one.
-    pub(super) fn posture_error(&self, errors: &[f64]) -> f64 {
+    pub(crate) fn posture_error(&self, errors: &[f64]) -> f64 {
         let upright = |t: &ResolvedTask| {
             matches!(
                 t.task,
@@ -430,7 +430,7 @@ impl PhaseSolver {
     /// kinematics kept in `data`, which must hold `q`'s on entry (the frame's first evaluation
     /// does not compute them again): after the call `data` holds the final `q`'s.
     #[allow(clippy::too_many_arguments)] // the frame's inputs, each from a different owner
-    pub(super) fn run(
+    pub(crate) fn run(
         &mut self,
         model: &Model,
         data: &mut ModelData,
@@ -575,7 +575,7 @@ impl PhaseSolver {
     }
 
     /// The last run's driver outcome (iterations, stop reason, task errors).
-    pub(super) fn driver_report(&self) -> &DriverReport {
+    pub(crate) fn driver_report(&self) -> &DriverReport {
         self.driver.report()
     }
 }
@@ -617,7 +617,7 @@ fn balance_joints(
 
 /// The joints that turn `frame` but not `torso` in `model` (at the posture in `data`): a
 /// foot's own leg joints, a hand's own arm joints.
-pub(super) fn own_joints(
+pub(crate) fn own_joints(
     model: &Model,
     data: &ModelData,
     frame: &str,

@@ -55,7 +55,7 @@
 //!
 //! "lift" is the lift gate of [`PhaseMachine::update_gated`] (always open for
 //! [`PhaseMachine::update`]): a robot that shifted its weight ahead of the human's lift-off
-//! ([`super::look_ahead`]) waits for it with both feet down.
+//! ([`crate::imitation::walking::look_ahead`]) waits for it with both feet down.
 //!
 //! Why these edges:
 //! * Aborting "CoM to RFoot" goes straight back to DS: both feet are still on the ground, so the
@@ -76,10 +76,14 @@
 //! sole only while the right foot is in the air or being lowered ("Lift RFoot", LS, "Lower
 //! RFoot").
 
+pub(crate) mod solver;
+pub mod tables;
+pub(crate) mod zmp_balance;
+
 use std::fmt;
 
-use super::support::HumanSupport;
 use crate::human::Side;
+use crate::imitation::reference::support::HumanSupport;
 
 /// The steps of a take-off (DS to a single support), in order.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -526,7 +530,7 @@ impl HoldTimer {
 ///
 /// ```
 /// use taskstack::imitation::phase::{Measurements, PhaseConfig, PhaseMachine, SupportPhase, TakeOff};
-/// use taskstack::imitation::support::HumanSupport;
+/// use taskstack::imitation::reference::support::HumanSupport;
 ///
 /// let mut machine = PhaseMachine::new(PhaseConfig::default())?;
 /// let far = Measurements {
@@ -589,7 +593,7 @@ impl PhaseMachine {
     /// [`PhaseMachine::update`] after `dt` seconds, with the swing foot allowed to leave the
     /// ground only if `lift`: otherwise a finished "CoM to foot" step waits with the weight on
     /// the support foot (the robot shifts its weight ahead of a human lift-off it knows is
-    /// coming, [`super::look_ahead`]). A weight shift ends once its condition has held for
+    /// coming, [`crate::imitation::walking::look_ahead`]). A weight shift ends once its condition has held for
     /// [`PhaseConfig::settle_time`] (counting this `dt`).
     pub fn update_gated(
         &mut self,

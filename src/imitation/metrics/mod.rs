@@ -4,54 +4,59 @@
 //!   reference, in the model root's frame (m), split by single support, double support and the
 //!   transition steps ([`SupportKind`]): on every frame whose phase tracks it. The hands'
 //!   references are the human's arms hung from the robot's shoulders (Poubel's method:
-//!   `imitation::shoulder_anchor`; Koenemann's: its own arm mapping), so the error is the arms'
+//!   `imitation::poubel::shoulder_anchor`; Koenemann's: its own arm mapping), so the error is the arms'
 //!   copy, not the trunk's.
 //! * **Static stability**: the signed distance of the CoM ground projection to the edge of the
 //!   support polygon (positive inside, m): the convex hull of the sole outlines
 //!   ([`FootFrames::outline`](crate::robots::FootFrames::outline)) of the feet on the ground, a foot being on the ground when all its
 //!   outline points are within [`CONTACT_HEIGHT`] of the floor, and the contact points of the
-//!   hands held as supports ([`super::hand_support`]).
+//!   hands held as supports ([`crate::imitation::poubel::hand_support`]).
 //! * **Executability**: joint-limit violations, and velocity-limit violations
 //!   (`|Δq|/Δt > fraction · v_max`), counted per joint and frame.
 //! * **Side slip**: how far a standing foot moved in the world from where it stood at the start
 //!   of its stance, model switches included (m, and rad for its orientation). A foot stands
 //!   when it is the model root or when the phase keeps it on the ground (both feet in DS and in
 //!   the CoM steps of the transitions).
-//! * **Locomotion and timing** ([`super::travel`]): travel of the scaled human and of the robot,
+//! * **Locomotion and timing** ([`crate::imitation::metrics::travel`]): travel of the scaled human and of the robot,
 //!   steps of both, catch-up time after the clip, the hands' lag; tracking errors over the clip's
 //!   own frames apart from the hold that follows it ([`MetricsRecorder::mark_clip_end`]).
-//! * **Reach** ([`super::reach`]): the clip's frames whose hand reference lay beyond the arm's
+//! * **Reach** ([`crate::imitation::reach`]): the clip's frames whose hand reference lay beyond the arm's
 //!   reach from the robot's own shoulder, and by how much (m); and per hand the part of its
 //!   error that no arm posture within the joint limits (and the self-collision margin)
 //!   removes, as far as a multi-start IK of the arm finds: the rest is lateness or an arm
 //!   posture that cannot follow the reference.
-//! * **Hands held as supports** ([`super::hand_support`]): per hand, the contacts made, the
+//! * **Hands held as supports** ([`crate::imitation::poubel::hand_support`]): per hand, the contacts made, the
 //!   time from the start of placing to the contact (s, robot clock), and the distance of the
 //!   held hand from its contact point (m).
-//! * **Self-collision clearance** ([`super::clearance`]): the smallest distance of the
+//! * **Self-collision clearance** ([`crate::imitation::metrics::clearance`]): the smallest distance of the
 //!   profile's paired bodies over the run (m), and the frames closer than the margin.
 //! * **Support changes and transitions**: changes of the human's support and of the robot's
 //!   continuous phase (DS, RS, LS); the time from leaving one continuous phase to reaching the
 //!   next (s). **Solve time** per frame (µs).
 
+pub mod clearance;
+pub mod travel;
+mod walking;
+
+pub use walking::{WalkMeter, WalkingSummary};
+
 use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 
-use super::clearance::{ClearanceMeter, SelfClearance};
-use super::imitator::Imitator;
-use super::output::{HandPlacement, RobotFrame};
-use super::phase::{SupportKind, SupportPhase};
-use super::reach::{HandReach, ReachMeter};
-use super::support::HumanSupport;
-use super::travel::{
+use crate::imitation::imitator::Imitator;
+use crate::imitation::metrics::clearance::{ClearanceMeter, SelfClearance};
+use crate::imitation::metrics::travel::{
     FootTiming, HandTrace, Stance, StepCounter, Travel, TravelRecorder, robot_stance,
 };
-use super::walking::{WalkMeter, WalkingSummary};
+use crate::imitation::output::{HandPlacement, RobotFrame};
+use crate::imitation::phase::{SupportKind, SupportPhase};
+use crate::imitation::reach::{HandReach, ReachMeter};
+use crate::imitation::reference::support::HumanSupport;
 use crate::solver::JointBounds;
 use crate::tasks::{convex_hull, hull_margin};
 
 /// The old paths of `output::CONTACT_HEIGHT` and `output::sole_on_floor`; kept for one
 /// release.
-pub use super::output::{CONTACT_HEIGHT, sole_on_floor};
+pub use crate::imitation::output::{CONTACT_HEIGHT, sole_on_floor};
 
 /// Frames of a run by the kind of the robot's phase.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -86,7 +91,7 @@ pub struct MeanMax {
     pub count: usize,
 }
 
-/// What one hand held as a support achieved ([`super::hand_support`]).
+/// What one hand held as a support achieved ([`crate::imitation::poubel::hand_support`]).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct HeldHand {
     /// Contacts made: the hand reached its contact point and held it.
@@ -261,7 +266,7 @@ impl HeldHandTally {
     }
 }
 
-pub use super::output::EFFECTORS;
+pub use crate::imitation::output::EFFECTORS;
 
 /// Tracking error of one effector.
 #[derive(Debug, Clone, PartialEq)]
@@ -365,7 +370,7 @@ pub struct ImitationMetrics {
     /// The time shift (s) that best aligns the robot's hands with the scaled reference.
     pub hand_lag_s: f64,
     /// Over the clip's frames, how far the hand references lay beyond the arms' reach from the
-    /// robot's shoulders (`[left, right]`; [`super::reach`]); `None` when the profile maps no
+    /// robot's shoulders (`[left, right]`; [`crate::imitation::reach`]); `None` when the profile maps no
     /// shoulder or hand.
     pub hand_reach: Option<[HandReach; 2]>,
     /// How long the human's clock was paused in all while hands were placed on their contacts
@@ -374,7 +379,7 @@ pub struct ImitationMetrics {
     /// The hands held as supports (`[left, right]`); `None` when no hand was placed.
     pub held_hands: Option<[HeldHand; 2]>,
     /// How late the robot lifted each foot after the human lifted the same foot (s; one value
-    /// per paired lift, [`super::travel`]), and `human_lifts` how many the human made.
+    /// per paired lift, [`crate::imitation::metrics::travel`]), and `human_lifts` how many the human made.
     pub lift_lag: Spread,
     /// How late the robot put each foot down after the human (s), paired as `lift_lag`.
     pub landing_lag: Spread,
@@ -397,7 +402,7 @@ pub struct ImitationMetrics {
     /// continuous phase, no step pending, on the human's feet. False after a hold that ended
     /// before the robot did (a fixed one too short, or the cap of an automatic one).
     pub finished: bool,
-    /// The robot's walks ([`super::walking`]); `None` when it never walked.
+    /// The robot's walks ([`crate::imitation::walking`]); `None` when it never walked.
     pub walking: Option<WalkingSummary>,
 }
 

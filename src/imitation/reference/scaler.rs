@@ -56,8 +56,8 @@
 use nalgebra::{Rotation3, Vector2, Vector3};
 use thiserror::Error;
 
-use super::support::HumanSupport;
 use crate::human::{HumanFrame, HumanJoint, SegmentDirections, Side};
+use crate::imitation::reference::support::HumanSupport;
 use crate::model::{Model, ModelData, ModelError};
 use crate::robots::{BipedProfile, FootArea, RobotPoint, SolePlacement};
 
@@ -671,7 +671,7 @@ impl Scaler {
             self.ankles = Some(la - ra);
         }
         // Any slope: a foot on its toes still turns the frame. With the footprints' 45° limit
-        // ([`super::footsteps::footprint`]) the heading jumped between the foot and the pelvis
+        // ([`crate::imitation::walking::footsteps::footprint`]) the heading jumped between the foot and the pelvis
         // on the frames where a foot point dips past it: the references of six bundled clips
         // moved, and Kinect ges02's hands came 0.5–0.8 cm further off.
         let pelvis = frame.pelvis_heading(min);

@@ -35,10 +35,12 @@
 
 use nalgebra::Rotation2;
 
-use super::look_ahead::{FootLift, FootLookAhead, FootSchedule, MotionTimes, footprint};
-use super::phase::SupportPhase;
-use super::support::HumanSupport;
 use crate::human::{HumanFrame, Side};
+use crate::imitation::phase::SupportPhase;
+use crate::imitation::reference::support::HumanSupport;
+use crate::imitation::walking::look_ahead::{
+    FootLift, FootLookAhead, FootSchedule, MotionTimes, footprint,
+};
 use crate::robots::{FootArea, SolePlacement};
 
 /// How long after a human foot lands its footprint is still taken (s): the heel strikes first,
@@ -51,23 +53,23 @@ pub struct FootstepConfig {
     /// Whether the robot's feet follow the human's footprints (walking). Off by default: the
     /// robot then only stands on one leg when the human does, for as long, lifting the foot in
     /// place and putting it back where it was. Walking (`imitate --walk`; the imitator then
-    /// uses [`TaskTables::centre_stances_for_walking`](super::tables::TaskTables::centre_stances_for_walking))
+    /// uses [`TaskTables::centre_stances_for_walking`](crate::imitation::phase::tables::TaskTables::centre_stances_for_walking))
     /// is not yet the default: in the physics judge the NAO's loaded feet turn over 2° in some
     /// of the quasi-static steps it takes, and the G1's walking steps fall on the judge's weak
     /// model (the CHANGELOG has the runs).
     pub follow: bool,
-    /// With `follow`, walk with the pattern generator ([`super::walking`]): dynamic steps
+    /// With `follow`, walk with the pattern generator ([`crate::imitation::walking`]): dynamic steps
     /// (NAO: 1.0 s double + 0.67 s single support while following the human) instead of
     /// quasi-static ones (the CoM moved over the stance foot before each lift). Off by
     /// default: the NAO's walks stand in the physics judge, but the steps are slow (about
     /// 0.02 m/s), the arms hold still while the robot walks (unless `walking_arms`), a pivot
     /// turn is not followed, and the G1 falls at its first steps (see the changelog and
-    /// [`super::walking`]).
+    /// [`crate::imitation::walking`]).
     pub dynamic: bool,
     /// With `dynamic`, the hands follow the scaled human while the robot walks: after each
     /// walking frame an arm step moves the arm joints alone, the hands toward their targets
     /// at their single-support speed, the arms clear of the torso and head
-    /// ([`super::walking::walking_arms_table`]). Off by default: on the bundled walks the
+    /// ([`crate::imitation::walking::walking_arms_table`]). Off by default: on the bundled walks the
     /// hands come 4–8 cm nearer the human over the clip, but the walk's plan keeps the CoM's
     /// ZMP in the support and does not see the arms' momentum, and the physics judge's weak
     /// NAO falls on the walking clips with it.
@@ -90,7 +92,7 @@ pub struct FootstepConfig {
     /// A human standing on one foot this long (s) is followed onto one leg. Default 0.3.
     pub stance_time: f64,
     /// Walking dynamically, a human standing on one foot this long (s) is followed onto one
-    /// leg; shorter stances are the human's steps, which the walk takes ([`super::walking`]).
+    /// leg; shorter stances are the human's steps, which the walk takes ([`crate::imitation::walking`]).
     /// Default 1.
     pub long_stance_time: f64,
     /// The robot lands a foot that has been this long (s) in single support with the human's
@@ -226,7 +228,7 @@ pub struct StepRequest {
     /// The support to work toward.
     pub support: HumanSupport,
     /// Whether the swing foot may leave the ground: false while the robot shifts its weight
-    /// ahead of a human lift-off that has not happened yet ([`super::look_ahead`]).
+    /// ahead of a human lift-off that has not happened yet ([`crate::imitation::walking::look_ahead`]).
     pub lift: bool,
 }
 
@@ -253,7 +255,7 @@ impl FootstepPlanner {
         }
     }
 
-    /// The planner looks ahead on the human's clock with `ahead` (see [`super::look_ahead`]).
+    /// The planner looks ahead on the human's clock with `ahead` (see [`crate::imitation::walking::look_ahead`]).
     pub fn with_look_ahead(mut self, ahead: FootLookAhead) -> Self {
         let times = MotionTimes::new(&ahead);
         self.ahead = Some(Ahead {
@@ -478,7 +480,7 @@ impl FootstepPlanner {
     }
 
     /// Looking ahead without walking: the human lift to follow now, if any (see
-    /// [`super::look_ahead`]): the earliest of each foot's first lift that starts within the
+    /// [`crate::imitation::walking::look_ahead`]): the earliest of each foot's first lift that starts within the
     /// lift lead, is not followed yet, is worth following, and leaves no longer one of the other
     /// foot out.
     fn stance_ahead(&self, now: f64) -> Option<FootLift> {
@@ -510,7 +512,7 @@ impl FootstepPlanner {
     /// The next step from double support: the human's one-leg stance (online: once it has
     /// lasted [`FootstepConfig::stance_time`], walking dynamically
     /// [`FootstepConfig::long_stance_time`]), or the foot farthest off its target (walking
-    /// dynamically, the [`super::walking`] follower steps toward the targets instead).
+    /// dynamically, the [`crate::imitation::walking`] follower steps toward the targets instead).
     fn choose(&self, aims: &Aims) -> Step {
         let dynamic = self.config.follow && self.config.dynamic;
         let stance_time = match dynamic {
@@ -683,7 +685,7 @@ mod tests {
     }
 
     /// A human frame standing with the ankles at `r` and `l` (x, y), feet pointing +x.
-    pub(super) fn human(r: [f64; 2], l: [f64; 2]) -> HumanFrame {
+    pub(crate) fn human(r: [f64; 2], l: [f64; 2]) -> HumanFrame {
         let mut frame = HumanFrame::new(0.0);
         let v = |x: f64, y: f64, z: f64| nalgebra::Vector3::new(x, y, z);
         frame.set(HumanJoint::RAnkle, Some(v(r[0], r[1], 0.08)));
@@ -910,7 +912,8 @@ mod tests {
             end,
             landing: Some(pose(0.4, 0.1, 0.0)),
         };
-        let schedule = super::super::look_ahead::FootSchedule::from_lifts(&[lift]).unwrap();
+        let schedule =
+            crate::imitation::walking::look_ahead::FootSchedule::from_lifts(&[lift]).unwrap();
         FootstepPlanner::new(config, AREA).with_look_ahead(FootLookAhead {
             schedule,
             lift_lead: 0.5,
@@ -933,7 +936,7 @@ mod tests {
 
     #[test]
     fn looking_ahead_the_weight_shifts_before_the_lift_and_the_foot_lowers_before_the_landing() {
-        use super::super::phase::TakeOff;
+        use crate::imitation::phase::TakeOff;
         let (h, p) = (HumanSupport::Double, SupportPhase::Double);
         let shift = SupportPhase::DoubleToRight(TakeOff::ComToFoot);
         let mut planner = looking_ahead(FootstepConfig::default(), 3.0);
@@ -957,7 +960,7 @@ mod tests {
 
     #[test]
     fn looking_ahead_a_stance_ended_before_the_robot_lifts_is_given_up() {
-        use super::super::phase::TakeOff;
+        use crate::imitation::phase::TakeOff;
         let shift = SupportPhase::DoubleToRight(TakeOff::ComToFoot);
         let (h, right) = (HumanSupport::Double, HumanSupport::Right);
         let mut planner = looking_ahead(FootstepConfig::default(), 1.5);

@@ -31,8 +31,8 @@
 use nalgebra::Vector3;
 use thiserror::Error;
 
-use super::support::{SupportConfig, SupportDetector, SupportError};
 use crate::human::{CaptureSystem, HumanFrame, HumanJoint, Side};
+use crate::imitation::reference::support::{SupportConfig, SupportDetector, SupportError};
 use crate::scene::Scene;
 
 /// A body part that can rest on a surface.

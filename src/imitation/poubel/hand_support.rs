@@ -1,5 +1,5 @@
 //! Hands as supports (Di Fava et al. §III.C, Algorithm 1): a hand that the contact list of a
-//! recording ([`super::contact_events`]) puts on a surface becomes a support of the robot.
+//! recording ([`crate::imitation::reference::contact_events`]) puts on a surface becomes a support of the robot.
 //!
 //! # The plan
 //!
@@ -37,13 +37,13 @@
 use nalgebra::{Rotation2, Vector2, Vector3};
 use thiserror::Error;
 
-use super::contact_events::{
+use crate::human::{HumanFrame, HumanJoint, Side};
+use crate::imitation::error::ImitationError;
+#[cfg(doc)]
+use crate::imitation::output::RobotFrame;
+use crate::imitation::reference::contact_events::{
     ContactChange, ContactConfig, ContactError, ContactEvent, ContactLink, contact_events,
 };
-use super::error::ImitationError;
-#[cfg(doc)]
-use super::output::RobotFrame;
-use crate::human::{HumanFrame, HumanJoint, Side};
 use crate::scene::{Scene, Surface};
 use crate::tasks::convex_hull;
 
@@ -246,7 +246,7 @@ impl HandSupportConfig {
 }
 
 /// The old path of `output::HandPlacement`; kept for one release.
-pub use super::output::HandPlacement;
+pub use crate::imitation::output::HandPlacement;
 
 /// What the imitator knows of a hand in the current frame, to map a surface to the robot.
 #[derive(Clone, Copy, Debug)]

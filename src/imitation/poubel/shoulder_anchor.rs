@@ -1,7 +1,7 @@
 //! The scaled human's arms hung from the robot's own shoulders.
 //!
 //! The scaler places each arm from the *scaled* shoulder with the robot's segment lengths
-//! ([`super::scaler`], eq. 1). The robot's shoulder stands elsewhere whenever its trunk does not
+//! ([`crate::imitation::reference::scaler`], eq. 1). The robot's shoulder stands elsewhere whenever its trunk does not
 //! follow the scaled trunk: the tables hold the torso upright and facing over the feet while
 //! the human's shoulders sway and counter-rotate as they walk (on CMU 07_04 the G1's left
 //! shoulder moves 9 cm against the scaled one in 0.13 s), and a robot standing on bent knees
@@ -36,15 +36,15 @@
 
 use nalgebra::Vector3;
 
-use super::reach::Arm;
 use crate::human::{HumanJoint, Side};
+use crate::imitation::reach::Arm;
 use crate::model::ModelData;
 
 /// Moves each arm of `references` (scaled human points indexed by [`HumanJoint::index`], root
 /// frame) by the offset of the robot's shoulder, from the kinematics in `data` (the root
 /// model's), from its scaled shoulder. An arm the profile does not map (`arms[side]` `None`) or
 /// without a scaled shoulder is left as it is.
-pub(super) fn hang_arms_from_robot_shoulders(
+pub(crate) fn hang_arms_from_robot_shoulders(
     arms: &[Option<Arm>; 2],
     data: &ModelData,
     references: &mut [Option<Vector3<f64>>],

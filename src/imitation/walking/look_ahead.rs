@@ -6,15 +6,15 @@
 //!
 //! [`FootSchedule::of_clip`] runs the online [`SupportDetector`] over the clip once (so the
 //! offline and the online imitation see the same supports; these are also the feet's floor
-//! contacts of [`super::contact_events`]) and keeps, per foot, the intervals `[start, end)` of the
+//! contacts of [`crate::imitation::reference::contact_events`]) and keeps, per foot, the intervals `[start, end)` of the
 //! human's clock (s) during which the foot is off the ground (the other foot alone supports the
 //! body; an airborne frame keeps the last support, as the phase machine does), with the
 //! footprint it lands on (human world frame: ankle ground point and heading, as
-//! [`super::footsteps`] reads it).
+//! [`crate::imitation::walking::footsteps`] reads it).
 //!
 //! # What the robot does with it
 //!
-//! The [`FootstepPlanner`](super::footsteps::FootstepPlanner) looks ahead on the human's clock
+//! The [`FootstepPlanner`](crate::imitation::walking::footsteps::FootstepPlanner) looks ahead on the human's clock
 //! by how long the robot's own motions take ([`MotionTimes`]): its weight shift (the *lift
 //! lead*) for lift-offs, its lowering (the *landing lead*) for landings; first guesses
 //! [`FootLookAhead::lift_lead`] and [`FootLookAhead::landing_lead`], then the robot's last timed
@@ -40,14 +40,16 @@
 //! Units: seconds, metres, radians. The schedule is built once (it allocates); looking ahead
 //! while stepping does not.
 //!
-//! [`FootstepConfig::stance_time`]: super::footsteps::FootstepConfig::stance_time
-//! [`StepRequest::lift`]: super::footsteps::StepRequest::lift
+//! [`FootstepConfig::stance_time`]: crate::imitation::walking::footsteps::FootstepConfig::stance_time
+//! [`StepRequest::lift`]: crate::imitation::walking::footsteps::StepRequest::lift
 
 use thiserror::Error;
 
-use super::phase::{Landing, SupportPhase, TakeOff};
-use super::support::{HumanSupport, SupportConfig, SupportDetector, SupportError};
 use crate::human::{HumanFrame, Side};
+use crate::imitation::phase::{Landing, SupportPhase, TakeOff};
+use crate::imitation::reference::support::{
+    HumanSupport, SupportConfig, SupportDetector, SupportError,
+};
 use crate::locomotion::GroundPose;
 
 /// One lift of a human foot: off the ground from `start` to `end` (human clock, s).

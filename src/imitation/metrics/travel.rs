@@ -1,5 +1,5 @@
 //! Did the robot go where the human went, step when the human stepped, and follow with its
-//! hands in time? The locomotion and timing part of the [metrics](super::metrics).
+//! hands in time? The locomotion and timing part of the [metrics](crate::imitation::metrics).
 //!
 //! * **Travel**: start-to-end displacement of the scaled human's stance (the ankles' midpoint
 //!   times the leg ratio) and of the robot's mid-feet point, and the difference of their heading
@@ -22,9 +22,9 @@
 
 use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 
-use super::footsteps::wrap;
-use super::phase::SupportKind;
 use crate::human::Side;
+use crate::imitation::phase::SupportKind;
+use crate::imitation::walking::footsteps::wrap;
 
 /// Largest distance (m) between the robot's and the scaled human's stance at which the robot has
 /// caught up.

@@ -39,7 +39,7 @@
 //! ```
 //! use taskstack::human::HumanJoint;
 //! use taskstack::imitation::phase::SupportPhase;
-//! use taskstack::imitation::tables::{Axes, PointTarget, Task, TaskTables};
+//! use taskstack::imitation::phase::tables::{Axes, PointTarget, Task, TaskTables};
 //! use taskstack::robots::nao;
 //!
 //! let mut tables = TaskTables::paper(&nao::profile());
@@ -53,12 +53,12 @@
 //! tables.set(rs)?;
 //! let shape = tables.table(SupportPhase::Right).shape(23);
 //! assert_eq!(shape.level_rows().collect::<Vec<_>>(), vec![2, 12]);
-//! # Ok::<(), taskstack::imitation::tables::TableError>(())
+//! # Ok::<(), taskstack::imitation::phase::tables::TableError>(())
 //! ```
 //!
 //! # Table I
 //!
-//! Generated from [`TaskTables::paper`] (`cargo run --example table1 > src/imitation/table1.md`;
+//! Generated from [`TaskTables::paper`] (`cargo run --example table1 > src/imitation/phase/table1.md`;
 //! a unit test keeps this copy equal to the data):
 //!
 #![doc = include_str!("table1.md")]
@@ -66,8 +66,8 @@
 use std::collections::HashSet;
 use std::fmt;
 
-use super::phase::{Landing, PhaseConfig, SupportPhase, TakeOff};
 use crate::human::{HumanJoint, Side};
+use crate::imitation::phase::{Landing, PhaseConfig, SupportPhase, TakeOff};
 use crate::robots::BipedProfile;
 use crate::solver::StackShape;
 
@@ -187,7 +187,7 @@ pub enum PointTarget {
         /// How far below the initial posture (m).
         lower: f64,
     },
-    /// Above the target footprint of the step the robot is taking ([`super::footsteps`]), at
+    /// Above the target footprint of the step the robot is taking ([`crate::imitation::walking::footsteps`]), at
     /// the frame's rest height plus `lift`: a swing foot carried to where it will land. Held
     /// where the step began when no step is planned.
     Footstep {
@@ -195,10 +195,10 @@ pub enum PointTarget {
         lift: f64,
     },
     /// The contact point of the `Side` hand while it is placed on a surface or rests there as
-    /// a support ([`super::hand_support`]); the task has no effect (zero rows) while the hand
+    /// a support ([`crate::imitation::poubel::hand_support`]); the task has no effect (zero rows) while the hand
     /// is free.
     HandContact(Side),
-    /// Where the walking pattern generator puts the frame this frame ([`super::walking`]): the
+    /// Where the walking pattern generator puts the frame this frame ([`crate::imitation::walking`]): the
     /// planned sole's ground point, at the frame's rest height plus the planned swing height. A
     /// sole on the floor or on its swing path.
     Planned,
@@ -224,7 +224,7 @@ pub enum OrientationTarget {
     Footstep,
     /// The frame's z axis along the walk's planned up direction (2 rows, as `Upright`): a torso
     /// leaning over the stance hip as far as the walking pattern generator's CoM is from the
-    /// middle of the feet ([`super::walking`]).
+    /// middle of the feet ([`crate::imitation::walking`]).
     Leaning,
     /// As [`OrientationTarget::Upright`] (the z axis leaning `lean` rad about the root sole's
     /// x axis), with the x axis facing midway between the two soles' headings: 3 rows (the
@@ -245,7 +245,7 @@ pub enum Task {
     /// moves the CoM by millimetres per radian and is left to the posture gradient.
     ComXY(ComGoal),
     /// The CoM's height above the root sole (1 row), at the walk's planned height
-    /// ([`super::walking`]): the cart-table's constant height.
+    /// ([`crate::imitation::walking`]): the cart-table's constant height.
     ComHeight,
     /// Coordinates of a point fixed to a named robot frame (see [`crate::robots::BipedProfile`]), 1–3
     /// rows.
@@ -442,7 +442,7 @@ pub struct TaskTable {
     /// Gradient tasks, summed in the null space of all levels.
     pub gradients: Vec<Gradient>,
     /// Whether the clamping loop (fix violating joints at their limit and re-solve) runs, as
-    /// Table I describes the method. The [`Imitator`](super::imitator::Imitator) always keeps the
+    /// Table I describes the method. The [`Imitator`](crate::imitation::imitator::Imitator) always keeps the
     /// joint limits, whatever this says: its output is sent to a robot.
     pub clamping: bool,
 }
@@ -794,7 +794,7 @@ impl TaskTable {
         table
     }
 
-    /// Table I made physically executable (the [`Imitator`](super::imitator::Imitator)'s
+    /// Table I made physically executable (the [`Imitator`](crate::imitation::imitator::Imitator)'s
     /// default). Same phases and model roots as [`TaskTable::paper`]; the differences are what
     /// the physics of a real robot asks for:
     ///
@@ -828,7 +828,7 @@ impl TaskTable {
     ///   the swing foot and the hands, which go around the body instead of through it.
     /// * **Feet go where the human's went.** In single support the free foot is carried flat at
     ///   the lift height ρ ("swing": ankle height and sole orientation) to the target footprint
-    ///   of the step ([`super::footsteps`]: the human's footprint, scaled and clipped to the step
+    ///   of the step ([`crate::imitation::walking::footsteps`]: the human's footprint, scaled and clipped to the step
     ///   envelope; "step": the ankle's horizontal position), in levels of their own above the
     ///   hands, instead of following the human's swinging ankle beside them: a hand out of
     ///   reach must not decide where a foot lands. The height comes before the reach: a target
@@ -1244,7 +1244,7 @@ impl TaskTables {
         Ok(())
     }
 
-    /// Adds the hand supports of [`super::hand_support`] to every table: a point task per hand
+    /// Adds the hand supports of [`crate::imitation::poubel::hand_support`] to every table: a point task per hand
     /// ([`PointTarget::HandContact`]) in a `"hand contact"` level of their own, right below the
     /// feet's `"contact"` level (at the top when a table has none): a hand rests on a surface
     /// without ever pulling a standing foot off the ground, and above balance, so the CoM moves
@@ -1267,7 +1267,7 @@ impl TaskTables {
     /// [`Constraint::Zmp`] right below the levels that place the feet and the CoM (`"contact"`,
     /// `"hand contact"`, `"balance"` and `"collision"`), above the posture, the swing foot and
     /// the hands. The CoM task keeps the statics, its reference shaped so that the cart-table
-    /// ZMP stays near it ([`super::shaping`]); this level bounds what the arms' motion adds:
+    /// ZMP stays near it ([`crate::imitation::shaping`]); this level bounds what the arms' motion adds:
     /// the ZMP of the CoM plus the arms' momentum rate stays inside the soles' contact area
     /// (margin 0: the profile's outline is already the area the robot can count on, the NAO's
     /// its pressure sensors' hull inside the real sole), and the arms' vertical moment within
@@ -1300,7 +1300,7 @@ impl TaskTables {
     }
 
     /// Adapts the executable tables to walking
-    /// ([`FootstepConfig::follow`](super::footsteps::FootstepConfig::follow)): in single support
+    /// ([`FootstepConfig::follow`](crate::imitation::walking::footsteps::FootstepConfig::follow)): in single support
     /// and while a foot moves the CoM goes over the centre of the support sole's contact rectangle
     /// ([`BipedProfile::sole_centre`]) instead of near its inner edge, and the "collision" level
     /// moves above "balance". A walking step carries the swing foot across, and with the CoM 15 mm
