@@ -13,9 +13,9 @@ use std::hint::black_box;
 use std::time::Instant;
 use taskstack::human::HumanFrame;
 use taskstack::imitation::config::ImitationMethod;
-use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
 use taskstack::imitation::koenemann::KoenemannConfig;
 use taskstack::imitation::phase::SupportPhase;
+use taskstack::imitation::{Imitator, ImitatorConfig};
 use taskstack::io::clip::Clip;
 use taskstack::robots::{BipedProfile, g1, nao};
 

@@ -9,7 +9,7 @@
 use std::fs::File;
 use std::io::BufWriter;
 
-use taskstack::batch::JointsWriter;
+use taskstack::export::JointsWriter;
 use taskstack::human::HumanFrame;
 use taskstack::imitation::metrics::MetricsRecorder;
 use taskstack::imitation::reference::support::SupportConfig;

@@ -5,7 +5,7 @@
 use thiserror::Error;
 
 use crate::batch::BatchError;
-use crate::imitation::imitator::ImitationError;
+use crate::imitation::ImitationError;
 use crate::imitation::phase::PhaseError;
 use crate::imitation::phase::tables::TableError;
 use crate::imitation::reference::scaler::ScaleError;
@@ -13,7 +13,7 @@ use crate::imitation::reference::support::SupportError;
 use crate::io::bvh::BvhError;
 use crate::io::clip::ClipError;
 use crate::io::kinect::KinectError;
-use crate::locomotion::LocomotionError;
+use crate::locomotion::{LocomotionError, WalkerError};
 use crate::model::{DhError, ModelError, UrdfError};
 use crate::problem::ProblemError;
 use crate::robots::ProfileError;
@@ -45,6 +45,9 @@ pub enum Error {
     /// [`LocomotionError`].
     #[error(transparent)]
     Locomotion(#[from] LocomotionError),
+    /// [`WalkerError`].
+    #[error(transparent)]
+    Walker(#[from] WalkerError),
     /// [`ImitationError`].
     #[error(transparent)]
     Imitation(#[from] ImitationError),

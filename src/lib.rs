@@ -97,7 +97,7 @@
 //! turns the frames into the run's metrics (tracking errors, CoM margin, limit violations,
 //! foot slip, travel, solve times). [`batch`] writes them to disk, as the `taskstack` tool does:
 //! `joints.csv` (a header `time,<joint names>`, then per frame the time in s and the angles in
-//! rad, six decimals; [`batch::JointsWriter`]) and `metrics.json` ([`batch::metrics_json`]:
+//! rad, six decimals; [`export::JointsWriter`]) and `metrics.json` ([`batch::metrics_json`]:
 //! the metrics with their units in the key names). The tool adds `view.html`, a 3D viewer of the
 //! robot and the scaled human, and SVG plots.
 #![forbid(unsafe_code)]
@@ -121,9 +121,12 @@ pub mod tasks;
 // What a user touches most, at the crate root.
 pub use error::Error;
 pub use human::{HumanFrame, HumanJoint, Side};
-pub use imitation::imitator::{ImitationError, Imitator, ImitatorConfig, RobotFrame};
+pub use imitation::phase::SupportPhase;
+pub use imitation::{ImitationError, Imitator, ImitatorConfig, RobotFrame};
+pub use io::clip::{Clip, ClipError};
 pub use model::{Model, ModelData, ModelError};
 pub use robots::{BipedProfile, ProfileError};
+pub use solver::driver::{DriverSettings, PositionDriver};
 pub use solver::{JointBounds, Solver, SolverError, StackShape};
 pub use tasks::{
     ComTask, OrientationTask, PoseTask, PositionTask, PostureTask, TaskError, TaskSet,

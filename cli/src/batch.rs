@@ -16,7 +16,7 @@ use taskstack::batch::clips_in;
 use taskstack::imitation::metrics::ImitationMetrics;
 
 use crate::Report;
-use crate::options::ImitationOptions;
+use crate::options::{ClipOptions, ImitationOptions};
 use crate::run::{Settings, imitate_into};
 
 /// Imitate many clips, each into its own folder OUT/<clip name>/, in parallel.
@@ -37,6 +37,8 @@ pub(crate) struct BatchArgs {
     #[arg(long, short, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1024))]
     jobs: Option<u32>,
     #[command(flatten)]
+    clip_options: ClipOptions,
+    #[command(flatten)]
     options: ImitationOptions,
 }
 
@@ -56,7 +58,7 @@ pub(crate) fn run(args: BatchArgs, report: Report) -> Result<ExitCode> {
         profile: args.options.profile()?,
         config: args.options.imitator_config(),
         hold: args.options.hold,
-        map: args.options.skeleton_map()?,
+        setup: args.clip_options.setup(args.options.skeleton_map()?)?,
         exports: args.options.exports(),
     };
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());

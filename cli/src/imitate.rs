@@ -5,23 +5,17 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Duration;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
 use taskstack::batch::{HOLD_CAP, Hold};
-use taskstack::human::HumanFrame;
 use taskstack::imitation::metrics::ImitationMetrics;
-use taskstack::imitation::poubel::hand_support::{HandContactPlan, HandSupportConfig};
 use taskstack::imitation::reach::POSTURE_UNREACHABLE;
-use taskstack::imitation::reference::contact_events::ContactConfig;
-use taskstack::imitation::reference::support::SupportConfig;
-use taskstack::imitation::walking::look_ahead::{FootLookAhead, FootSchedule};
-use taskstack::scene::Scene;
 
 use crate::Report;
 use crate::check::PhysicsModel;
-use crate::options::{ImitationOptions, open_clip};
+use crate::options::{ClipOptions, ImitationOptions};
 use crate::run::{Progress, Settings, default_out, imitate_into, output_files};
 
 /// The clip imitated when none is given: CMU 05_02 (standing, arm gestures, small steps, a
@@ -74,28 +68,8 @@ pub(crate) struct ImitateArgs {
     /// folder.
     #[arg(long, short, value_name = "DIR")]
     out: Option<PathBuf>,
-    /// Hands as supports (Di Fava et al.): the contacts of the human's hands with the surfaces
-    /// of this scene (TOML, the clip's world frame; see `taskstack contacts`) are found first;
-    /// a hand the human rests on a surface is placed on it, held there and joins the support
-    /// polygon, whose centre the CoM goes to. The human's clock pauses until the hand is
-    /// placed, so joints.csv has its own time axis. Poubel et al.'s method only.
-    #[arg(long, value_name = "SCENE.toml")]
-    scene: Option<PathBuf>,
-    /// Offline mode: the whole clip is read first, so the robot knows when the human will lift
-    /// each foot, for how long and where it will land. It starts shifting its weight onto the
-    /// other foot as long before the human lifts one as its weight shift takes (the foot itself
-    /// leaves the ground with the human's), lowers a lifted foot as long before the human's lands
-    /// as its lowering takes, and with --walk steps toward where the human's foot will land. It
-    /// times its own motions as it goes; --lift-lead and --landing-lead are the first guesses.
-    /// Poubel et al.'s method only
-    #[arg(long)]
-    offline: bool,
-    /// Offline mode: the first guess of how long the robot's weight shift takes (s, ≥ 0)
-    #[arg(long, value_name = "SECONDS", default_value_t = FootLookAhead::DEFAULT_LIFT_LEAD, requires = "offline", allow_negative_numbers = true)]
-    lift_lead: f64,
-    /// Offline mode: the first guess of how long the robot's lowering of a foot takes (s, ≥ 0)
-    #[arg(long, value_name = "SECONDS", default_value_t = FootLookAhead::DEFAULT_LANDING_LEAD, requires = "offline", allow_negative_numbers = true)]
-    landing_lead: f64,
+    #[command(flatten)]
+    clip_options: ClipOptions,
     /// After the run, check it in physics on the nominal and the weak model (`taskstack
     /// check`: needs the Python package with its simulation extra); the exit status is then
     /// the check's (1 when a model fails it).
@@ -117,35 +91,13 @@ pub(crate) fn run(args: ImitateArgs, report: Report) -> Result<ExitCode> {
         bail!("the bundled clip is not at {}: give a CLIP", clip.display());
     }
     let out = args.out.clone().unwrap_or_else(|| default_out(&clip));
-    let mut settings = Settings {
+    let settings = Settings {
         profile: args.options.profile()?,
         config: args.options.imitator_config(),
         hold: args.options.hold,
-        map: args.options.skeleton_map()?,
+        setup: args.clip_options.setup(args.options.skeleton_map()?)?,
         exports: args.options.exports(),
     };
-    if args.scene.is_some() || args.offline {
-        let source = open_clip(&clip, settings.map.as_ref())?;
-        let capture = source.capture();
-        let frames = (source.collect::<Result<Vec<HumanFrame>, _>>())
-            .with_context(|| format!("clip {}", clip.display()))?;
-        if let Some(scene) = &args.scene {
-            let scene = Scene::from_toml_file(scene)?;
-            let plan =
-                HandContactPlan::of_clip(&frames, &scene, &ContactConfig::for_capture(capture))
-                    .with_context(|| format!("contacts of clip {}", clip.display()))?;
-            settings.config.hand_supports = Some(HandSupportConfig::new(plan));
-        }
-        if args.offline {
-            let schedule = FootSchedule::of_clip(&frames, SupportConfig::for_capture(capture))
-                .with_context(|| format!("foot lifts of clip {}", clip.display()))?;
-            settings.config.look_ahead = Some(FootLookAhead {
-                schedule,
-                lift_lead: args.lift_lead,
-                landing_lead: args.landing_lead,
-            });
-        }
-    }
     let bar = ProgressBar::hidden();
     let mut progress = |event: Progress| match event {
         Progress::Start(total) if report.human() => {
@@ -185,7 +137,9 @@ pub(crate) fn run(args: ImitateArgs, report: Report) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// The hand contacts of `clip` with the surfaces of the scene file `scene`.
+/// The run's summary for the terminal, one line per concern: the clip and the hold, the hand
+/// supports, the support changes, the tracking, the balance and limits, the travel and steps,
+/// the solve time, the files written.
 fn print_summary(
     text: &mut String,
     m: &ImitationMetrics,
@@ -215,6 +169,34 @@ fn print_summary(
             unfinished(m)
         );
     }
+    print_hand_supports(text, m);
+    let _ = writeln!(
+        text,
+        "support changes: human {}, robot {} ({})",
+        m.human_support_changes,
+        m.robot_support_changes,
+        m.robot_support_sequence.join(" → ")
+    );
+    print_tracking(text, m);
+    print_balance(text, m);
+    print_locomotion(text, m);
+    let s = &m.solve_time_us;
+    let _ = writeln!(
+        text,
+        "time per frame: median {:.0} µs, 99th percentile {:.0} µs",
+        s.median, s.p99
+    );
+    let _ = writeln!(
+        text,
+        "wrote {}/{{{}}}",
+        out.display(),
+        output_files(settings.exports).join(", ")
+    );
+}
+
+/// The hand supports' lines: the human's clock paused while hands were placed, each hand's
+/// contacts.
+fn print_hand_supports(text: &mut String, m: &ImitationMetrics) {
     if m.human_clock_pause > 0.0 {
         let _ = writeln!(
             text,
@@ -239,14 +221,10 @@ fn print_summary(
             hand("r_hand", &hands[1])
         );
     }
-    let _ = writeln!(
-        text,
-        "support changes: human {}, robot {} ({})",
-        m.human_support_changes,
-        m.robot_support_changes,
-        m.robot_support_sequence.join(" → ")
-    );
-    print_tracking(text, m);
+}
+
+/// The balance, joint limits, standing feet and self-collision lines.
+fn print_balance(text: &mut String, m: &ImitationMetrics) {
     let _ = writeln!(
         text,
         "balance: CoM ground projection at least {:.1} mm inside the support polygon ({} frames outside)",
@@ -278,6 +256,10 @@ fn print_summary(
             c.frames_below_margin
         );
     }
+}
+
+/// The travel, walking and foot-lift lines.
+fn print_locomotion(text: &mut String, m: &ImitationMetrics) {
     let t = &m.travel;
     let _ = writeln!(
         text,
@@ -304,18 +286,6 @@ fn print_summary(
             m.lift_lag.count, m.human_lifts, m.lift_lag.median, m.landing_lag.median
         );
     }
-    let s = &m.solve_time_us;
-    let _ = writeln!(
-        text,
-        "time per frame: median {:.0} µs, 99th percentile {:.0} µs",
-        s.median, s.p99
-    );
-    let _ = writeln!(
-        text,
-        "wrote {}/{{{}}}",
-        out.display(),
-        output_files(settings.exports).join(", ")
-    );
 }
 
 /// What the robot was still doing at the end of a run.

@@ -1,16 +1,62 @@
 //! Options shared by `imitate` and `batch`: the robot, the imitator's settings, the hold.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use clap::Args;
 use taskstack::ImitatorConfig;
-use taskstack::batch::{Hold, MAX_HOLD};
+use taskstack::batch::{ClipSetup, Hold, LookAheadLeads, MAX_HOLD};
 use taskstack::imitation::config::ImitationMethod;
 use taskstack::imitation::koenemann::{Calibration, FootRetargeting, KoenemannConfig};
-use taskstack::io::clip::Clip;
+use taskstack::imitation::walking::look_ahead::FootLookAhead;
 use taskstack::io::skeleton_map::SkeletonMap;
 use taskstack::robots::{BipedProfile, g1, nao};
+use taskstack::scene::Scene;
+
+/// What each clip gives its run beyond its frames (`imitate` and `batch`).
+#[derive(Debug, Clone, Args)]
+pub(crate) struct ClipOptions {
+    /// Hands as supports (Di Fava et al.): the contacts of the human's hands with the surfaces
+    /// of this scene (TOML, the clip's world frame; see `taskstack contacts`) are found first;
+    /// a hand the human rests on a surface is placed on it, held there and joins the support
+    /// polygon, whose centre the CoM goes to. The human's clock pauses until the hand is
+    /// placed, so joints.csv has its own time axis. Poubel et al.'s method only.
+    #[arg(long, value_name = "SCENE.toml")]
+    scene: Option<PathBuf>,
+    /// Offline mode: the whole clip is read first, so the robot knows when the human will lift
+    /// each foot, for how long and where it will land. It starts shifting its weight onto the
+    /// other foot as long before the human lifts one as its weight shift takes (the foot itself
+    /// leaves the ground with the human's), lowers a lifted foot as long before the human's lands
+    /// as its lowering takes, and with --walk steps toward where the human's foot will land. It
+    /// times its own motions as it goes; --lift-lead and --landing-lead are the first guesses.
+    /// Poubel et al.'s method only
+    #[arg(long)]
+    offline: bool,
+    /// Offline mode: the first guess of how long the robot's weight shift takes (s, ≥ 0)
+    #[arg(long, value_name = "SECONDS", default_value_t = FootLookAhead::DEFAULT_LIFT_LEAD, requires = "offline", allow_negative_numbers = true)]
+    lift_lead: f64,
+    /// Offline mode: the first guess of how long the robot's lowering of a foot takes (s, ≥ 0)
+    #[arg(long, value_name = "SECONDS", default_value_t = FootLookAhead::DEFAULT_LANDING_LEAD, requires = "offline", allow_negative_numbers = true)]
+    landing_lead: f64,
+}
+
+impl ClipOptions {
+    /// The clip setup of these options with the skeleton `map` (the scene file read here).
+    pub(crate) fn setup(&self, map: Option<SkeletonMap>) -> Result<ClipSetup> {
+        let scene = (self.scene.as_ref())
+            .map(Scene::from_toml_file)
+            .transpose()?;
+        let look_ahead = self.offline.then_some(LookAheadLeads {
+            lift_lead: self.lift_lead,
+            landing_lead: self.landing_lead,
+        });
+        Ok(ClipSetup {
+            skeleton_map: map,
+            look_ahead,
+            scene,
+        })
+    }
+}
 
 #[derive(Debug, Clone, Args)]
 pub(crate) struct ImitationOptions {
@@ -270,18 +316,6 @@ pub(crate) fn robot_profile(robot: &str) -> Result<BipedProfile> {
         path => BipedProfile::from_toml_file(path)
             .with_context(|| format!("--robot {path}: not nao, g1 or a readable profile"))?,
     })
-}
-
-/// Opens a clip, by the map if one is given; the error names the file.
-pub(crate) fn open_clip(path: &Path, map: Option<&SkeletonMap>) -> Result<Clip> {
-    if path.is_dir() {
-        anyhow::bail!("clip {}: is a folder, not a clip file", path.display());
-    }
-    let clip = match map {
-        None => Clip::open(path),
-        Some(map) => Clip::open_mapped(path, map),
-    };
-    clip.with_context(|| format!("clip {}", path.display()))
 }
 
 fn number(text: &str) -> Result<f64, String> {

@@ -8,7 +8,7 @@
 //! * `joints.svg`: the right arm's joint angles against their limits.
 
 use taskstack::human::Side;
-use taskstack::imitation::metrics::{CONTACT_HEIGHT, EFFECTORS};
+use taskstack::imitation::output::{CONTACT_HEIGHT, EFFECTORS};
 use taskstack::imitation::phase::SupportPhase;
 use taskstack::imitation::reference::support::HumanSupport;
 use taskstack::model::Model;

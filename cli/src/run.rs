@@ -11,15 +11,14 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use serde_json::json;
-use taskstack::batch::{Hold, JointsWriter, imitate_clip, metrics_json};
+use taskstack::batch::{ClipSession, ClipSetup, Hold, imitate_clip, metrics_json};
+use taskstack::export::JointsWriter;
 use taskstack::export::{MotionRecorder, MotionTrack, write_motion_npz, write_unitree_csv};
 use taskstack::imitation::metrics::ImitationMetrics;
-use taskstack::imitation::reference::support::SupportConfig;
-use taskstack::io::skeleton_map::SkeletonMap;
 use taskstack::robots::BipedProfile;
 use taskstack::{Imitator, ImitatorConfig, RobotFrame};
 
-use crate::options::{Exports, open_clip};
+use crate::options::Exports;
 use crate::plots::PlotRecorder;
 use crate::view::ViewWriter;
 
@@ -42,7 +41,7 @@ pub(crate) struct Settings {
     pub(crate) profile: BipedProfile,
     pub(crate) config: ImitatorConfig,
     pub(crate) hold: Hold,
-    pub(crate) map: Option<SkeletonMap>,
+    pub(crate) setup: ClipSetup,
     pub(crate) exports: Exports,
 }
 
@@ -71,15 +70,18 @@ pub(crate) fn imitate_into(
     settings: &Settings,
     progress: &mut dyn FnMut(Progress),
 ) -> Result<ImitationMetrics> {
-    let source = open_clip(clip, settings.map.as_ref())?;
+    if clip.is_dir() {
+        anyhow::bail!("clip {}: is a folder, not a clip file", clip.display());
+    }
+    let session = ClipSession::open(clip, &settings.setup)?;
     let hold_frames = settings.hold.max_frames();
     progress(Progress::Start(
-        source.declared_frames().map(|n| n + hold_frames),
+        session.clip().declared_frames().map(|n| n + hold_frames),
     ));
     std::fs::create_dir_all(out)
         .with_context(|| format!("output folder {}: cannot create it", out.display()))?;
     let mut staged = Staged::new(out);
-    let result = run_staged(clip, source, &mut staged, settings, progress);
+    let result = run_staged(clip, session, &mut staged, settings, progress);
     match result {
         Ok(metrics) => staged.commit().map(|()| metrics),
         Err(err) => {
@@ -92,17 +94,14 @@ pub(crate) fn imitate_into(
 /// The run itself, every file written through `staged`.
 fn run_staged(
     clip: &Path,
-    source: taskstack::io::clip::Clip,
+    session: ClipSession,
     staged: &mut Staged,
     settings: &Settings,
     progress: &mut dyn FnMut(Progress),
 ) -> Result<ImitationMetrics> {
     let mut joints = JointsWriter::new(staged.create("joints.csv")?);
     let view_file = staged.create("view.html")?;
-    let config = ImitatorConfig {
-        support: SupportConfig::for_capture(source.capture()),
-        ..settings.config.clone()
-    };
+    let config = session.config(&settings.config);
     let mut imitator = Imitator::new(settings.profile.clone(), config)
         .with_context(|| format!("robot {}", settings.profile.name))?;
     let title = clip
@@ -132,7 +131,13 @@ fn run_staged(
             progress(Progress::Frames(done));
         }
     };
-    let metrics = imitate_clip(clip, source, &mut imitator, settings.hold, each)?;
+    let metrics = imitate_clip(
+        clip,
+        session.into_clip(),
+        &mut imitator,
+        settings.hold,
+        each,
+    )?;
     progress(Progress::Frames(done));
     let in_folder = || format!("output folder {}", staged.out.display());
     written.with_context(in_folder)?;

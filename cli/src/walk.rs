@@ -8,7 +8,7 @@ use std::process::ExitCode;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use serde_json::json;
-use taskstack::batch::JointsWriter;
+use taskstack::export::JointsWriter;
 use taskstack::human::HumanJoint;
 use taskstack::human::Side;
 use taskstack::imitation::phase::SupportPhase;

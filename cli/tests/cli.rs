@@ -217,6 +217,27 @@ fn imitate_offline_reports_foot_lags_and_checks_its_leads() {
         "{lags}"
     );
     assert!(lags["lift"]["count"].is_u64() && lags["landing"]["median"].is_number());
+    // `batch` prepares its clips as `imitate` does: the same offline run, byte for byte.
+    let batch_out = dir.join("batch");
+    let args = [
+        "batch",
+        s(&clip),
+        "--offline",
+        "--out",
+        s(&batch_out),
+        "--hold",
+        "1",
+    ];
+    let run = taskstack(&args);
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    let stem = clip.file_stem().unwrap();
+    let batch_joints = std::fs::read(batch_out.join(stem).join("joints.csv")).unwrap();
+    let online_out = dir.join("online");
+    let run = taskstack(&["imitate", s(&clip), "--out", s(&online_out), "--hold", "1"]);
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    let online_joints = std::fs::read(online_out.join("joints.csv")).unwrap();
+    assert_eq!(batch_joints, std::fs::read(out.join("joints.csv")).unwrap());
+    assert_ne!(batch_joints, online_joints, "--offline changes the run");
     let bad = [
         "imitate",
         s(&clip),

@@ -8,14 +8,15 @@ use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray2};
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
-use taskstack::batch::{Hold, imitate_clip as run_clip, metrics_json};
+use taskstack::batch::{
+    ClipSession, ClipSetup, Hold, LookAheadLeads, imitate_clip as run_clip, metrics_json,
+};
 use taskstack::export::{MotionRecorder, MotionTrack};
 use taskstack::human::{CaptureSystem, HumanFrame, HumanJoint};
+use taskstack::imitation::EFFECTORS;
 use taskstack::imitation::config::ImitationMethod;
-use taskstack::imitation::imitator::EFFECTORS;
 use taskstack::imitation::koenemann::{Calibration, FootRetargeting, KoenemannConfig};
 use taskstack::imitation::reference::support::SupportConfig;
-use taskstack::imitation::walking::look_ahead::{FootLookAhead, FootSchedule};
 use taskstack::io::clip::Clip;
 use taskstack::robots::{BipedProfile, g1, nao};
 use taskstack::{Imitator, ImitatorConfig, RobotFrame};
@@ -130,6 +131,8 @@ impl Settings {
         Ok(profile)
     }
 
+    // One function on purpose (~100 lines): one line per keyword argument of `imitate`, in the
+    // order of its signature.
     fn config(&self, capture: CaptureSystem) -> PyResult<ImitatorConfig> {
         let method = match self.method.as_str() {
             "poubel" => ImitationMethod::Poubel,
@@ -267,26 +270,17 @@ fn run(
     offline: bool,
     hold: Hold,
 ) -> PyResult<ClipRun> {
-    let open = || Clip::open(path).map_err(to_py);
-    let mut source = open()?;
-    let capture = source.capture();
-    let mut config = settings.config(capture)?;
-    if offline {
-        let frames = (source.collect::<Result<Vec<HumanFrame>, _>>()).map_err(to_py)?;
-        let schedule =
-            FootSchedule::of_clip(&frames, SupportConfig::for_capture(capture)).map_err(to_py)?;
-        config.look_ahead = Some(FootLookAhead {
-            schedule,
-            lift_lead: FootLookAhead::DEFAULT_LIFT_LEAD,
-            landing_lead: FootLookAhead::DEFAULT_LANDING_LEAD,
-        });
-        source = open()?;
-    }
+    let setup = ClipSetup {
+        look_ahead: offline.then(LookAheadLeads::default),
+        ..ClipSetup::default()
+    };
+    let session = ClipSession::open(path, &setup).map_err(to_py)?;
+    let config = session.config(&settings.config(session.clip().capture())?);
     let mut imitator = Imitator::new(profile, config).map_err(to_py)?;
     let mut recorder = MotionRecorder::new(&imitator).map_err(to_py)?;
     let (mut phases, mut servo_targets) = (Vec::new(), Vec::new());
     let mut recorded = Ok(());
-    let metrics = run_clip(path, source, &mut imitator, hold, |frame| {
+    let metrics = run_clip(path, session.into_clip(), &mut imitator, hold, |frame| {
         if recorded.is_ok() {
             recorded = recorder.record(frame);
         }

@@ -16,8 +16,8 @@ use nalgebra::{IsometryMatrix3, Quaternion, UnitQuaternion, Vector3};
 use thiserror::Error;
 
 use crate::human::Side;
-use crate::imitation::imitator::{Imitator, RobotFrame};
 use crate::imitation::output::sole_on_floor;
+use crate::imitation::{Imitator, RobotFrame};
 use crate::model::{FrameId, ModelData, ModelError};
 use crate::robots::BipedProfile;
 

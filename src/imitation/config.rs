@@ -244,6 +244,8 @@ impl ImitatorConfig {
     /// Checks the imitator's own settings (the phase, table, support and solver settings are
     /// checked by their owners): every speed, fraction and time finite and > 0, footstep
     /// thresholds ≥ 0, at least one iteration per frame. The error names the field.
+    // One function on purpose (~105 lines): one independent check per setting, in the order of
+    // the fields; split up, a reader would hunt for the check of a field.
     pub(super) fn validate(&self) -> Result<(), ImitationError> {
         let invalid = |name, value, reason| {
             Err(ImitationError::InvalidParameter {

@@ -16,8 +16,12 @@ use crate::imitation::state::Shared;
 use crate::robots::BipedProfile;
 use crate::solver::JointBounds;
 
+// The paths these had before `imitation` re-exported them; kept for one release.
+#[doc(hidden)]
 pub use crate::imitation::config::{ImitationMethod, ImitatorConfig};
+#[doc(hidden)]
 pub use crate::imitation::error::ImitationError;
+#[doc(hidden)]
 pub use crate::imitation::output::{EFFECTORS, RobotFrame};
 
 /// The online imitator.

@@ -37,6 +37,11 @@ pub mod shaping;
 mod state;
 pub mod walking;
 
+pub use config::{ImitationMethod, ImitatorConfig};
+pub use error::ImitationError;
+pub use imitator::Imitator;
+pub use output::{EFFECTORS, RobotFrame};
+
 // The paths of the modules before they moved into their rooms, kept for one release.
 #[doc(hidden)]
 pub use metrics::{clearance, travel};

@@ -32,6 +32,11 @@ enum Source {
     // Boxed: the BVH reader is several times larger than the Kinect one.
     Bvh(Box<BvhReader<BufReader<File>>>),
     Kinect(KinectReader<BufReader<File>>),
+    /// A clip read whole ([`Clip::read_whole`]), replayed from `next` on.
+    Frames {
+        frames: Vec<HumanFrame>,
+        next: usize,
+    },
 }
 
 /// A clip being read, one frame at a time.
@@ -98,6 +103,34 @@ impl Clip {
         match &self.source {
             Source::Bvh(r) => Some(r.declared_frames().saturating_sub(r.frames_read())),
             Source::Kinect(_) => None,
+            Source::Frames { frames, next } => Some((frames.len() - next) as u64),
+        }
+    }
+
+    /// The clip with the frames not read yet read into memory, replayed by [`Clip::read_frame`]
+    /// and seen whole by [`Clip::frames_ahead`]: for a run that needs the whole clip before its
+    /// first frame (the look-ahead of the feet, a scene's hand contacts).
+    ///
+    /// # Errors
+    /// The reader's error, naming the line.
+    pub fn read_whole(self) -> Result<Clip, ClipError> {
+        if matches!(self.source, Source::Frames { .. }) {
+            return Ok(self);
+        }
+        let capture = self.capture;
+        let frames = self.collect::<Result<Vec<HumanFrame>, _>>()?;
+        Ok(Clip {
+            source: Source::Frames { frames, next: 0 },
+            capture,
+        })
+    }
+
+    /// The frames still to read of a clip read whole ([`Clip::read_whole`]); `None` for a clip
+    /// read from its file as it goes.
+    pub fn frames_ahead(&self) -> Option<&[HumanFrame]> {
+        match &self.source {
+            Source::Frames { frames, next } => Some(&frames[*next..]),
+            _ => None,
         }
     }
 
@@ -106,6 +139,14 @@ impl Clip {
         Ok(match &mut self.source {
             Source::Bvh(r) => r.read_frame(out)?,
             Source::Kinect(r) => r.read_frame(out)?,
+            Source::Frames { frames, next } => match frames.get(*next) {
+                Some(frame) => {
+                    *out = *frame;
+                    *next += 1;
+                    true
+                }
+                None => false,
+            },
         })
     }
 }

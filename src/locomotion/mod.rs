@@ -79,7 +79,7 @@ pub use planner::{StepPlan, goal_feet, plan_steps};
 pub use preview::{CartTable, PreviewGains, PreviewSettings};
 pub use schedule::{SoleCentres, Support};
 pub use swing::{SolePose, SwingProfile};
-pub use walker::{WalkerFrame, WholeBodyWalker};
+pub use walker::{WalkerError, WalkerFrame, WholeBodyWalker};
 
 /// Errors of the walking pattern generator and walker.
 #[derive(Debug, Clone, PartialEq, Error)]

@@ -15,6 +15,7 @@
 //! stance foot as the swing foot rose.
 
 use nalgebra::{IsometryMatrix3, Rotation3, Translation3, Vector2, Vector3};
+use thiserror::Error;
 
 use super::LocomotionError;
 use super::footstep::{Footstep, GroundPose};
@@ -23,14 +24,38 @@ use super::params::{WalkParams, standing_feet};
 use super::schedule::Support;
 use super::schedule::smooth;
 use super::swing::SolePose;
-use crate::Error;
 use crate::human::Side;
-use crate::model::{FrameId, Model, ModelData};
-use crate::robots::BipedProfile;
+use crate::model::{FrameId, Model, ModelData, ModelError};
 use crate::robots::servo::{LoadedSoles, ServoSag, other_sole_load};
+use crate::robots::{BipedProfile, ProfileError};
+use crate::solver::SolverError;
 use crate::solver::driver::{DriverSettings, PositionDriver};
 use crate::solver::{JointBounds, Solver};
+use crate::tasks::TaskError;
 use crate::tasks::{ComTask, PoseTask, Task, TaskSet, UprightTask};
+
+/// Errors of a [`WholeBodyWalker`]: its pattern generator's, or of the whole-body solve (a
+/// non-finite number, a frame or task the robot's profile does not have). Each wraps the error
+/// it came from, message unchanged.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum WalkerError {
+    /// The pattern generator refused a setting or a step.
+    #[error(transparent)]
+    Locomotion(#[from] LocomotionError),
+    /// The solver refused the stack or its numbers.
+    #[error(transparent)]
+    Solver(#[from] SolverError),
+    /// The kinematic model refused the posture.
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    /// A task could not be built or set.
+    #[error(transparent)]
+    Task(#[from] TaskError),
+    /// The robot's profile lacks what the walker needs.
+    #[error(transparent)]
+    Profile(#[from] ProfileError),
+}
 
 /// Gain of the pull toward the standing posture (per driver iteration).
 const POSTURE_GAIN: f64 = 0.05;
@@ -89,7 +114,7 @@ impl<'p> WholeBodyWalker<'p> {
         profile: &'p BipedProfile,
         params: WalkParams,
         right: GroundPose,
-    ) -> Result<Self, Error> {
+    ) -> Result<Self, WalkerError> {
         let (feet, com_xy) = standing_feet(profile, &right)?;
         let generator =
             PatternGenerator::new(params.settings, params.centres.clone(), feet, com_xy)?;
@@ -169,7 +194,7 @@ impl<'p> WholeBodyWalker<'p> {
     ///
     /// # Errors
     /// Solver and model errors (non-finite numbers).
-    pub fn tick(&mut self) -> Result<&WalkerFrame, Error> {
+    pub fn tick(&mut self) -> Result<&WalkerFrame, WalkerError> {
         let walk = *self.generator.tick();
         if let Support::Single { swing, .. } = walk.support {
             self.root = swing.other();
@@ -211,7 +236,7 @@ impl<'p> WholeBodyWalker<'p> {
     }
 
     /// The servo targets of `q` in the root's model with `loaded` soles.
-    fn update_servo_targets(&mut self, loaded: LoadedSoles) -> Result<(), Error> {
+    fn update_servo_targets(&mut self, loaded: LoadedSoles) -> Result<(), WalkerError> {
         let Some(servo) = &mut self.servo else {
             self.servo_targets.copy_from_slice(&self.q);
             return Ok(());
@@ -249,7 +274,7 @@ impl<'p> WholeBodyWalker<'p> {
 /// heading is left free: held too, it took a freedom the NAO's coupled hips need, the CoM task
 /// then swung the arms, and turning walks fell in physics. The height comes last: the legs
 /// alone cannot always keep it.
-fn rooted_stack(profile: &BipedProfile, root: Side) -> Result<RootedStack<'_>, Error> {
+fn rooted_stack(profile: &BipedProfile, root: Side) -> Result<RootedStack<'_>, WalkerError> {
     let model = profile.model(root);
     let other = PoseTask::new(
         model,

@@ -797,21 +797,15 @@ fn resolve(
     Ok(drive)
 }
 
-/// Numbers the free joints as variables (in `variable_order` or URDF order) and rewrites the
-/// drives from free-joint indices to variable indices.
-fn number_variables(
+/// The free joints (indices into the URDF's joints) in the order of their variables:
+/// `options.variable_order` when given (every free joint named once), else the URDF's.
+fn variable_order(
     robot: &urdf_rs::Robot,
-    drives: Vec<Drive>,
+    free: &[usize],
     options: &UrdfOptions,
-) -> Result<(Vec<Variable>, Vec<Drive>), UrdfError> {
-    let free: Vec<usize> = (0..drives.len())
-        .filter(|&j| {
-            // A free joint drives itself; mimics are driven by their (resolved) target.
-            matches!(drives[j], Drive::Variable { variable, .. } if variable == j)
-        })
-        .collect();
-    let order: Vec<usize> = match &options.variable_order {
-        None => free.clone(),
+) -> Result<Vec<usize>, UrdfError> {
+    match &options.variable_order {
+        None => Ok(free.to_vec()),
         Some(names) => {
             let mut order = Vec::with_capacity(names.len());
             for name in names {
@@ -828,56 +822,77 @@ fn number_variables(
                     robot.joints[missing].name.clone(),
                 ));
             }
-            order
+            Ok(order)
         }
+    }
+}
+
+/// The variable of the free joint `joint`: its limits (none for a continuous joint), velocity
+/// and effort. Errors: a non-finite limit, lower above upper, a negative velocity or effort.
+fn joint_variable(joint: &urdf_rs::Joint) -> Result<Variable, UrdfError> {
+    let limit = &joint.limit;
+    let (lower, upper) = if joint.joint_type == JointType::Continuous {
+        (f64::NEG_INFINITY, f64::INFINITY)
+    } else {
+        finite(
+            || format!("joint `{}` limit", joint.name),
+            &[limit.lower, limit.upper],
+        )?;
+        (limit.lower, limit.upper)
     };
+    if lower > upper {
+        return Err(UrdfError::LowerAboveUpper {
+            joint: joint.name.clone(),
+            lower,
+            upper,
+        });
+    }
+    // An infinite limit means none.
+    if limit.velocity.is_nan() || limit.velocity < 0.0 {
+        return Err(UrdfError::NegativeVelocity {
+            joint: joint.name.clone(),
+            velocity: limit.velocity,
+        });
+    }
+    if limit.effort.is_nan() || limit.effort < 0.0 {
+        return Err(UrdfError::NegativeEffort {
+            joint: joint.name.clone(),
+            effort: limit.effort,
+        });
+    }
+    Ok(Variable {
+        name: joint.name.clone(),
+        lower,
+        upper,
+        velocity: limit.velocity,
+        // urdf-rs reads a missing effort as 0: no actuator has none, so 0 means "not stated".
+        effort: if limit.effort > 0.0 {
+            limit.effort
+        } else {
+            f64::INFINITY
+        },
+    })
+}
+
+/// Numbers the free joints as variables (in `variable_order` or URDF order) and rewrites the
+/// drives from free-joint indices to variable indices.
+fn number_variables(
+    robot: &urdf_rs::Robot,
+    drives: Vec<Drive>,
+    options: &UrdfOptions,
+) -> Result<(Vec<Variable>, Vec<Drive>), UrdfError> {
+    let free: Vec<usize> = (0..drives.len())
+        .filter(|&j| {
+            // A free joint drives itself; mimics are driven by their (resolved) target.
+            matches!(drives[j], Drive::Variable { variable, .. } if variable == j)
+        })
+        .collect();
+    let order = variable_order(robot, &free, options)?;
     let mut variable_of = vec![usize::MAX; drives.len()];
     let mut variables = Vec::with_capacity(order.len());
     for (k, &j) in order.iter().enumerate() {
         variable_of[j] = k;
-        let joint = &robot.joints[j];
-        let limit = &joint.limit;
-        let (lower, upper) = if joint.joint_type == JointType::Continuous {
-            (f64::NEG_INFINITY, f64::INFINITY)
-        } else {
-            finite(
-                || format!("joint `{}` limit", joint.name),
-                &[limit.lower, limit.upper],
-            )?;
-            (limit.lower, limit.upper)
-        };
-        if lower > upper {
-            return Err(UrdfError::LowerAboveUpper {
-                joint: joint.name.clone(),
-                lower,
-                upper,
-            });
-        }
-        // An infinite limit means none.
-        if limit.velocity.is_nan() || limit.velocity < 0.0 {
-            return Err(UrdfError::NegativeVelocity {
-                joint: joint.name.clone(),
-                velocity: limit.velocity,
-            });
-        }
-        if limit.effort.is_nan() || limit.effort < 0.0 {
-            return Err(UrdfError::NegativeEffort {
-                joint: joint.name.clone(),
-                effort: limit.effort,
-            });
-        }
-        variables.push(Variable {
-            name: joint.name.clone(),
-            lower,
-            upper,
-            velocity: limit.velocity,
-            // urdf-rs reads a missing effort as 0: no actuator has none, so 0 means "not stated".
-            effort: if limit.effort > 0.0 {
-                limit.effort
-            } else {
-                f64::INFINITY
-            },
-        });
+        variables.push(joint_variable(&robot.joints[j])?);
     }
     let drives = drives
         .into_iter()

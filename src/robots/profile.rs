@@ -20,7 +20,8 @@ use std::fmt;
 
 use nalgebra::{Rotation3, Vector2, Vector3};
 
-/// The old path of [`crate::robots::ProfileError`]; kept for one release.
+// The old path of `robots::ProfileError`; kept for one release.
+#[doc(hidden)]
 pub use super::error::ProfileError;
 use super::self_collision::SelfCollision;
 use super::tuning::MotionTuning;
@@ -242,6 +243,8 @@ impl BipedProfile {
     /// inside the limits, the step envelope is valid, the servo saturation (if any) is a finite
     /// angle > 0, the self-collision bodies resolve on both models ([`SelfCollision::resolve`])
     /// and every pair keeps its margin in the standing posture. The error names the field.
+    // One function on purpose (~85 lines): one independent check after another, in the order
+    // of the docs above.
     pub fn validate(&self) -> Result<(), ProfileError> {
         let invalid = |field: &str, reason: String| ProfileError::Invalid {
             field: field.to_owned(),

@@ -258,6 +258,9 @@ impl PositionDriver {
     /// [`TaskModel::measure`] of the result. Errors: wrong sizes, a non-finite `q`,
     /// a non-finite Jacobian entry, task error or gradient from the model
     /// ([`SolverError::NonFinite`], naming the place), or the model's own error.
+    // One function on purpose (~80 lines): the iteration read top to bottom (evaluate, keep
+    // the best, the stop tests in their order, one step); split up, the order of the stop tests,
+    // which decides the result, would be spread over several functions.
     pub fn run<M: TaskModel>(
         &mut self,
         solver: &mut Solver,

@@ -127,7 +127,7 @@ fn clips_with_the_same_stem_are_refused_before_any_work() {
 #[test]
 fn an_out_of_range_hold_is_refused_before_any_work() {
     use taskstack::batch::{Hold, imitate_clip};
-    use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
+    use taskstack::imitation::{Imitator, ImitatorConfig};
     use taskstack::io::clip::Clip;
     use taskstack::robots::nao;
 
@@ -189,7 +189,7 @@ fn a_clip_failing_part_way_leaves_the_earlier_outputs() {
 #[test]
 fn imitate_clip_holds_the_last_pose() {
     use taskstack::batch::imitate_clip;
-    use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
+    use taskstack::imitation::{Imitator, ImitatorConfig};
     use taskstack::io::clip::Clip;
     use taskstack::robots::nao;
 
@@ -232,7 +232,7 @@ fn the_automatic_hold_waits_for_the_robot_to_finish() {
 
 fn automatic_hold_waits(profile: taskstack::robots::BipedProfile, settle_time: f64) {
     use taskstack::batch::{HOLD_CAP, HOLD_STEP, Hold, imitate_clip};
-    use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
+    use taskstack::imitation::{Imitator, ImitatorConfig};
     use taskstack::io::clip::Clip;
 
     // The slow dance ends with the robot still bringing its CoM back from a one-leg stance.
@@ -276,7 +276,7 @@ fn automatic_hold_waits(profile: taskstack::robots::BipedProfile, settle_time: f
 #[test]
 fn a_dynamic_walk_finishes_within_the_automatic_hold() {
     use taskstack::batch::{HOLD_CAP, Hold, imitate_clip};
-    use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
+    use taskstack::imitation::{Imitator, ImitatorConfig};
     use taskstack::io::clip::Clip;
     use taskstack::robots::nao;
 
@@ -541,8 +541,8 @@ fn nao_clip_metrics_with(
 ) {
     use taskstack::batch::metrics_value;
     use taskstack::human::HumanFrame;
-    use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
     use taskstack::imitation::metrics::MetricsRecorder;
+    use taskstack::imitation::{Imitator, ImitatorConfig};
     use taskstack::io::clip::Clip;
     use taskstack::robots::nao;
 

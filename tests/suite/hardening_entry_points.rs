@@ -4,9 +4,9 @@
 //! behaviour, and that a refused call changed nothing.
 
 use taskstack::human::{HumanFrame, HumanJoint};
-use taskstack::imitation::imitator::{ImitationError, Imitator, ImitatorConfig, RobotFrame};
 use taskstack::imitation::reference::scaler::ScaleError;
 use taskstack::imitation::shaping::MotionLimits;
+use taskstack::imitation::{ImitationError, Imitator, ImitatorConfig, RobotFrame};
 use taskstack::io::clip::Clip;
 use taskstack::model::ModelError;
 use taskstack::robots::nao;

@@ -13,7 +13,6 @@ use crate::common;
 
 use taskstack::human::{HumanFrame, HumanJoint, Side};
 use taskstack::imitation::config::ImitationMethod;
-use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
 use taskstack::imitation::koenemann::KoenemannConfig;
 use taskstack::imitation::metrics::{ImitationMetrics, MetricsRecorder};
 use taskstack::imitation::phase::SupportPhase;
@@ -21,6 +20,7 @@ use taskstack::imitation::reference::support::SupportConfig;
 use taskstack::imitation::shaping::MotionLimits;
 use taskstack::imitation::walking::footsteps::FootstepConfig;
 use taskstack::imitation::walking::look_ahead::{FootLookAhead, FootSchedule};
+use taskstack::imitation::{Imitator, ImitatorConfig};
 use taskstack::io::clip::Clip;
 use taskstack::locomotion::WalkParams;
 use taskstack::robots::nao;

@@ -12,11 +12,11 @@ use proptest::prelude::*;
 use taskstack::human::Side;
 use taskstack::human::{HumanFrame, HumanJoint};
 use taskstack::imitation::config::ImitationMethod;
-use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
 use taskstack::imitation::koenemann::KoenemannConfig;
 use taskstack::imitation::output::RobotFrame;
 use taskstack::imitation::phase::SupportPhase;
 use taskstack::imitation::reference::support::SupportConfig;
+use taskstack::imitation::{Imitator, ImitatorConfig};
 use taskstack::io::clip::Clip;
 use taskstack::robots::{BipedProfile, nao};
 

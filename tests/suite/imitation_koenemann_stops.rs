@@ -5,9 +5,9 @@
 
 use taskstack::human::HumanFrame;
 use taskstack::imitation::config::ImitationMethod;
-use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
 use taskstack::imitation::koenemann::KoenemannConfig;
 use taskstack::imitation::reference::support::SupportConfig;
+use taskstack::imitation::{Imitator, ImitatorConfig};
 use taskstack::io::clip::Clip;
 use taskstack::robots::nao;
 

@@ -2,10 +2,10 @@
 //! a frame is counted once, a slower wobble not at all.
 
 use taskstack::human::HumanFrame;
-use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
 use taskstack::imitation::metrics::{ImitationMetrics, MetricsRecorder};
 use taskstack::imitation::output::RobotFrame;
 use taskstack::imitation::reference::support::SupportConfig;
+use taskstack::imitation::{Imitator, ImitatorConfig};
 use taskstack::io::clip::Clip;
 use taskstack::robots::nao;
 

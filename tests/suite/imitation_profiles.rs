@@ -5,9 +5,9 @@
 //! support foot not slipping across model switches.
 
 use taskstack::human::HumanFrame;
-use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
 use taskstack::imitation::metrics::{ImitationMetrics, MetricsRecorder};
 use taskstack::imitation::reference::support::SupportConfig;
+use taskstack::imitation::{Imitator, ImitatorConfig};
 use taskstack::io::clip::Clip;
 use taskstack::robots::{BipedProfile, ProfileError, g1};
 

@@ -6,9 +6,9 @@
 
 use taskstack::human::HumanFrame;
 use taskstack::human::Side;
-use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
 use taskstack::imitation::phase::SupportPhase;
 use taskstack::imitation::reference::support::SupportConfig;
+use taskstack::imitation::{Imitator, ImitatorConfig};
 use taskstack::io::clip::Clip;
 use taskstack::robots::BipedProfile;
 use taskstack::robots::nao;

@@ -7,11 +7,11 @@
 use nalgebra::{Rotation3, Vector3};
 use taskstack::human::HumanFrame;
 use taskstack::imitation::config::ImitationMethod;
-use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
 use taskstack::imitation::koenemann::KoenemannConfig;
 use taskstack::imitation::phase::tables::{OrientationTarget, Task, TaskTables};
 use taskstack::imitation::phase::{PhaseConfig, SupportPhase};
 use taskstack::imitation::reference::support::SupportConfig;
+use taskstack::imitation::{Imitator, ImitatorConfig};
 use taskstack::io::clip::Clip;
 use taskstack::robots::{BipedProfile, g1, nao};
 

@@ -15,6 +15,7 @@ mod solver_common;
 static GLOBAL: alloc_counter::Counting = alloc_counter::Counting;
 
 mod batch;
+mod batch_session;
 mod crate_api;
 mod export_motion;
 mod hardening_entry_points;

@@ -4,8 +4,8 @@
 //! divided by each servo's stiffness `effort / servo_saturation`.
 
 use taskstack::human::HumanFrame;
-use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
 use taskstack::imitation::reference::support::SupportConfig;
+use taskstack::imitation::{Imitator, ImitatorConfig};
 use taskstack::io::clip::Clip;
 use taskstack::robots::{BipedProfile, g1, nao};
 

@@ -5,9 +5,9 @@
 use nalgebra::Vector3;
 use taskstack::human::{HumanFrame, HumanJoint};
 use taskstack::imitation::config::ImitationMethod;
-use taskstack::imitation::imitator::{Imitator, ImitatorConfig};
 use taskstack::imitation::koenemann::KoenemannConfig;
 use taskstack::imitation::reference::support::SupportConfig;
+use taskstack::imitation::{Imitator, ImitatorConfig};
 use taskstack::io::clip::Clip;
 use taskstack::robots::sway::{SWAY_DAMPING, SwayError, SwayShaper};
 use taskstack::robots::{BipedProfile, g1};

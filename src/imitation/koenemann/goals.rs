@@ -547,7 +547,7 @@ pub(super) fn in_torso(data: &ModelData, torso: FrameId, frame: FrameId) -> Isom
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::imitation::imitator::ImitatorConfig;
+    use crate::imitation::ImitatorConfig;
     use crate::robots::nao;
 
     fn nao_shared() -> (Shared, JointBounds) {

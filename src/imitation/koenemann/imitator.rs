@@ -95,6 +95,202 @@ fn arm_joints(shared: &Shared) -> Result<Vec<bool>, ImitationError> {
     }
 }
 
+/// The IKs of Koenemann et al.'s method, built once for the right-rooted model (the root at the
+/// start; the goals name frames of both models alike).
+#[derive(Debug)]
+struct Solves {
+    arms: GoalIk,
+    arms_apart: Option<GoalIk>,
+    feet: GoalIk,
+    stance: GoalIk,
+    settle: GoalIk,
+}
+
+impl Solves {
+    fn new(shared: &Shared, f: &Frames, method: &KoenemannConfig) -> Result<Self, ImitationError> {
+        let (arms, arms_apart) = Self::arms(shared, f, method)?;
+        let (feet, stance, settle) = Self::legs(shared, f, method)?;
+        Ok(Solves {
+            arms,
+            arms_apart,
+            feet,
+            stance,
+            settle,
+        })
+    }
+
+    /// The hands' IK (weighted DLS, the paper's) and the IK that keeps the arms apart after it.
+    fn arms(
+        shared: &Shared,
+        f: &Frames,
+        method: &KoenemannConfig,
+    ) -> Result<(GoalIk, Option<GoalIk>), ImitationError> {
+        let profile = &shared.profile;
+        let arm_settings = arm_settings(method);
+        let dls = Method::WeightedDls {
+            damping: method.damping,
+        };
+        let arms = GoalIk::new(
+            f.hands.map(torso_point).to_vec(),
+            &[],
+            Distances::default(),
+            arm_joints(shared)?,
+            dls,
+            arm_settings,
+        )?;
+        // The upper body drawn toward its standing posture where the hands leave it free.
+        let arms = match method.arm_posture_gain {
+            0.0 => arms,
+            gain => {
+                let gains = (shared.legs.iter()).map(|&leg| if leg { 0.0 } else { gain });
+                arms.with_posture(profile.stand.clone(), gains.collect())
+            }
+        };
+        // The arms' self-collision pairs: weighted DLS has no inequalities, so a second IK
+        // moves the upper body the least that keeps them apart, after the hands' IK.
+        let upper_body: Vec<bool> = shared.legs.iter().map(|leg| !leg).collect();
+        let upper_distances = Distances::moved_by(profile, &shared.q, &upper_body, 0)?;
+        let guard_settings = DriverSettings {
+            max_iterations: 4,
+            ..arm_settings
+        };
+        let arms_apart = (!upper_distances.is_empty())
+            .then(|| {
+                GoalIk::new(
+                    Vec::new(),
+                    &[],
+                    upper_distances,
+                    upper_body,
+                    Method::Prioritized,
+                    guard_settings,
+                )
+            })
+            .transpose()?;
+        Ok((arms, arms_apart))
+    }
+
+    /// The legs' IKs: the feet following the human (`feet`), one sole held while the other
+    /// follows (`stance`), and the held sole alone (`settle`).
+    fn legs(
+        shared: &Shared,
+        f: &Frames,
+        method: &KoenemannConfig,
+    ) -> Result<(GoalIk, GoalIk, GoalIk), ImitationError> {
+        let profile = &shared.profile;
+        let leg_settings = leg_settings(method);
+        let orientation = Goal::RootOrientation {
+            frame: f.soles[0],
+            target: Default::default(),
+        };
+        let com = Goal::RootCom {
+            target: Default::default(),
+        };
+        let feet_goals = vec![
+            com,
+            torso_point(f.soles[0]),
+            torso_normal(f.soles[0]),
+            torso_point(f.soles[1]),
+            torso_normal(f.soles[1]),
+        ];
+        // The CoM first, strictly: statically stable by construction. Below it the prioritized
+        // solver's least squares stand in for the paper's DLS: they are exact where the goals
+        // agree and converge in a few iterations where DLS needs tens (see `taskstack solve`).
+        // The legs alone: the CoM rows would move the arms and head too.
+        let legs = shared.legs.clone();
+        // The legs' self-collision pairs below the CoM (feet) or the held sole (stance), above
+        // the goals the feet follow the human with.
+        let feet = GoalIk::new(
+            feet_goals,
+            &[1, 2],
+            Distances::moved_by(profile, &shared.q, &legs, 1)?,
+            legs.clone(),
+            Method::Prioritized,
+            leg_settings,
+        )?;
+        // The held sole above all: the closed chain of double support must not give way.
+        let hold = Goal::RootPoint {
+            frame: f.soles[1],
+            offset: Vector3::zeros(),
+            target: Vector3::zeros(),
+        };
+        let settle_goals = vec![hold, orientation];
+        let settle_settings = DriverSettings {
+            tolerance: HOLD_TOLERANCE,
+            stall_tolerance: 0.01 * HOLD_TOLERANCE,
+            max_iterations: 10,
+            ..leg_settings
+        };
+        let settle = GoalIk::new(
+            settle_goals,
+            &[],
+            Distances::default(),
+            legs.clone(),
+            Method::Prioritized,
+            settle_settings,
+        )?;
+        let stance_goals = vec![
+            hold,
+            orientation,
+            com,
+            torso_point(f.soles[0]),
+            torso_normal(f.soles[0]),
+        ];
+        let stance = GoalIk::new(
+            stance_goals,
+            &[2, 1],
+            Distances::moved_by(profile, &shared.q, &legs, 2)?,
+            legs,
+            Method::Prioritized,
+            leg_settings,
+        )?;
+        Ok((feet, stance, settle))
+    }
+}
+
+/// The hands' IK settings: a few iterations a frame, steps of at most 0.1 rad.
+fn arm_settings(method: &KoenemannConfig) -> DriverSettings {
+    DriverSettings {
+        gain: 1.0,
+        dt: 1.0,
+        tolerance: 1e-4,
+        stall_tolerance: 1e-7,
+        max_iterations: method.arm_iterations,
+        max_task_error: 0.05,
+        max_joint_step: 0.1,
+        patience: 0,
+    }
+}
+
+/// The legs' IK settings: the method's tolerance and iterations, steps of at most 0.05 rad.
+fn leg_settings(method: &KoenemannConfig) -> DriverSettings {
+    DriverSettings {
+        tolerance: method.tolerance,
+        stall_tolerance: LEG_STALL_FRACTION * method.tolerance,
+        patience: LEG_PATIENCE,
+        max_iterations: method.max_leg_iterations,
+        max_task_error: 0.02,
+        max_joint_step: 0.05,
+        ..arm_settings(method)
+    }
+}
+
+/// A goal on the origin of `frame`, in the torso's frame.
+fn torso_point(frame: FrameId) -> Goal {
+    Goal::TorsoPoint {
+        frame,
+        offset: Vector3::zeros(),
+        target: Vector3::zeros(),
+    }
+}
+
+/// A goal on the z axis of `frame` (a sole's normal), in the torso's frame.
+fn torso_normal(frame: FrameId) -> Goal {
+    Goal::TorsoNormal {
+        frame,
+        normal: Vector3::z(),
+    }
+}
+
 /// Koenemann et al.'s imitator.
 #[derive(Debug)]
 pub(crate) struct KoenemannImitator {
@@ -242,139 +438,13 @@ impl KoenemannImitator {
         let profile = &shared.profile;
         let body = Body::measure(profile, &shared.q)?;
         let frames = [frames(profile, Side::Left)?, frames(profile, Side::Right)?];
-        let arm_settings = DriverSettings {
-            gain: 1.0,
-            dt: 1.0,
-            tolerance: 1e-4,
-            stall_tolerance: 1e-7,
-            max_iterations: method.arm_iterations,
-            max_task_error: 0.05,
-            max_joint_step: 0.1,
-            patience: 0,
-        };
-        let leg_settings = DriverSettings {
-            tolerance: method.tolerance,
-            stall_tolerance: LEG_STALL_FRACTION * method.tolerance,
-            patience: LEG_PATIENCE,
-            max_iterations: method.max_leg_iterations,
-            max_task_error: 0.02,
-            max_joint_step: 0.05,
-            ..arm_settings
-        };
-        let f = &frames[Side::Right.index()];
-        let point = |frame| Goal::TorsoPoint {
-            frame,
-            offset: Vector3::zeros(),
-            target: Vector3::zeros(),
-        };
-        let normal = |frame| Goal::TorsoNormal {
-            frame,
-            normal: Vector3::z(),
-        };
-        let orientation = Goal::RootOrientation {
-            frame: f.soles[0],
-            target: Default::default(),
-        };
-        let dls = Method::WeightedDls {
-            damping: method.damping,
-        };
-        let arms = GoalIk::new(
-            f.hands.map(point).to_vec(),
-            &[],
-            Distances::default(),
-            arm_joints(&shared)?,
-            dls,
-            arm_settings,
-        )?;
-        // The upper body drawn toward its standing posture where the hands leave it free.
-        let arms = match method.arm_posture_gain {
-            0.0 => arms,
-            gain => {
-                let gains = (shared.legs.iter()).map(|&leg| if leg { 0.0 } else { gain });
-                arms.with_posture(profile.stand.clone(), gains.collect())
-            }
-        };
-        // The arms' self-collision pairs: weighted DLS has no inequalities, so a second IK
-        // moves the upper body the least that keeps them apart, after the hands' IK.
-        let upper_body: Vec<bool> = shared.legs.iter().map(|leg| !leg).collect();
-        let upper_distances = Distances::moved_by(profile, &shared.q, &upper_body, 0)?;
-        let guard_settings = DriverSettings {
-            max_iterations: 4,
-            ..arm_settings
-        };
-        let arms_apart = (!upper_distances.is_empty())
-            .then(|| {
-                GoalIk::new(
-                    Vec::new(),
-                    &[],
-                    upper_distances,
-                    upper_body,
-                    Method::Prioritized,
-                    guard_settings,
-                )
-            })
-            .transpose()?;
-        let com = Goal::RootCom {
-            target: Default::default(),
-        };
-        let feet_goals = vec![
-            com,
-            point(f.soles[0]),
-            normal(f.soles[0]),
-            point(f.soles[1]),
-            normal(f.soles[1]),
-        ];
-        // The CoM first, strictly: statically stable by construction. Below it the prioritized
-        // solver's least squares stand in for the paper's DLS: they are exact where the goals
-        // agree and converge in a few iterations where DLS needs tens (see `taskstack solve`).
-        // The legs alone: the CoM rows would move the arms and head too.
-        let legs = shared.legs.clone();
-        // The legs' self-collision pairs below the CoM (feet) or the held sole (stance), above
-        // the goals the feet follow the human with.
-        let feet = GoalIk::new(
-            feet_goals,
-            &[1, 2],
-            Distances::moved_by(profile, &shared.q, &legs, 1)?,
-            legs.clone(),
-            Method::Prioritized,
-            leg_settings,
-        )?;
-        // The held sole above all: the closed chain of double support must not give way.
-        let hold = Goal::RootPoint {
-            frame: f.soles[1],
-            offset: Vector3::zeros(),
-            target: Vector3::zeros(),
-        };
-        let settle_goals = vec![hold, orientation];
-        let settle_settings = DriverSettings {
-            tolerance: HOLD_TOLERANCE,
-            stall_tolerance: 0.01 * HOLD_TOLERANCE,
-            max_iterations: 10,
-            ..leg_settings
-        };
-        let settle = GoalIk::new(
-            settle_goals,
-            &[],
-            Distances::default(),
-            legs.clone(),
-            Method::Prioritized,
-            settle_settings,
-        )?;
-        let stance_goals = vec![
-            hold,
-            orientation,
-            com,
-            point(f.soles[0]),
-            normal(f.soles[0]),
-        ];
-        let stance = GoalIk::new(
-            stance_goals,
-            &[2, 1],
-            Distances::moved_by(profile, &shared.q, &legs, 2)?,
-            legs,
-            Method::Prioritized,
-            leg_settings,
-        )?;
+        let Solves {
+            arms,
+            arms_apart,
+            feet,
+            stance,
+            settle,
+        } = Solves::new(&shared, &frames[Side::Right.index()], &method)?;
         let tuning = profile.tuning;
         let time_constant = (profile.size()?.com_height / GRAVITY).sqrt();
         let leg_ramp_time = (method.leg_ramp_time)

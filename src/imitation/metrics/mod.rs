@@ -54,8 +54,8 @@ use crate::imitation::reference::support::HumanSupport;
 use crate::solver::JointBounds;
 use crate::tasks::{convex_hull, hull_margin};
 
-/// The old paths of `output::CONTACT_HEIGHT` and `output::sole_on_floor`; kept for one
-/// release.
+// The old paths of `output::CONTACT_HEIGHT` and `output::sole_on_floor`; kept for one release.
+#[doc(hidden)]
 pub use crate::imitation::output::{CONTACT_HEIGHT, sole_on_floor};
 
 /// Frames of a run by the kind of the robot's phase.
@@ -266,6 +266,8 @@ impl HeldHandTally {
     }
 }
 
+// The old path of `output::EFFECTORS`; kept for one release.
+#[doc(hidden)]
 pub use crate::imitation::output::EFFECTORS;
 
 /// Tracking error of one effector.

@@ -206,6 +206,64 @@ fn axis_list(axes: Axes) -> [Axis; 3] {
     out
 }
 
+/// `table`'s tasks resolved against `model`: each task's frame point, axes and rows, its
+/// height at the zero posture (`rest`) and its place at the standing one (`initial`); the CoM
+/// tasks move the `balance` joints alone.
+fn resolve_tasks(
+    table: &TaskTable,
+    model: &Model,
+    rest: &ModelData,
+    initial: &ModelData,
+    balance: &[bool],
+) -> Result<Vec<ResolvedTask>, ImitationError> {
+    let mut tasks = Vec::new();
+    for (level, l) in table.levels.iter().enumerate() {
+        let mut row = 0;
+        for task in &l.tasks {
+            let (point, axes) = match task {
+                Task::ComXY(_) => (None, Axes::XY),
+                Task::ComHeight => (None, Axes::Z),
+                Task::Point {
+                    frame,
+                    offset,
+                    axes,
+                    ..
+                } => (Some((frame, Vector3::from(*offset))), *axes),
+                Task::Orientation { frame, .. } => (Some((frame, Vector3::zeros())), Axes::XY),
+            };
+            let point = point
+                .map(|(frame, offset)| {
+                    model
+                        .frame_id(frame)
+                        .map(|frame| FramePoint { frame, offset })
+                })
+                .transpose()?;
+            let (rest_height, standing) = match &point {
+                Some(p) => (
+                    model.point_position(rest, p.frame, &p.offset)?.z,
+                    model.point_position(initial, p.frame, &p.offset)?,
+                ),
+                None => (0.0, Vector3::zeros()),
+            };
+            tasks.push(ResolvedTask {
+                axes: axis_list(axes),
+                rows: task.rows(),
+                task: task.clone(),
+                point,
+                level,
+                row,
+                rest_height,
+                standing,
+                held: Vector3::zeros(),
+                held_yaw: 0.0,
+                joints: matches!(task, Task::ComXY(_) | Task::ComHeight).then(|| balance.to_vec()),
+            });
+            row += task.rows();
+        }
+    }
+    Ok(tasks)
+}
+
 impl PhaseSolver {
     /// `table` resolved against the profile's model rooted at its support sole; standing targets
     /// from `initial_q`.
@@ -222,52 +280,7 @@ impl PhaseSolver {
         let mut initial = model.new_data();
         model.forward_kinematics(&mut initial, initial_q)?;
         let balance = balance_joints(profile, model, &initial)?;
-        let mut tasks = Vec::new();
-        for (level, l) in table.levels.iter().enumerate() {
-            let mut row = 0;
-            for task in &l.tasks {
-                let (point, axes) = match task {
-                    Task::ComXY(_) => (None, Axes::XY),
-                    Task::ComHeight => (None, Axes::Z),
-                    Task::Point {
-                        frame,
-                        offset,
-                        axes,
-                        ..
-                    } => (Some((frame, Vector3::from(*offset))), *axes),
-                    Task::Orientation { frame, .. } => (Some((frame, Vector3::zeros())), Axes::XY),
-                };
-                let point = point
-                    .map(|(frame, offset)| {
-                        model
-                            .frame_id(frame)
-                            .map(|frame| FramePoint { frame, offset })
-                    })
-                    .transpose()?;
-                let (rest_height, standing) = match &point {
-                    Some(p) => (
-                        model.point_position(&rest, p.frame, &p.offset)?.z,
-                        model.point_position(&initial, p.frame, &p.offset)?,
-                    ),
-                    None => (0.0, Vector3::zeros()),
-                };
-                tasks.push(ResolvedTask {
-                    axes: axis_list(axes),
-                    rows: task.rows(),
-                    task: task.clone(),
-                    point,
-                    level,
-                    row,
-                    rest_height,
-                    standing,
-                    held: Vector3::zeros(),
-                    held_yaw: 0.0,
-                    joints: matches!(task, Task::ComXY(_) | Task::ComHeight)
-                        .then(|| balance.clone()),
-                });
-                row += task.rows();
-            }
-        }
+        let tasks = resolve_tasks(table, model, &rest, &initial, &balance)?;
         let constraints = resolve_constraints(table, profile, model, &initial)?;
         let solver = Solver::with_settings(&table.shape(model.nv()), settings)?;
         let driver = PositionDriver::new(&solver, DriverSettings::default())?;

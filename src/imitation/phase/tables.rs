@@ -930,6 +930,8 @@ impl TaskTable {
 
     /// Checks the table: at least one level, every level with rows, every point task with an
     /// axis, task names unique, every number finite.
+    // One function on purpose (~90 lines): one independent check after another, in the order
+    // of the docs above.
     pub fn validate(&self) -> Result<(), TableError> {
         let phase = self.phase;
         if self.levels.is_empty() {
@@ -1101,6 +1103,8 @@ impl fmt::Display for PointCell<'_> {
 impl fmt::Display for TaskTable {
     /// One markdown row like Table I: Support | Step | Model | X_t | X'_c | Gradients (κ).
     /// Levels after the first CoM level are separated by ` ≻ ` (higher priority first).
+    // One function on purpose (~90 lines): one pass over the levels filling the row's columns
+    // left to right, as the paper's table reads.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let mut tracked = Vec::new();
         let mut coms = Vec::new();

@@ -245,7 +245,8 @@ impl HandSupportConfig {
     }
 }
 
-/// The old path of `output::HandPlacement`; kept for one release.
+// The old path of `output::HandPlacement`; kept for one release.
+#[doc(hidden)]
 pub use crate::imitation::output::HandPlacement;
 
 /// What the imitator knows of a hand in the current frame, to map a surface to the robot.

@@ -46,7 +46,7 @@ use crate::imitation::state::{Shared, effector_ids, ground_pose, human_stance, v
 use crate::imitation::walking::follower::WalkFollower;
 use crate::imitation::walking::footsteps::{FootstepPlanner, GroundPose, StepRequest};
 use crate::model::FrameId;
-use crate::robots::{BipedProfile, HumanJointAngles};
+use crate::robots::{BipedProfile, FootArea, HumanJointAngles, MotionTuning};
 use crate::solver::driver::DriverSettings;
 use crate::solver::{JointBounds, JointLimitAvoidance, JointTracking, Settings, SolverError};
 
@@ -162,29 +162,94 @@ fn elbows_kept_bent(
     JointBounds::with_velocity(&lower, &upper, bounds.velocity())
 }
 
+/// The phases' task tables (the config's own, or the executable tables of the profile, with
+/// the stances centred for walking when the robot follows the human's steps) and the hand
+/// supports; the tables gain the rows the hand supports and the ZMP balance need.
+fn tables_and_hands(
+    config: &mut ImitatorConfig,
+    profile: &BipedProfile,
+) -> (TaskTables, Option<HandSupports>) {
+    let mut tables = match config.tables.take() {
+        Some(tables) => tables,
+        None if config.footsteps.follow => {
+            let mut tables = TaskTables::executable(&config.phase, profile);
+            tables.centre_stances_for_walking(profile);
+            tables
+        }
+        None => TaskTables::executable(&config.phase, profile),
+    };
+    let outline_points = profile.feet.iter().map(|f| f.outline.len()).sum();
+    let hands = (config.hand_supports.take()).map(|c| HandSupports::new(c, outline_points));
+    if hands.is_some() {
+        tables.add_hand_supports(profile);
+    }
+    if config.zmp_balance {
+        tables.add_zmp_balance(profile);
+    }
+    (tables, hands)
+}
+
+/// The walk follower of a dynamic walk (`None` unless the config follows the human's steps
+/// dynamically): at the walking velocity fraction, the elbows kept bent as the support phases
+/// keep them when the arms move while walking.
+fn walk_follower(
+    config: &ImitatorConfig,
+    shared: &Shared,
+    position_bounds: &JointBounds,
+    arms: &[[Option<Arm>; 2]; 2],
+    solver: Settings,
+    area: FootArea,
+) -> Result<Option<WalkFollower>, ImitationError> {
+    if !(config.footsteps.follow && config.footsteps.dynamic) {
+        return Ok(None);
+    }
+    let (profile, q) = (&shared.profile, &shared.q);
+    let model = profile.model(Side::Right);
+    let tuning = profile.tuning;
+    let upper_body =
+        (config.upper_body_velocity_fraction).unwrap_or(tuning.upper_body_velocity_fraction);
+    let bounds = velocity_bounds(
+        model,
+        position_bounds,
+        &shared.legs,
+        config.walking_velocity_fraction,
+        upper_body,
+    )?;
+    // The walk's arm step keeps the elbows bent as the support phases do.
+    let bounds = match config.footsteps.walking_arms {
+        true => elbows_kept_bent(&bounds, &arms[Side::Right.index()], q)?,
+        false => bounds,
+    };
+    let footsteps = &config.footsteps;
+    Ok(Some(WalkFollower::new(
+        profile, q, solver, area, footsteps, bounds,
+    )?))
+}
+
+/// The hands' speed and acceleration limits per phase. A dynamic walk starts from double
+/// support and holds the arms where they are: at the double-support speed they stopped within
+/// a frame and the judge's weak NAO fell on CMU 05_02 (not at the stance speed). Its frames
+/// have no ZMP level, so its hands keep the ordinary speeds.
+fn hand_speed(config: &ImitatorConfig, tuning: &MotionTuning, walking: bool) -> HandSpeed {
+    match walking {
+        true => {
+            let speed = config.hand_speed_for(tuning, false);
+            HandSpeed {
+                double: speed.stance,
+                ..speed
+            }
+        }
+        false => config.hand_speed_for(tuning, config.zmp_balance),
+    }
+}
+
 impl PoubelImitator {
     /// An imitator for `profile` (validated by the caller with `config`).
     pub(crate) fn new(
         profile: BipedProfile,
         mut config: ImitatorConfig,
     ) -> Result<Self, ImitationError> {
-        let mut tables = match config.tables.take() {
-            Some(tables) => tables,
-            None if config.footsteps.follow => {
-                let mut tables = TaskTables::executable(&config.phase, &profile);
-                tables.centre_stances_for_walking(&profile);
-                tables
-            }
-            None => TaskTables::executable(&config.phase, &profile),
-        };
-        let outline_points = profile.feet.iter().map(|f| f.outline.len()).sum();
-        let hands = (config.hand_supports.take()).map(|c| HandSupports::new(c, outline_points));
-        if hands.is_some() {
-            tables.add_hand_supports(&profile);
-        }
-        if config.zmp_balance {
-            tables.add_zmp_balance(&profile);
-        }
+        let (tables, hands) = tables_and_hands(&mut config, &profile);
         // Position limits only matter to the limit-avoidance gradient and the start clamp.
         let (mut shared, position_bounds) = Shared::new(profile, &config)?;
         let (profile, q) = (&shared.profile, &shared.q);
@@ -220,29 +285,7 @@ impl PoubelImitator {
         if let Some(ahead) = config.look_ahead.take() {
             footsteps = footsteps.with_look_ahead(ahead);
         }
-        let walk = match config.footsteps.follow && config.footsteps.dynamic {
-            true => {
-                let upper_body = (config.upper_body_velocity_fraction)
-                    .unwrap_or(tuning.upper_body_velocity_fraction);
-                let bounds = velocity_bounds(
-                    model,
-                    &position_bounds,
-                    &shared.legs,
-                    config.walking_velocity_fraction,
-                    upper_body,
-                )?;
-                // The walk's arm step keeps the elbows bent as the support phases do.
-                let bounds = match config.footsteps.walking_arms {
-                    true => elbows_kept_bent(&bounds, &arms[Side::Right.index()], q)?,
-                    false => bounds,
-                };
-                let footsteps = &config.footsteps;
-                Some(WalkFollower::new(
-                    profile, q, solver, area, footsteps, bounds,
-                )?)
-            }
-            false => None,
-        };
+        let walk = walk_follower(&config, &shared, &position_bounds, &arms, solver, area)?;
         let tracking = JointTracking::new(q)?;
         let human_q = q.clone();
         let joint_velocity = JointVelocity::new(q.len());
@@ -262,20 +305,7 @@ impl PoubelImitator {
             iterations: config.iterations_per_frame,
             max_task_speed: config.max_task_speed.unwrap_or(tuning.task_speed),
             walking_arms: config.footsteps.walking_arms,
-            // A dynamic walk starts from double support and holds the arms where they are: at
-            // the double-support speed they stopped within a frame and the judge's weak NAO
-            // fell on CMU 05_02 (not at the stance speed).
-            // Its frames have no ZMP level, so its hands keep the ordinary speeds.
-            hand_speed: match walk.is_some() {
-                true => {
-                    let speed = config.hand_speed_for(&tuning, false);
-                    HandSpeed {
-                        double: speed.stance,
-                        ..speed
-                    }
-                }
-                false => config.hand_speed_for(&tuning, config.zmp_balance),
-            },
+            hand_speed: hand_speed(&config, &tuning, walk.is_some()),
             hand_rates: HandRates::default(),
             arms,
             phases,
@@ -448,21 +478,7 @@ impl PoubelImitator {
             self.tracking.set_reference(walk.start_posture())?;
         }
         let hands = self.hand_goals();
-        let phase = self
-            .walk
-            .as_ref()
-            .map_or(SupportPhase::Double, WalkFollower::phase);
-        let hand_steps = match self.walking_arms {
-            // The arm step takes the whole frame.
-            true => self
-                .hand_rates(phase, &hands, &[None; 2], dt)
-                .map(|v| v * dt),
-            // The walk holds the arms; after it they start again from rest.
-            false => {
-                self.hand_rates.stop();
-                [0.0; 2]
-            }
-        };
+        let hand_steps = self.walking_hand_steps(&hands, dt);
         let Some(walk) = &mut self.walk else {
             return Ok(());
         };
@@ -512,6 +528,27 @@ impl PoubelImitator {
         self.shared.output.walk = state;
         self.phase = phase;
         Ok(())
+    }
+
+    /// How far each hand moves toward the scaled human's this walking frame (m): the whole
+    /// frame's arm step with `walking_arms`, else none (the walk holds the arms; after it they
+    /// start again from rest).
+    fn walking_hand_steps(&mut self, hands: &[Option<Vector3<f64>>; 2], dt: f64) -> [f64; 2] {
+        let phase = self
+            .walk
+            .as_ref()
+            .map_or(SupportPhase::Double, WalkFollower::phase);
+        match self.walking_arms {
+            // The arm step takes the whole frame.
+            true => self
+                .hand_rates(phase, hands, &[None; 2], dt)
+                .map(|v| v * dt),
+            // The walk holds the arms; after it they start again from rest.
+            false => {
+                self.hand_rates.stop();
+                [0.0; 2]
+            }
+        }
     }
 
     /// The hands' speeds toward the scaled human's hands this frame (m/s; [`HandRates`]). A

@@ -19,7 +19,6 @@
 //! [`ClipOutcome`] holds the error, which names the file and the frame.
 
 use std::collections::HashSet;
-use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -27,13 +26,22 @@ use serde_json::{Value, json};
 use thiserror::Error;
 
 use crate::human::HumanFrame;
-use crate::imitation::imitator::{ImitationError, Imitator, ImitatorConfig, RobotFrame};
 use crate::imitation::metrics::{
     EffectorError, ImitationMetrics, MeanMax, MetricsRecorder, Spread,
 };
-use crate::imitation::reference::support::SupportConfig;
+use crate::imitation::poubel::hand_support::HandSupportError;
+use crate::imitation::walking::look_ahead::LookAheadError;
+use crate::imitation::{ImitationError, Imitator, ImitatorConfig, RobotFrame};
 use crate::io::clip::{Clip, ClipError};
 use crate::robots::{BipedProfile, nao};
+
+mod session;
+
+pub use session::{ClipSession, ClipSetup, LookAheadLeads};
+
+// The old path of `export::JointsWriter`; kept for one release.
+#[doc(hidden)]
+pub use crate::export::JointsWriter;
 
 /// Errors of a batch or of one of its clips. Each names the clip file.
 #[derive(Debug, Error)]
@@ -89,6 +97,22 @@ pub enum BatchError {
         /// The pool's error message.
         message: String,
     },
+    /// The human's foot lifts of an offline run could not be read off the clip.
+    #[error("{}: foot lifts: {source}", path.display())]
+    LookAhead {
+        /// The clip file.
+        path: PathBuf,
+        /// The look-ahead's error.
+        source: LookAheadError,
+    },
+    /// The hand contacts with the scene could not be found in the clip.
+    #[error("{}: hand contacts: {source}", path.display())]
+    HandSupports {
+        /// The clip file.
+        path: PathBuf,
+        /// The hand supports' error.
+        source: HandSupportError,
+    },
     /// A fixed hold that is not a number of seconds in `0..=`[`MAX_HOLD`].
     #[error("hold of {0} s: must be a number of seconds within 0–{MAX_HOLD} s")]
     Hold(f64),
@@ -102,12 +126,15 @@ pub struct BatchOptions {
     /// Worker threads; 0 means one per core. Ignored (always 1) without the `parallel` feature.
     pub threads: usize,
     /// Imitator settings shared by every clip, except `support`, which each clip replaces by the
-    /// defaults of its kind of source ([`SupportConfig::for_capture`] of [`Clip::capture`]: optical mocap or Kinect).
+    /// defaults of its kind of source ([`SupportConfig::for_capture`](crate::imitation::reference::support::SupportConfig::for_capture) of [`Clip::capture`]: optical mocap or Kinect).
     pub imitator: ImitatorConfig,
     /// After each clip, the human's last pose is held (frames 1/120 s apart) so that the robot
     /// can finish the step it is taking; those frames are in the outputs too. Default: until
     /// the robot has finished ([`Hold::UntilFinished`]).
     pub hold: Hold,
+    /// What each clip gives its run beyond its frames: a skeleton map, the offline look-ahead
+    /// of the feet, a scene for the hands ([`ClipSession`]). Default: none.
+    pub setup: ClipSetup,
 }
 
 impl Default for BatchOptions {
@@ -117,6 +144,7 @@ impl Default for BatchOptions {
             threads: 0,
             imitator: ImitatorConfig::default(),
             hold: Hold::UntilFinished,
+            setup: ClipSetup::default(),
         }
     }
 }
@@ -444,98 +472,28 @@ pub fn imitate_clip(
     Ok(recorder.finish())
 }
 
-/// Writes `joints.csv` as the frames come: a header `time,<the imitator's variable names>`,
-/// then per frame the time (s) and the joint angles (rad), six decimals.
-#[derive(Debug)]
-pub struct JointsWriter<W: std::io::Write> {
-    out: W,
-    line: String,
-}
-
-impl<W: std::io::Write> JointsWriter<W> {
-    /// A writer into `out` (buffer it: one write per frame follows).
-    pub fn new(out: W) -> Self {
-        Self {
-            out,
-            line: String::new(),
-        }
-    }
-
-    /// Writes the header line.
-    pub fn header(&mut self, imitator: &Imitator) -> std::io::Result<()> {
-        self.header_names(imitator.variable_names())
-    }
-
-    /// Writes the header line for joints named `names` (any source of joint angles: a walk, a
-    /// user's own loop).
-    pub fn header_names<'n>(
-        &mut self,
-        names: impl IntoIterator<Item = &'n str>,
-    ) -> std::io::Result<()> {
-        self.line.clear();
-        self.line.push_str("time");
-        for name in names {
-            self.line.push(',');
-            self.line.push_str(name);
-        }
-        self.line.push('\n');
-        self.out.write_all(self.line.as_bytes())
-    }
-
-    /// Writes `frame`'s line: its servo targets ([`RobotFrame::servo_targets`]), what a robot
-    /// with position servos plays.
-    pub fn frame(&mut self, frame: &RobotFrame) -> std::io::Result<()> {
-        self.row(frame.time, &frame.servo_targets)
-    }
-
-    /// Writes one line: `time` (s) and the joint angles `q` (rad).
-    pub fn row(&mut self, time: f64, q: &[f64]) -> std::io::Result<()> {
-        self.line.clear();
-        let _ = write!(self.line, "{time:.6}");
-        for q in q {
-            let _ = write!(self.line, ",{q:.6}");
-        }
-        self.line.push('\n');
-        self.out.write_all(self.line.as_bytes())
-    }
-
-    /// Flushes the output.
-    pub fn finish(&mut self) -> std::io::Result<()> {
-        self.out.flush()
-    }
-
-    /// The output, given back.
-    pub fn into_inner(self) -> W {
-        self.out
-    }
-}
-
 /// Retargets one clip to `options.robot` and writes `joints.csv` and `metrics.json` into
 /// `output` (created once the clip is open, before any frame is imitated). `joints.csv` is
 /// written as the frames come, so memory stays flat however long the clip. Both are written
 /// as `NAME.partial` and renamed when the run has succeeded; a failed run removes them and
-/// leaves an earlier run's files as they were. `options.imitator.support` is replaced by the
-/// clip's defaults.
+/// leaves an earlier run's files as they were. The clip is prepared by [`ClipSession`] with
+/// `options.setup` (`options.imitator.support` is replaced by the clip's defaults).
 pub fn retarget_clip(
     options: &BatchOptions,
     clip: &Path,
     output: &Path,
 ) -> Result<ClipSummary, BatchError> {
     let start = Instant::now();
-    let path = || clip.to_path_buf();
     let io = |file: &Path| {
         let file = file.to_path_buf();
         move |source| BatchError::Io { path: file, source }
     };
-    let source = Clip::open(clip).map_err(|source| BatchError::Clip {
-        path: path(),
-        source,
-    })?;
+    let session = ClipSession::open(clip, &options.setup)?;
     std::fs::create_dir_all(output).map_err(io(output))?;
     let joints_path = output.join("joints.csv");
     let metrics_path = output.join("metrics.json");
     let [joints_partial, metrics_partial] = [&joints_path, &metrics_path].map(|p| partial(p));
-    let result = write_clip(options, clip, source, &joints_partial, &metrics_partial);
+    let result = write_clip(options, clip, session, &joints_partial, &metrics_partial);
     let result = result.and_then(|summary| {
         std::fs::rename(&joints_partial, &joints_path).map_err(io(&joints_path))?;
         std::fs::rename(&metrics_partial, &metrics_path).map_err(io(&metrics_path))?;
@@ -561,7 +519,7 @@ fn partial(path: &Path) -> PathBuf {
 fn write_clip(
     options: &BatchOptions,
     clip: &Path,
-    source: Clip,
+    session: ClipSession,
     joints_path: &Path,
     metrics_path: &Path,
 ) -> Result<ClipSummary, BatchError> {
@@ -572,10 +530,7 @@ fn write_clip(
     };
     let file = std::fs::File::create(joints_path).map_err(io(joints_path))?;
     let mut joints = JointsWriter::new(std::io::BufWriter::new(file));
-    let config = ImitatorConfig {
-        support: SupportConfig::for_capture(source.capture()),
-        ..options.imitator.clone()
-    };
+    let config = session.config(&options.imitator);
     let robot = options.robot.clone();
     let mut imitator = Imitator::new(robot, config).map_err(|source| BatchError::Imitation {
         path: path(),
@@ -589,7 +544,7 @@ fn write_clip(
             written = joints.frame(frame);
         }
     };
-    let metrics = imitate_clip(clip, source, &mut imitator, options.hold, each)?;
+    let metrics = imitate_clip(clip, session.into_clip(), &mut imitator, options.hold, each)?;
     written
         .and_then(|()| joints.finish())
         .map_err(io(joints_path))?;
@@ -622,6 +577,8 @@ pub fn metrics_json(m: &ImitationMetrics, clip: &Path) -> String {
 
 /// The metrics of a run of `clip` as a JSON value (the fields of [`ImitationMetrics`] with
 /// their units in the key names; non-finite numbers become `null`).
+// One function on purpose (~105 lines): the layout of `metrics.json` in one place, one key per
+// line, as a reader of the file sees it.
 pub fn metrics_value(m: &ImitationMetrics, clip: &Path) -> Value {
     // A cell with no samples has no mean or maximum: `null`, not a 0 that reads as perfect.
     let some = |count: usize, v: f64| (count > 0).then_some(v);
