@@ -1,5 +1,5 @@
 //! Prints the paper's task tables (Poubel Table I) as markdown; this is how
-//! `src/imitation/phase/table1.md` is generated.
+//! `src/imitation/phase/tables/table1.md` is generated.
 
 use taskstack::imitation::phase::tables::TaskTables;
 use taskstack::robots::nao;

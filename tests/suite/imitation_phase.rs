@@ -751,13 +751,13 @@ proptest! {
     }
 }
 
-/// The docs include `src/imitation/phase/table1.md`; it must be exactly the rendering of the data.
+/// The docs include `src/imitation/phase/tables/table1.md`; it must be exactly the rendering of the data.
 #[test]
 fn checked_in_table_matches_the_data() {
     assert_eq!(
-        include_str!("../../src/imitation/phase/table1.md"),
+        include_str!("../../src/imitation/phase/tables/table1.md"),
         TaskTables::paper(&nao::profile()).to_string(),
-        "regenerate with `cargo run --example table1 > src/imitation/phase/table1.md`"
+        "regenerate with `cargo run --example table1 > src/imitation/phase/tables/table1.md`"
     );
 }
 

@@ -453,6 +453,18 @@ pub struct Measurements {
     pub swing_heel_height: f64,
 }
 
+impl Measurements {
+    /// Before the first solve: the CoM infinitely far from any goal (no step ends on it), the
+    /// torso on target, the feet on the ground.
+    pub const AT_START: Self = Self {
+        com_error: f64::INFINITY,
+        posture_error: 0.0,
+        posture_settled: false,
+        swing_toe_height: 0.0,
+        swing_heel_height: 0.0,
+    };
+}
+
 /// Whether an error has stopped shrinking: it has not come down by [`Settling::PROGRESS`] below
 /// its smallest value for [`Settling::PATIENCE`]. The imitator watches the torso's posture error
 /// with it ([`Measurements::posture_settled`]).

@@ -276,19 +276,16 @@ impl PoubelImitator {
             ..ScaleConfig::new(area)
         };
         let scaler = Scaler::new(RobotSkeleton::of(profile)?, scale)?;
-        let arms = Side::BOTH.map(|root| {
-            let model = profile.model(root);
-            Side::BOTH.map(|side| Arm::of(profile, model, side))
-        });
+        let arms = Side::BOTH
+            .map(|root| Side::BOTH.map(|side| Arm::of(profile, profile.model(root), side)));
         shared.bounds = elbows_kept_bent(&shared.bounds, &arms[Side::Right.index()], &shared.q)?;
-        let mut footsteps = FootstepPlanner::new(config.footsteps, area);
-        if let Some(ahead) = config.look_ahead.take() {
-            footsteps = footsteps.with_look_ahead(ahead);
-        }
+        let footsteps = match config.look_ahead.take() {
+            Some(ahead) => FootstepPlanner::new(config.footsteps, area).with_look_ahead(ahead),
+            None => FootstepPlanner::new(config.footsteps, area),
+        };
         let walk = walk_follower(&config, &shared, &position_bounds, &arms, solver, area)?;
         let tracking = JointTracking::new(q)?;
-        let human_q = q.clone();
-        let joint_velocity = JointVelocity::new(q.len());
+        let (human_q, joint_velocity) = (q.clone(), JointVelocity::new(q.len()));
         shared.reserve_output(phases_sizes(&phases));
         Ok(Self {
             detector: SupportDetector::new(config.support)?,
@@ -311,13 +308,7 @@ impl PoubelImitator {
             phases,
             effectors,
             phase: SupportPhase::Double,
-            measurements: Measurements {
-                com_error: f64::INFINITY,
-                posture_error: 0.0,
-                posture_settled: false,
-                swing_toe_height: 0.0,
-                swing_heel_height: 0.0,
-            },
+            measurements: Measurements::AT_START,
             posture_settling: Settling::new(),
             footsteps,
             motion,
