@@ -5,10 +5,12 @@ use std::time::Instant;
 
 use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 
-use super::goals::{Distances, Goal, GoalIk, in_torso};
-use super::mapping::{Limbs, Posture, PostureMapping};
+use super::body::{Body, beyond_fold, outside_torso};
+use super::goals::{Goal, GoalIk, in_torso};
+use super::mapping::{Posture, PostureMapping};
 use super::offset::{OffsetSpeed, offset};
 use super::retarget::{FootRetargeting, retarget_double, support_normal};
+use super::solves::{Frames, Solves, frames};
 use super::support_mode::{SupportMode, target_offset};
 use super::{ARM_STOP_TIME_CONSTANTS, KoenemannConfig, LEG_STOP_TIME_CONSTANTS};
 use crate::human::{HumanFrame, HumanJoint, Side, centre_of_mass};
@@ -16,281 +18,17 @@ use crate::imitation::config::ImitatorConfig;
 use crate::imitation::error::ImitationError;
 use crate::imitation::output::CONTACT_HEIGHT;
 use crate::imitation::output::RobotFrame;
-use crate::imitation::phase::solver::own_joints;
 use crate::imitation::phase::{HoldTimer, Landing, SupportPhase, TakeOff};
-use crate::imitation::reach::Arm;
-use crate::imitation::reference::scaler::reference_points;
 use crate::imitation::reference::support::{HumanSupport, SupportDetector};
 use crate::imitation::shaping::{HandRates, HandSpeed, MotionLimits, SwingHeight};
-use crate::imitation::state::{Shared, effector_ids, human_stance};
+use crate::imitation::state::{Shared, human_stance};
 use crate::locomotion::preview::GRAVITY;
-use crate::model::{FrameId, ModelData, ModelError};
+use crate::model::ModelData;
 use crate::robots::{BipedProfile, FootArea, SolePlacement};
-use crate::solver::driver::DriverSettings;
-use crate::solver::{JointBounds, Method};
+use crate::solver::JointBounds;
 
-/// How far the held sole may be from its place after a frame (m; its orientation's error in
-/// radians times [`super::goals::NORMAL_WEIGHT`]: 3.3e-6 rad).
-const HOLD_TOLERANCE: f64 = 1e-7;
 /// Smallest height of a swing sole above the floor while the human's foot is up (m).
 const SWING_CLEARANCE: f64 = 0.01;
-/// The legs' IK stops when no goal's error changed by more than this fraction of the tolerance
-/// in an iteration. A goal the legs cannot meet (a joint at its limit) crept 5 µm an iteration
-/// toward it and ran the IK to its cap of 200 on one NAO frame in ten of CMU 05_02 (3.4 ms a
-/// frame, 20× the median) to end 0.1 mm closer; a Gauss–Newton step that converges gains far
-/// more than 1 % of the tolerance an iteration.
-const LEG_STALL_FRACTION: f64 = 0.01;
-/// The legs' IK ends at its best iterate after this many iterations without a better one
-/// ([`DriverSettings::patience`]): on the G1 it circled through three iterates until its cap
-/// of 200 on most frames of CMU 02_10 (6.2 ms a frame), ending on one with the held sole 1.1 mm
-/// off.
-const LEG_PATIENCE: usize = 10;
-/// How far beyond the folded arm's reach a hand target is kept (m): at the reach itself the
-/// elbow ends a hair past its limit and the IK still pressed it.
-const FOLD_CLEARANCE: f64 = 0.005;
-
-/// Frames of one model.
-#[derive(Debug)]
-struct Frames {
-    torso: FrameId,
-    soles: [FrameId; 2],
-    ankles: [FrameId; 2],
-    hands: [FrameId; 2],
-    effectors: [FrameId; 4],
-}
-
-/// Robot geometry the method needs, measured once at the standing posture.
-#[derive(Debug)]
-struct Body {
-    /// Shoulders and hips in the torso frame (m), `[left, right]`.
-    shoulders: [Vector3<f64>; 2],
-    /// The nearest each hand gets to its shoulder, the elbow at its most bent (m; 0 for an arm
-    /// the profile does not map), `[left, right]`.
-    folded: [f64; 2],
-    hips: [Vector3<f64>; 2],
-    limbs: Limbs,
-    /// The point of each sole the offset ends at, in the sole frames: its centre, or its
-    /// stance point ([`MotionTuning::offset_to_stance_point`](crate::robots::MotionTuning::offset_to_stance_point)).
-    centres: [Vector3<f64>; 2],
-    /// Each ankle in its sole frame.
-    ankles: [Vector3<f64>; 2],
-    /// Each ankle relative to its hip standing (torso axes).
-    stance: [Vector3<f64>; 2],
-}
-
-/// The joints the hands' IK moves: all but a waist's (those that turn the profile's chest
-/// but not its torso, [`BipedProfile::chest`]). The hands then turn a robot's upper body at
-/// its shoulders, not at a waist that swings the whole trunk: on the G1, with hands at 1.2 m/s
-/// moving its waist, the trunk's swing made it fall in the physics judge.
-fn arm_joints(shared: &Shared) -> Result<Vec<bool>, ImitationError> {
-    let profile = &shared.profile;
-    let side = Side::Right;
-    match &profile.chest {
-        Some(chest) => {
-            let (model, data) = (profile.model(side), &shared.data[side.index()]);
-            let waist = own_joints(model, data, chest, &profile.torso)?;
-            Ok(waist.iter().map(|w| !w).collect())
-        }
-        None => Ok(vec![true; shared.q.len()]),
-    }
-}
-
-/// The IKs of Koenemann et al.'s method, built once for the right-rooted model (the root at the
-/// start; the goals name frames of both models alike).
-#[derive(Debug)]
-struct Solves {
-    arms: GoalIk,
-    arms_apart: Option<GoalIk>,
-    feet: GoalIk,
-    stance: GoalIk,
-    settle: GoalIk,
-}
-
-impl Solves {
-    fn new(shared: &Shared, f: &Frames, method: &KoenemannConfig) -> Result<Self, ImitationError> {
-        let (arms, arms_apart) = Self::arms(shared, f, method)?;
-        let (feet, stance, settle) = Self::legs(shared, f, method)?;
-        Ok(Solves {
-            arms,
-            arms_apart,
-            feet,
-            stance,
-            settle,
-        })
-    }
-
-    /// The hands' IK (weighted DLS, the paper's) and the IK that keeps the arms apart after it.
-    fn arms(
-        shared: &Shared,
-        f: &Frames,
-        method: &KoenemannConfig,
-    ) -> Result<(GoalIk, Option<GoalIk>), ImitationError> {
-        let profile = &shared.profile;
-        let arm_settings = arm_settings(method);
-        let dls = Method::WeightedDls {
-            damping: method.damping,
-        };
-        let arms = GoalIk::new(
-            f.hands.map(torso_point).to_vec(),
-            &[],
-            Distances::default(),
-            arm_joints(shared)?,
-            dls,
-            arm_settings,
-        )?;
-        // The upper body drawn toward its standing posture where the hands leave it free.
-        let arms = match method.arm_posture_gain {
-            0.0 => arms,
-            gain => {
-                let gains = (shared.legs.iter()).map(|&leg| if leg { 0.0 } else { gain });
-                arms.with_posture(profile.stand.clone(), gains.collect())
-            }
-        };
-        // The arms' self-collision pairs: weighted DLS has no inequalities, so a second IK
-        // moves the upper body the least that keeps them apart, after the hands' IK.
-        let upper_body: Vec<bool> = shared.legs.iter().map(|leg| !leg).collect();
-        let upper_distances = Distances::moved_by(profile, &shared.q, &upper_body, 0)?;
-        let guard_settings = DriverSettings {
-            max_iterations: 4,
-            ..arm_settings
-        };
-        let arms_apart = (!upper_distances.is_empty())
-            .then(|| {
-                GoalIk::new(
-                    Vec::new(),
-                    &[],
-                    upper_distances,
-                    upper_body,
-                    Method::Prioritized,
-                    guard_settings,
-                )
-            })
-            .transpose()?;
-        Ok((arms, arms_apart))
-    }
-
-    /// The legs' IKs: the feet following the human (`feet`), one sole held while the other
-    /// follows (`stance`), and the held sole alone (`settle`).
-    fn legs(
-        shared: &Shared,
-        f: &Frames,
-        method: &KoenemannConfig,
-    ) -> Result<(GoalIk, GoalIk, GoalIk), ImitationError> {
-        let profile = &shared.profile;
-        let leg_settings = leg_settings(method);
-        let orientation = Goal::RootOrientation {
-            frame: f.soles[0],
-            target: Default::default(),
-        };
-        let com = Goal::RootCom {
-            target: Default::default(),
-        };
-        let feet_goals = vec![
-            com,
-            torso_point(f.soles[0]),
-            torso_normal(f.soles[0]),
-            torso_point(f.soles[1]),
-            torso_normal(f.soles[1]),
-        ];
-        // The CoM first, strictly: statically stable by construction. Below it the prioritized
-        // solver's least squares stand in for the paper's DLS: they are exact where the goals
-        // agree and converge in a few iterations where DLS needs tens (see `taskstack solve`).
-        // The legs alone: the CoM rows would move the arms and head too.
-        let legs = shared.legs.clone();
-        // The legs' self-collision pairs below the CoM (feet) or the held sole (stance), above
-        // the goals the feet follow the human with.
-        let feet = GoalIk::new(
-            feet_goals,
-            &[1, 2],
-            Distances::moved_by(profile, &shared.q, &legs, 1)?,
-            legs.clone(),
-            Method::Prioritized,
-            leg_settings,
-        )?;
-        // The held sole above all: the closed chain of double support must not give way.
-        let hold = Goal::RootPoint {
-            frame: f.soles[1],
-            offset: Vector3::zeros(),
-            target: Vector3::zeros(),
-        };
-        let settle_goals = vec![hold, orientation];
-        let settle_settings = DriverSettings {
-            tolerance: HOLD_TOLERANCE,
-            stall_tolerance: 0.01 * HOLD_TOLERANCE,
-            max_iterations: 10,
-            ..leg_settings
-        };
-        let settle = GoalIk::new(
-            settle_goals,
-            &[],
-            Distances::default(),
-            legs.clone(),
-            Method::Prioritized,
-            settle_settings,
-        )?;
-        let stance_goals = vec![
-            hold,
-            orientation,
-            com,
-            torso_point(f.soles[0]),
-            torso_normal(f.soles[0]),
-        ];
-        let stance = GoalIk::new(
-            stance_goals,
-            &[2, 1],
-            Distances::moved_by(profile, &shared.q, &legs, 2)?,
-            legs,
-            Method::Prioritized,
-            leg_settings,
-        )?;
-        Ok((feet, stance, settle))
-    }
-}
-
-/// The hands' IK settings: a few iterations a frame, steps of at most 0.1 rad.
-fn arm_settings(method: &KoenemannConfig) -> DriverSettings {
-    DriverSettings {
-        gain: 1.0,
-        dt: 1.0,
-        tolerance: 1e-4,
-        stall_tolerance: 1e-7,
-        max_iterations: method.arm_iterations,
-        max_task_error: 0.05,
-        max_joint_step: 0.1,
-        patience: 0,
-    }
-}
-
-/// The legs' IK settings: the method's tolerance and iterations, steps of at most 0.05 rad.
-fn leg_settings(method: &KoenemannConfig) -> DriverSettings {
-    DriverSettings {
-        tolerance: method.tolerance,
-        stall_tolerance: LEG_STALL_FRACTION * method.tolerance,
-        patience: LEG_PATIENCE,
-        max_iterations: method.max_leg_iterations,
-        max_task_error: 0.02,
-        max_joint_step: 0.05,
-        ..arm_settings(method)
-    }
-}
-
-/// A goal on the origin of `frame`, in the torso's frame.
-fn torso_point(frame: FrameId) -> Goal {
-    Goal::TorsoPoint {
-        frame,
-        offset: Vector3::zeros(),
-        target: Vector3::zeros(),
-    }
-}
-
-/// A goal on the z axis of `frame` (a sole's normal), in the torso's frame.
-fn torso_normal(frame: FrameId) -> Goal {
-    Goal::TorsoNormal {
-        frame,
-        normal: Vector3::z(),
-    }
-}
-
 /// Koenemann et al.'s imitator.
 #[derive(Debug)]
 pub(crate) struct KoenemannImitator {
@@ -351,81 +89,6 @@ pub(crate) struct KoenemannImitator {
     swing: SwingHeight,
     /// Placement of the non-root sole held in double support (root frame).
     hold: IsometryMatrix3<f64>,
-}
-
-fn frames(profile: &BipedProfile, root: Side) -> Result<Frames, ModelError> {
-    let model = profile.model(root);
-    let id = |name: &str| model.frame_id(name);
-    let [lf, rf] = &profile.feet;
-    let [lh, rh] = &profile.hands;
-    Ok(Frames {
-        torso: id(&profile.torso)?,
-        soles: [id(&lf.sole)?, id(&rf.sole)?],
-        ankles: [id(&lf.ankle)?, id(&rf.ankle)?],
-        hands: [id(lh)?, id(rh)?],
-        effectors: effector_ids(profile)?[root.index()],
-    })
-}
-
-impl Body {
-    fn measure(profile: &BipedProfile, q: &[f64]) -> Result<Self, ImitationError> {
-        let model = profile.model(Side::Right);
-        let mut data = model.new_data();
-        model.forward_kinematics(&mut data, q)?;
-        let f = frames(profile, Side::Right)?;
-        let torso = data.frame_placement(f.torso).inverse();
-        let points = reference_points(model, &data, &profile.points)?;
-        let point = |joint: HumanJoint| {
-            points[joint.index()].ok_or(ImitationError::InvalidParameter {
-                name: "profile.points",
-                value: joint.index() as f64,
-                reason: "the method needs the shoulders, elbows, hips and knees mapped",
-            })
-        };
-        use HumanJoint as J;
-        let pair = |l, r| -> Result<[Vector3<f64>; 2], ImitationError> {
-            Ok([point(l)?, point(r)?].map(|p| torso.transform_point(&p.into()).coords))
-        };
-        let shoulders = pair(J::LShoulder, J::RShoulder)?;
-        let elbows = pair(J::LElbow, J::RElbow)?;
-        let hips = pair(J::LHip, J::RHip)?;
-        let knees = pair(J::LKnee, J::RKnee)?;
-        let hands = f
-            .hands
-            .map(|h| in_torso(&data, f.torso, h).translation.vector);
-        let ankles = f
-            .ankles
-            .map(|a| in_torso(&data, f.torso, a).translation.vector);
-        let length = |a: &[Vector3<f64>; 2], b: &[Vector3<f64>; 2], c: &[Vector3<f64>; 2]| {
-            [0, 1].map(|k| (b[k] - a[k]).norm() + (c[k] - b[k]).norm())
-        };
-        let sole_ankle = |s: Side| {
-            let k = s.index();
-            (data.frame_placement(f.soles[k]).inverse() * data.frame_placement(f.ankles[k]))
-                .translation
-                .vector
-        };
-        let folded =
-            Side::BOTH.map(|side| Arm::of(profile, model, side).map_or(0.0, |a| a.nearest()));
-        Ok(Body {
-            shoulders,
-            folded,
-            hips,
-            limbs: Limbs {
-                arms: length(&shoulders, &elbows, &hands),
-                legs: length(&hips, &knees, &ankles),
-            },
-            centres: Side::BOTH.map(|s| {
-                let [x, y] = match profile.tuning.offset_to_stance_point {
-                    true => profile.stance_point(s, profile.tuning.support_margin),
-                    false => profile.sole_centre(s),
-                };
-                Vector3::new(x, y, 0.0)
-            }),
-            ankles: Side::BOTH.map(sole_ankle),
-            stance: [0, 1].map(|k| ankles[k] - hips[k]),
-        })
-    }
 }
 
 impl KoenemannImitator {
@@ -1090,36 +753,4 @@ fn stop_before(target: f64, step: f64, limit: f64, stop_time: f64, dt: f64) -> f
     }
     let stop = (2.0 * limit / stop_time * target.abs()).sqrt() * dt;
     step.clamp(-stop, stop)
-}
-
-/// `p` (torso frame, m) pushed along the line from arm `k`'s shoulder until it lies
-/// [`FOLD_CLEARANCE`] beyond the nearest its hand gets (the elbow at its most bent). A target
-/// the folded arm cannot reach had the arm's IK press the elbow into its limit frame after
-/// frame, and the free joints of the wrist turned back and forth at their velocity bound
-/// (NAO, CMU 02_10: 145 frames with a joint reversal, 135 of them the right wrist's yaw; 2
-/// with the target pushed out).
-fn beyond_fold(p: Vector3<f64>, k: usize, body: &Body) -> Vector3<f64> {
-    let arm = p - body.shoulders[k];
-    let nearest = body.folded[k] + FOLD_CLEARANCE;
-    match arm.try_normalize(1e-9) {
-        Some(direction) if arm.norm() < nearest => body.shoulders[k] + direction * nearest,
-        _ => p,
-    }
-}
-
-/// `p` pushed out of the torso's vertical cylinder of `radius` around the torso's z axis,
-/// between the hips and the shoulders (torso frame).
-fn outside_torso(p: Vector3<f64>, radius: f64, body: &Body) -> Vector3<f64> {
-    let (low, high) = (body.hips[0].z, body.shoulders[0].z);
-    let across = p.xy().norm();
-    if p.z < low || p.z > high || across >= radius {
-        return p;
-    }
-    let direction = if across > 1e-9 {
-        p.xy() / across
-    } else {
-        nalgebra::Vector2::new(1.0, 0.0)
-    };
-    let xy = direction * radius;
-    Vector3::new(xy.x, xy.y, p.z)
 }

@@ -54,11 +54,13 @@
 //! human's CoM is estimated from the skeleton ([`crate::human::centre_of_mass`]) where the
 //! paper had the Xsens suit's.
 
+mod body;
 pub(super) mod goals;
 pub(super) mod imitator;
 pub mod mapping;
 pub mod offset;
 pub mod retarget;
+mod solves;
 pub mod support_mode;
 
 pub use mapping::Calibration;
