@@ -5,6 +5,7 @@
 
 pub mod hand_support;
 mod imitator;
+mod setup;
 mod shoulder_anchor;
 
 pub(crate) use imitator::PoubelImitator;
