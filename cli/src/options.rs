@@ -85,8 +85,9 @@ pub(crate) struct ImitationOptions {
     pub(crate) dynamic_walk: bool,
     /// Experimental, with --dynamic-walk: the hands follow the human while the robot walks
     /// (an arm step after each walking frame moves the arms alone). The hands come 4–8 cm
-    /// nearer the human on the bundled walks, but the physics judge's weak NAO falls on every
-    /// walking clip: for kinematic retargeting, not yet for a robot.
+    /// nearer the human on the bundled walks, but the walk's plan does not see the arms'
+    /// momentum and the physics judge's NAO falls on some walking clips: for kinematic
+    /// retargeting, not yet for a robot.
     #[arg(long, requires = "dynamic_walk")]
     pub(crate) walking_arms: bool,
     /// With --walk: a robot foot farther than this from its target footprint (m, ≥ 0) takes a

@@ -71,8 +71,8 @@ pub struct FootstepConfig {
     /// at their single-support speed, the arms clear of the torso and head
     /// ([`crate::imitation::walking::walking_arms_table`]). Off by default: on the bundled walks the
     /// hands come 4–8 cm nearer the human over the clip, but the walk's plan keeps the CoM's
-    /// ZMP in the support and does not see the arms' momentum, and the physics judge's weak
-    /// NAO falls on the walking clips with it.
+    /// ZMP in the support and does not see the arms' momentum: the physics judge's NAO falls
+    /// on some walking clips with it.
     pub walking_arms: bool,
     /// A foot farther than this from its target (m) is moved by a step. Default 0.02.
     pub distance: f64,
