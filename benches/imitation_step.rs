@@ -15,6 +15,7 @@ use taskstack::human::HumanFrame;
 use taskstack::imitation::config::ImitationMethod;
 use taskstack::imitation::koenemann::KoenemannConfig;
 use taskstack::imitation::phase::SupportPhase;
+use taskstack::imitation::poubel::PoubelConfig;
 use taskstack::imitation::{Imitator, ImitatorConfig};
 use taskstack::io::clip::Clip;
 use taskstack::robots::{BipedProfile, g1, nao};
@@ -30,7 +31,7 @@ type Robot = (&'static str, fn() -> BipedProfile);
 fn bench(c: &mut Criterion) {
     let robots: [Robot; 2] = [("nao", nao::profile), ("g1", g1::profile)];
     let methods = [
-        ("poubel", ImitationMethod::Poubel),
+        ("poubel", ImitationMethod::default()),
         (
             "koenemann",
             ImitationMethod::Koenemann(KoenemannConfig::default()),
@@ -49,7 +50,7 @@ fn bench(c: &mut Criterion) {
     ]
     .into_iter()
     .flat_map(|clip| robots.map(|robot| (clip, robot)))
-    .flat_map(|case| methods.map(|method| (case, method)))
+    .flat_map(|case| methods.clone().map(|method| (case, method)))
     {
         let frames = frames(clip);
         let config = ImitatorConfig {
@@ -125,9 +126,13 @@ fn bench_laps(c: &mut Criterion, name: &str, imitator: &mut Imitator, frames: &[
 /// 07_04, NAO: the clip replayed in laps, so the robot keeps walking after the human's steps.
 fn dynamic_walk(c: &mut Criterion) {
     let frames = frames("cmu_07_04_slow_walk.bvh");
-    let mut config = ImitatorConfig::default();
-    config.footsteps.follow = true;
-    config.footsteps.dynamic = true;
+    let mut poubel = PoubelConfig::default();
+    poubel.footsteps.follow = true;
+    poubel.footsteps.dynamic = true;
+    let config = ImitatorConfig {
+        method: ImitationMethod::Poubel(poubel),
+        ..ImitatorConfig::default()
+    };
     let mut imitator = Imitator::new(nao::profile(), config).unwrap();
     let walking = frames
         .iter()
@@ -142,12 +147,15 @@ fn dynamic_walk(c: &mut Criterion) {
     bench_laps(c, name, &mut imitator, &frames);
 }
 
-/// Poubel's method on the NAO with the ZMP balance (`ImitatorConfig::zmp_balance`) and hands
+/// Poubel's method on the NAO with the ZMP balance (`PoubelConfig::zmp_balance`) and hands
 /// at 1 m/s, on the stand on one leg (CMU 05_02): the cost of the "dynamics" level.
 fn zmp_balance(c: &mut Criterion) {
     let frames = frames("cmu_05_02_stand_arm_gestures_turn_single_leg.bvh");
     let config = ImitatorConfig {
-        zmp_balance: true,
+        method: ImitationMethod::Poubel(PoubelConfig {
+            zmp_balance: true,
+            ..PoubelConfig::default()
+        }),
         max_tracking_speed: Some(1.0),
         max_tracking_acceleration: Some(10.0),
         ..ImitatorConfig::default()

@@ -2,7 +2,7 @@
 //! Jacobian (2 rows), the l_hand, r_hand, l_ankle position Jacobians (9 rows) and the CoM.
 //! Goal: ≤ 2 µs median. Also FK alone, for the split; and the whole body's angular momentum
 //! Jacobian (3 rows) and the ZMP task's rows (a 4-edge sole and the vertical moment), the
-//! rows `ImitatorConfig::zmp_balance` adds.
+//! rows `PoubelConfig::zmp_balance` adds.
 
 use std::hint::black_box;
 

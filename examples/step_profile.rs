@@ -40,11 +40,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if koenemann {
         config.method = ImitationMethod::Koenemann(KoenemannConfig::default());
     }
-    config.footsteps.follow = has("--walk") || has("--dynamic-walk");
-    config.footsteps.dynamic = has("--dynamic-walk");
-    if let Some(at) = args.iter().position(|a| a == "--max-passes") {
-        let budget = args.get(at + 1).and_then(|n| n.parse().ok()).ok_or(usage)?;
-        config.solver.max_passes = Some(budget);
+    if let Some(poubel) = config.poubel_mut() {
+        poubel.footsteps.follow = has("--walk") || has("--dynamic-walk");
+        poubel.footsteps.dynamic = has("--dynamic-walk");
+        if let Some(at) = args.iter().position(|a| a == "--max-passes") {
+            let budget = args.get(at + 1).and_then(|n| n.parse().ok()).ok_or(usage)?;
+            poubel.solver.max_passes = Some(budget);
+        }
     }
     let profile = if has("g1") {
         g1::profile()

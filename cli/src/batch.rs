@@ -56,7 +56,7 @@ pub(crate) fn run(args: BatchArgs, report: Report) -> Result<ExitCode> {
         .with_context(|| format!("output folder {}: cannot create it", args.out.display()))?;
     let settings = Settings {
         profile: args.options.profile()?,
-        config: args.options.imitator_config(),
+        config: args.options.imitator_config()?,
         hold: args.options.hold,
         setup: args.clip_options.setup(args.options.skeleton_map()?)?,
         exports: args.options.exports(),

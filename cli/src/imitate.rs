@@ -93,7 +93,7 @@ pub(crate) fn run(args: ImitateArgs, report: Report) -> Result<ExitCode> {
     let out = args.out.clone().unwrap_or_else(|| default_out(&clip));
     let settings = Settings {
         profile: args.options.profile()?,
-        config: args.options.imitator_config(),
+        config: args.options.imitator_config()?,
         hold: args.options.hold,
         setup: args.clip_options.setup(args.options.skeleton_map()?)?,
         exports: args.options.exports(),

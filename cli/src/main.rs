@@ -88,6 +88,10 @@ fn main() -> ExitCode {
     match result {
         Ok(code) => code,
         Err(error) if is_broken_pipe(&error) => ExitCode::SUCCESS,
+        Err(error) if error.is::<options::UsageError>() => {
+            eprintln!("taskstack: error: {error}");
+            ExitCode::from(2)
+        }
         Err(error) => {
             eprintln!("taskstack: error: {}", describe(&error));
             ExitCode::FAILURE

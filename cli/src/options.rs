@@ -6,8 +6,9 @@ use anyhow::{Context, Result};
 use clap::Args;
 use taskstack::ImitatorConfig;
 use taskstack::batch::{ClipSetup, Hold, LookAheadLeads, MAX_HOLD};
-use taskstack::imitation::config::ImitationMethod;
+use taskstack::imitation::ImitationMethod;
 use taskstack::imitation::koenemann::{Calibration, FootRetargeting, KoenemannConfig};
+use taskstack::imitation::poubel::PoubelConfig;
 use taskstack::imitation::walking::look_ahead::FootLookAhead;
 use taskstack::io::skeleton_map::SkeletonMap;
 use taskstack::robots::{BipedProfile, g1, nao};
@@ -148,9 +149,15 @@ pub(crate) struct ImitationOptions {
     /// robot profile's (NAO 0.5, G1 0.1).
     #[arg(long, value_name = "F", value_parser = fraction, allow_negative_numbers = true)]
     pub(crate) upper_body_fraction: Option<f64>,
-    /// Fastest speed of the CoM and foot targets (m/s, > 0). Default: the profile's (0.15).
+    /// Poubel's method: fastest speed any task's target moves at (m/s, > 0): the CoM, the
+    /// feet, the torso, and the hands where --tracking-speed does not set theirs. Default: the
+    /// robot profile's (NAO 0.15).
     #[arg(long, value_name = "M_PER_S", value_parser = positive, allow_negative_numbers = true)]
     pub(crate) task_speed: Option<f64>,
+    /// `--method koenemann`: fastest speed of the swing foot's target toward the human's foot
+    /// (m/s, > 0). Default: the robot profile's task speed (NAO 0.15).
+    #[arg(long, value_name = "M_PER_S", value_parser = positive, allow_negative_numbers = true)]
+    pub(crate) swing_speed: Option<f64>,
     /// Fastest speed of the hand targets toward the scaled human (m/s, > 0), in every phase.
     /// Default: the profile's, once both feet have stood for a second / on one foot and while
     /// the weight shifts (NAO 0.8 / 0.3, G1 1.2 / 0.6; both methods; --dynamic-walk the second
@@ -162,7 +169,7 @@ pub(crate) struct ImitationOptions {
     /// G1 5; both methods).
     #[arg(long, value_name = "M_PER_S2", value_parser = positive, allow_negative_numbers = true)]
     pub(crate) tracking_acceleration: Option<f64>,
-    /// Solver iterations per human frame (1–100).
+    /// Poubel's method: solver iterations per human frame (1–100).
     #[arg(long, value_name = "N", default_value_t = 1,
           value_parser = clap::value_parser!(u32).range(1..=100))]
     pub(crate) iterations: u32,
@@ -261,37 +268,60 @@ impl ImitationOptions {
             .transpose()
     }
 
-    /// The imitator settings of these options (support detection is set per clip).
-    pub(crate) fn imitator_config(&self) -> ImitatorConfig {
-        let method = match self.method {
-            MethodName::Poubel => ImitationMethod::Poubel,
-            MethodName::Koenemann => ImitationMethod::Koenemann(KoenemannConfig {
-                calibration: match self.calibration {
-                    CalibrationName::Auto => Calibration::Auto,
-                    CalibrationName::FirstFrame => Calibration::FirstFrame,
-                    CalibrationName::Ideal => Calibration::Ideal,
-                },
-                retargeting: match self.retargeting {
-                    RetargetingName::ShiftBothFeet => FootRetargeting::ShiftBothFeet,
-                    RetargetingName::MoveOneFoot => FootRetargeting::MoveOneFoot,
-                },
-                ..KoenemannConfig::default()
-            }),
+    /// The imitator settings of these options (support detection is set per clip); an option
+    /// of the other method is an error.
+    pub(crate) fn imitator_config(&self) -> Result<ImitatorConfig> {
+        let (method, others) = match self.method {
+            MethodName::Poubel => (
+                ImitationMethod::Poubel(self.poubel()),
+                self.koenemann_given(),
+            ),
+            MethodName::Koenemann => {
+                let koenemann = KoenemannConfig {
+                    calibration: match self.calibration {
+                        CalibrationName::Auto => Calibration::Auto,
+                        CalibrationName::FirstFrame => Calibration::FirstFrame,
+                        CalibrationName::Ideal => Calibration::Ideal,
+                    },
+                    retargeting: match self.retargeting {
+                        RetargetingName::ShiftBothFeet => FootRetargeting::ShiftBothFeet,
+                        RetargetingName::MoveOneFoot => FootRetargeting::MoveOneFoot,
+                    },
+                    swing_speed: self.swing_speed,
+                    ..KoenemannConfig::default()
+                };
+                (ImitationMethod::Koenemann(koenemann), self.poubel_given())
+            }
         };
-        let mut config = ImitatorConfig {
+        if let Some(option) = others.first() {
+            let method = format!("{:?}", self.method).to_lowercase();
+            let message = format!("{option} is not an option of --method {method}");
+            return Err(UsageError(message).into());
+        }
+        Ok(ImitatorConfig {
             method,
             velocity_fraction: self.velocity_fraction,
             upper_body_velocity_fraction: self.upper_body_fraction,
-            max_task_speed: self.task_speed,
             max_tracking_speed: self.tracking_speed,
             max_tracking_acceleration: self.tracking_acceleration,
-            iterations_per_frame: self.iterations as usize,
             ..ImitatorConfig::default()
+        })
+    }
+
+    /// Poubel et al.'s settings of these options.
+    fn poubel(&self) -> PoubelConfig {
+        let mut poubel = PoubelConfig {
+            max_task_speed: self.task_speed,
+            iterations_per_frame: self.iterations as usize,
+            zmp_balance: self.zmp_balance,
+            damping_momentum: self.damping_momentum,
+            damping: self.damping,
+            ..PoubelConfig::default()
         };
-        config.footsteps.follow = self.walk || self.dynamic_walk;
-        config.footsteps.dynamic = self.dynamic_walk;
-        config.footsteps.walking_arms = self.walking_arms;
-        let steps = &mut config.footsteps;
+        let steps = &mut poubel.footsteps;
+        steps.follow = self.walk || self.dynamic_walk;
+        steps.dynamic = self.dynamic_walk;
+        steps.walking_arms = self.walking_arms;
         for (option, field) in [
             (self.step_distance, &mut steps.distance),
             (self.step_heading, &mut steps.heading),
@@ -302,10 +332,46 @@ impl ImitationOptions {
                 *field = value;
             }
         }
-        config.zmp_balance = self.zmp_balance;
-        config.damping_momentum = self.damping_momentum;
-        config.damping = self.damping;
-        config
+        poubel
+    }
+
+    /// The options of Poubel's method given away from their defaults.
+    fn poubel_given(&self) -> Vec<&'static str> {
+        let steps = [
+            self.step_distance,
+            self.step_heading,
+            self.step_pivot,
+            self.step_slide,
+        ];
+        [
+            (self.walk, "--walk"),
+            (self.dynamic_walk, "--dynamic-walk"),
+            (self.walking_arms, "--walking-arms"),
+            (steps.iter().any(Option::is_some), "--step-*"),
+            (self.zmp_balance, "--zmp-balance"),
+            (self.damping.is_some(), "--damping"),
+            (self.damping_momentum != 0.0, "--damping-momentum"),
+            (self.task_speed.is_some(), "--task-speed"),
+            (self.iterations != 1, "--iterations"),
+        ]
+        .into_iter()
+        .filter_map(|(given, name)| given.then_some(name))
+        .collect()
+    }
+
+    /// The options of Koenemann's method given away from their defaults.
+    fn koenemann_given(&self) -> Vec<&'static str> {
+        [
+            (self.calibration != CalibrationName::Auto, "--calibration"),
+            (
+                self.retargeting != RetargetingName::ShiftBothFeet,
+                "--retargeting",
+            ),
+            (self.swing_speed.is_some(), "--swing-speed"),
+        ]
+        .into_iter()
+        .filter_map(|(given, name)| given.then_some(name))
+        .collect()
     }
 }
 
@@ -377,6 +443,18 @@ fn hold(text: &str) -> Result<Hold, String> {
         Err(format!("{value} s is not within 0–{MAX_HOLD} s"))
     }
 }
+
+/// Options that parse but do not go together (exit code 2, as clap's own usage errors).
+#[derive(Debug)]
+pub(crate) struct UsageError(pub(crate) String);
+
+impl std::fmt::Display for UsageError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for UsageError {}
 
 /// The motion exports beside `joints.csv`.
 #[derive(Debug, Clone, Copy, Default)]

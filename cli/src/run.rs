@@ -101,7 +101,7 @@ fn run_staged(
 ) -> Result<ImitationMetrics> {
     let mut joints = JointsWriter::new(staged.create("joints.csv")?);
     let view_file = staged.create("view.html")?;
-    let config = session.config(&settings.config);
+    let config = session.config(&settings.config)?;
     let mut imitator = Imitator::new(settings.profile.clone(), config)
         .with_context(|| format!("robot {}", settings.profile.name))?;
     let title = clip

@@ -563,6 +563,23 @@ fn bad_options_are_usage_errors_naming_the_option() {
         1,
         &["--skeleton", "no-such-map.toml"],
     );
+    // An option of the other method is refused, not ignored: `--task-speed` clips every task
+    // of Poubel's method; Koenemann's swing foot has `--swing-speed`.
+    fails(
+        &["imitate", c, "--method", "koenemann", "--task-speed", "0.3"],
+        2,
+        &["--task-speed", "--method koenemann"],
+    );
+    fails(
+        &["imitate", c, "--method", "koenemann", "--walk"],
+        2,
+        &["--walk", "--method koenemann"],
+    );
+    fails(
+        &["imitate", c, "--swing-speed", "0.3"],
+        2,
+        &["--swing-speed", "--method poubel"],
+    );
     fails(&["batch", c], 2, &["--out"]);
     fails(&["frobnicate"], 2, &["frobnicate"]);
 }

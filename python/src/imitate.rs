@@ -14,8 +14,9 @@ use taskstack::batch::{
 use taskstack::export::{MotionRecorder, MotionTrack};
 use taskstack::human::{CaptureSystem, HumanFrame, HumanJoint};
 use taskstack::imitation::EFFECTORS;
-use taskstack::imitation::config::ImitationMethod;
+use taskstack::imitation::ImitationMethod;
 use taskstack::imitation::koenemann::{Calibration, FootRetargeting, KoenemannConfig};
+use taskstack::imitation::poubel::PoubelConfig;
 use taskstack::imitation::reference::support::SupportConfig;
 use taskstack::io::clip::Clip;
 use taskstack::robots::{BipedProfile, g1, nao};
@@ -51,6 +52,7 @@ pub(crate) struct Settings {
     velocity_fraction: Option<f64>,
     upper_body_fraction: Option<f64>,
     task_speed: Option<f64>,
+    swing_speed: Option<f64>,
     tracking_speed: Option<f64>,
     tracking_acceleration: Option<f64>,
     iterations: usize,
@@ -78,6 +80,7 @@ impl Settings {
             velocity_fraction: None,
             upper_body_fraction: None,
             task_speed: None,
+            swing_speed: None,
             tracking_speed: None,
             tracking_acceleration: None,
             iterations: 1,
@@ -105,6 +108,7 @@ impl Settings {
                 "velocity_fraction" => s.velocity_fraction = value.extract()?,
                 "upper_body_fraction" => s.upper_body_fraction = value.extract()?,
                 "task_speed" => s.task_speed = value.extract()?,
+                "swing_speed" => s.swing_speed = value.extract()?,
                 "tracking_speed" => s.tracking_speed = value.extract()?,
                 "tracking_acceleration" => s.tracking_acceleration = value.extract()?,
                 "iterations" => s.iterations = value.extract()?,
@@ -131,52 +135,56 @@ impl Settings {
         Ok(profile)
     }
 
-    // One function on purpose (~100 lines): one line per keyword argument of `imitate`, in the
-    // order of its signature.
+    /// The imitator settings for a clip of `capture`: the shared ones here, the method's in
+    /// [`Settings::poubel`] and [`Settings::koenemann`]; a keyword of the other method is a
+    /// `ValueError`.
     fn config(&self, capture: CaptureSystem) -> PyResult<ImitatorConfig> {
-        let method = match self.method.as_str() {
-            "poubel" => ImitationMethod::Poubel,
-            "koenemann" => ImitationMethod::Koenemann(KoenemannConfig {
-                calibration: match self.calibration.as_str() {
-                    "auto" => Calibration::Auto,
-                    "first-frame" => Calibration::FirstFrame,
-                    "ideal" => Calibration::Ideal,
-                    other => {
-                        return Err(value_error(format!(
-                            "calibration {other:?}: expected \"auto\", \"first-frame\" or \"ideal\""
-                        )));
-                    }
-                },
-                retargeting: match self.retargeting.as_str() {
-                    "shift-both-feet" => FootRetargeting::ShiftBothFeet,
-                    "move-one-foot" => FootRetargeting::MoveOneFoot,
-                    other => {
-                        return Err(value_error(format!(
-                            "retargeting {other:?}: expected \"shift-both-feet\" or \"move-one-foot\""
-                        )));
-                    }
-                },
-                ..KoenemannConfig::default()
-            }),
+        let (method, others) = match self.method.as_str() {
+            "poubel" => (
+                ImitationMethod::Poubel(self.poubel()?),
+                self.koenemann_given(),
+            ),
+            "koenemann" => (
+                ImitationMethod::Koenemann(self.koenemann()?),
+                self.poubel_given(),
+            ),
             other => {
                 return Err(value_error(format!(
                     "method {other:?}: expected \"poubel\" or \"koenemann\""
                 )));
             }
         };
-        let fraction = |name: &str, value: f64| {
-            if value > 0.0 && value <= 1.0 {
-                Ok(value)
-            } else {
-                Err(value_error(format!("{name} = {value}: must be in (0, 1]")))
-            }
-        };
-        let positive = |name: &str, value: Option<f64>| match value {
-            Some(v) if !(v.is_finite() && v > 0.0) => {
-                Err(value_error(format!("{name} = {v}: must be a number > 0")))
+        if let Some(key) = others.first() {
+            return Err(value_error(format!(
+                "{key}: not a setting of method {:?}",
+                self.method
+            )));
+        }
+        let fraction = |name: &str, value: Option<f64>| match value {
+            Some(v) if !(v > 0.0 && v <= 1.0) => {
+                Err(value_error(format!("{name} = {v}: must be in (0, 1]")))
             }
             v => Ok(v),
         };
+        Ok(ImitatorConfig {
+            method,
+            velocity_fraction: fraction("velocity_fraction", self.velocity_fraction)?,
+            upper_body_velocity_fraction: fraction(
+                "upper_body_fraction",
+                self.upper_body_fraction,
+            )?,
+            max_tracking_speed: positive("tracking_speed", self.tracking_speed)?,
+            max_tracking_acceleration: positive(
+                "tracking_acceleration",
+                self.tracking_acceleration,
+            )?,
+            support: SupportConfig::for_capture(capture),
+            ..ImitatorConfig::default()
+        })
+    }
+
+    /// Poubel et al.'s settings of these keywords.
+    fn poubel(&self) -> PyResult<PoubelConfig> {
         if self.walking_arms && !self.dynamic_walk {
             return Err(value_error(
                 "walking_arms = True: the arms follow the human only in the dynamic walk \
@@ -189,29 +197,25 @@ impl Settings {
                 self.iterations
             )));
         }
-        let mut config = ImitatorConfig {
-            method,
-            velocity_fraction: (self.velocity_fraction)
-                .map(|f| fraction("velocity_fraction", f))
-                .transpose()?,
-            upper_body_velocity_fraction: (self.upper_body_fraction)
-                .map(|f| fraction("upper_body_fraction", f))
-                .transpose()?,
+        if !(0.0..=1.0).contains(&self.damping_momentum) {
+            return Err(value_error(format!(
+                "damping_momentum = {}: must be in [0, 1]",
+                self.damping_momentum
+            )));
+        }
+        let mut poubel = PoubelConfig {
             max_task_speed: positive("task_speed", self.task_speed)?,
-            max_tracking_speed: positive("tracking_speed", self.tracking_speed)?,
-            max_tracking_acceleration: positive(
-                "tracking_acceleration",
-                self.tracking_acceleration,
-            )?,
             iterations_per_frame: self.iterations,
-            support: SupportConfig::for_capture(capture),
-            ..ImitatorConfig::default()
+            zmp_balance: self.zmp_balance,
+            damping_momentum: self.damping_momentum,
+            damping: positive("damping", self.damping)?,
+            ..PoubelConfig::default()
         };
-        config.footsteps.follow = self.walk || self.dynamic_walk;
-        config.footsteps.dynamic = self.dynamic_walk;
-        config.footsteps.walking_arms = self.walking_arms;
+        let steps = &mut poubel.footsteps;
+        steps.follow = self.walk || self.dynamic_walk;
+        steps.dynamic = self.dynamic_walk;
+        steps.walking_arms = self.walking_arms;
         // Out of range (NaN, < 0), the imitator refuses them by name.
-        let steps = &mut config.footsteps;
         for (option, field) in [
             (self.step_distance, &mut steps.distance),
             (self.step_heading, &mut steps.heading),
@@ -222,16 +226,77 @@ impl Settings {
                 *field = value;
             }
         }
-        config.zmp_balance = self.zmp_balance;
-        if !(0.0..=1.0).contains(&self.damping_momentum) {
-            return Err(value_error(format!(
-                "damping_momentum = {}: must be in [0, 1]",
-                self.damping_momentum
-            )));
+        Ok(poubel)
+    }
+
+    /// The keywords of Poubel et al.'s method given away from their defaults.
+    fn poubel_given(&self) -> Vec<&'static str> {
+        [
+            (self.walk, "walk"),
+            (self.dynamic_walk, "dynamic_walk"),
+            (self.walking_arms, "walking_arms"),
+            (self.step_distance.is_some(), "step_distance"),
+            (self.step_heading.is_some(), "step_heading"),
+            (self.step_pivot.is_some(), "step_pivot"),
+            (self.step_slide.is_some(), "step_slide"),
+            (self.zmp_balance, "zmp_balance"),
+            (self.damping.is_some(), "damping"),
+            (self.damping_momentum != 0.0, "damping_momentum"),
+            (self.task_speed.is_some(), "task_speed"),
+            (self.iterations != 1, "iterations"),
+        ]
+        .into_iter()
+        .filter_map(|(given, name)| given.then_some(name))
+        .collect()
+    }
+
+    /// The keywords of Koenemann et al.'s method given away from their defaults.
+    fn koenemann_given(&self) -> Vec<&'static str> {
+        [
+            (self.calibration != "auto", "calibration"),
+            (self.retargeting != "shift-both-feet", "retargeting"),
+            (self.swing_speed.is_some(), "swing_speed"),
+        ]
+        .into_iter()
+        .filter_map(|(given, name)| given.then_some(name))
+        .collect()
+    }
+
+    /// Koenemann et al.'s settings of these keywords.
+    fn koenemann(&self) -> PyResult<KoenemannConfig> {
+        Ok(KoenemannConfig {
+            calibration: match self.calibration.as_str() {
+                "auto" => Calibration::Auto,
+                "first-frame" => Calibration::FirstFrame,
+                "ideal" => Calibration::Ideal,
+                other => {
+                    return Err(value_error(format!(
+                        "calibration {other:?}: expected \"auto\", \"first-frame\" or \"ideal\""
+                    )));
+                }
+            },
+            retargeting: match self.retargeting.as_str() {
+                "shift-both-feet" => FootRetargeting::ShiftBothFeet,
+                "move-one-foot" => FootRetargeting::MoveOneFoot,
+                other => {
+                    return Err(value_error(format!(
+                        "retargeting {other:?}: expected \"shift-both-feet\" or \"move-one-foot\""
+                    )));
+                }
+            },
+            swing_speed: positive("swing_speed", self.swing_speed)?,
+            ..KoenemannConfig::default()
+        })
+    }
+}
+
+/// `value` if it is `None` or a finite number > 0; else a `ValueError` naming `name`.
+fn positive(name: &str, value: Option<f64>) -> PyResult<Option<f64>> {
+    match value {
+        Some(v) if !(v.is_finite() && v > 0.0) => {
+            Err(value_error(format!("{name} = {v}: must be a number > 0")))
         }
-        config.damping_momentum = self.damping_momentum;
-        config.damping = positive("damping", self.damping)?;
-        Ok(config)
+        v => Ok(v),
     }
 }
 
@@ -275,7 +340,7 @@ fn run(
         ..ClipSetup::default()
     };
     let session = ClipSession::open(path, &setup).map_err(to_py)?;
-    let config = session.config(&settings.config(session.clip().capture())?);
+    let config = (session.config(&settings.config(session.clip().capture())?)).map_err(to_py)?;
     let mut imitator = Imitator::new(profile, config).map_err(to_py)?;
     let mut recorder = MotionRecorder::new(&imitator).map_err(to_py)?;
     let (mut phases, mut servo_targets) = (Vec::new(), Vec::new());

@@ -101,6 +101,7 @@ def imitate_clip(
     velocity_fraction: Optional[float] = None,
     upper_body_fraction: Optional[float] = None,
     task_speed: Optional[float] = None,
+    swing_speed: Optional[float] = None,
     tracking_speed: Optional[float] = None,
     tracking_acceleration: Optional[float] = None,
     iterations: int = 1,
@@ -147,7 +148,11 @@ def imitate_clip(
             (default: 0.1 with Poubel's method, the robot's with Koenemann's: NAO 0.1,
             G1 0.012).
         upper_body_fraction: the same for arms, head and torso (default: the robot's).
-        task_speed: fastest CoM and foot target speed (m/s; default: the robot's).
+        task_speed: Poubel's method: fastest speed of any task's target, the CoM, feet, torso
+            and the hands where ``tracking_speed`` does not set theirs (m/s; default: the
+            robot's, NAO 0.15).
+        swing_speed: ``method="koenemann"``: fastest speed of the swing foot's target (m/s;
+            default: the robot's task speed).
         tracking_speed: fastest hand target speed (m/s; default: the robot's).
         tracking_acceleration: largest change of the hand targets' speed (m/s²; default: the
             robot's).
@@ -161,7 +166,10 @@ def imitate_clip(
 
     Raises:
         FileNotFoundError, OSError: the clip or the profile cannot be read.
-        ValueError: a malformed clip, an option out of range, a frame the imitator refuses.
+        ValueError: a malformed clip, an option out of range or of the other method (Poubel's
+            ``walk`` … ``iterations`` with ``method="koenemann"``; ``calibration``,
+            ``retargeting``, ``swing_speed`` with ``method="poubel"``), a frame the imitator
+            refuses.
     """
     raw = _imitate_clip(
         str(path),
@@ -182,6 +190,7 @@ def imitate_clip(
         velocity_fraction=velocity_fraction,
         upper_body_fraction=upper_body_fraction,
         task_speed=task_speed,
+        swing_speed=swing_speed,
         tracking_speed=tracking_speed,
         tracking_acceleration=tracking_acceleration,
         iterations=iterations,

@@ -33,9 +33,11 @@ class Imitator:
         120 Hz, mm noise) or "kinect" (depth camera, 30 Hz, cm noise), which sets the support
         detection's thresholds; ``options``: ``method``, ``walk``, ``dynamic_walk``,
         ``walking_arms``, ``step_distance``, ``step_heading``, ``step_pivot``, ``step_slide``,
-        ``zmp_balance``, ``velocity_fraction``, ``upper_body_fraction``, ``task_speed``, ``tracking_speed``,
-        ``tracking_acceleration``, ``iterations``, ``calibration``, ``retargeting``,
-        ``sway_shaping``, as ``taskstack.imitate_clip``'s (an unknown one is a TypeError)."""
+        ``zmp_balance``, ``damping``, ``damping_momentum``, ``velocity_fraction``,
+        ``upper_body_fraction``, ``task_speed``, ``swing_speed``,
+        ``tracking_speed``, ``tracking_acceleration``, ``iterations``, ``calibration``,
+        ``retargeting``, ``sway_shaping``, as ``taskstack.imitate_clip``'s (an unknown one is a
+        TypeError; one of the other method's is a ValueError)."""
         ...
     @property
     def joint_names(self) -> List[str]:

@@ -177,6 +177,13 @@ def test_bad_input_raises_python_exceptions_with_the_rust_message(tmp):
             taskstack.imitate_clip(KINECT, damping_momentum=bad)
     with pytest.raises(ValueError, match="damping"):
         taskstack.imitate_clip(KINECT, damping=0.0)
+    # A setting of the other method is refused, not ignored.
+    with pytest.raises(ValueError, match="walk: not a setting of method \"koenemann\""):
+        taskstack.imitate_clip(KINECT, method="koenemann", walk=True)
+    with pytest.raises(ValueError, match="swing_speed: not a setting of method \"poubel\""):
+        taskstack.Imitator(swing_speed=0.2)
+    with pytest.raises(ValueError, match="swing_speed"):
+        taskstack.Imitator(method="koenemann", swing_speed=-1.0)
     with pytest.raises(FileNotFoundError, match="missing_profile.toml"):
         taskstack.imitate_clip(KINECT, robot=str(tmp / "missing_profile.toml"))
     with pytest.raises(TypeError, match="velocity_fractoin"):

@@ -113,6 +113,15 @@ pub enum BatchError {
         /// The hand supports' error.
         source: HandSupportError,
     },
+    /// An offline look-ahead or a scene asked of a method without support phases and task
+    /// tables (Koenemann et al.'s): only Poubel et al.'s method has them.
+    #[error("{}: {what} needs Poubel et al.'s method (support phases and task tables)", path.display())]
+    NeedsPoubel {
+        /// The clip file.
+        path: PathBuf,
+        /// What was asked: `the offline look-ahead` or `a scene`.
+        what: &'static str,
+    },
     /// A fixed hold that is not a number of seconds in `0..=`[`MAX_HOLD`].
     #[error("hold of {0} s: must be a number of seconds within 0–{MAX_HOLD} s")]
     Hold(f64),
@@ -530,7 +539,7 @@ fn write_clip(
     };
     let file = std::fs::File::create(joints_path).map_err(io(joints_path))?;
     let mut joints = JointsWriter::new(std::io::BufWriter::new(file));
-    let config = session.config(&options.imitator);
+    let config = session.config(&options.imitator)?;
     let robot = options.robot.clone();
     let mut imitator = Imitator::new(robot, config).map_err(|source| BatchError::Imitation {
         path: path(),

@@ -5,7 +5,7 @@
 //! contacts with the scene ([`HandSupportConfig`]). `taskstack imitate`, `taskstack batch`,
 //! [`retarget_clip`](super::retarget_clip) and the Python package prepare their clips here.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use super::BatchError;
 use crate::imitation::ImitatorConfig;
@@ -53,6 +53,7 @@ impl Default for LookAheadLeads {
 /// A clip opened for one run, with the settings it gives the imitator.
 #[derive(Debug)]
 pub struct ClipSession {
+    path: PathBuf,
     clip: Clip,
     look_ahead: Option<FootLookAhead>,
     hand_supports: Option<HandSupportConfig>,
@@ -78,6 +79,7 @@ impl ClipSession {
         .map_err(clip_error)?;
         if setup.look_ahead.is_none() && setup.scene.is_none() {
             return Ok(Self {
+                path: path.to_path_buf(),
                 clip,
                 look_ahead: None,
                 hand_supports: None,
@@ -112,6 +114,7 @@ impl ClipSession {
                 source,
             })?;
         Ok(Self {
+            path: path.to_path_buf(),
             clip,
             look_ahead,
             hand_supports,
@@ -125,18 +128,31 @@ impl ClipSession {
 
     /// `base` with this clip's settings: the support thresholds of its capture system, its
     /// foot lifts ahead (offline) and its hand contacts (a scene).
-    pub fn config(&self, base: &ImitatorConfig) -> ImitatorConfig {
+    ///
+    /// # Errors
+    /// [`BatchError::NeedsPoubel`] when the clip was opened offline or with a scene and
+    /// `base` imitates by Koenemann et al.'s method.
+    pub fn config(&self, base: &ImitatorConfig) -> Result<ImitatorConfig, BatchError> {
         let mut config = ImitatorConfig {
             support: SupportConfig::for_capture(self.clip.capture()),
             ..base.clone()
         };
+        let needs_poubel = |what| BatchError::NeedsPoubel {
+            path: self.path.clone(),
+            what,
+        };
         if let Some(look_ahead) = &self.look_ahead {
-            config.look_ahead = Some(look_ahead.clone());
+            let poubel = config.poubel_mut();
+            poubel
+                .ok_or_else(|| needs_poubel("the offline look-ahead"))?
+                .look_ahead = Some(look_ahead.clone());
         }
         if let Some(hand_supports) = &self.hand_supports {
-            config.hand_supports = Some(hand_supports.clone());
+            let poubel = config.poubel_mut();
+            poubel.ok_or_else(|| needs_poubel("a scene"))?.hand_supports =
+                Some(hand_supports.clone());
         }
-        config
+        Ok(config)
     }
 
     /// The clip, to imitate ([`imitate_clip`](super::imitate_clip)).

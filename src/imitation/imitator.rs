@@ -43,9 +43,11 @@ impl Imitator {
     pub fn new(profile: BipedProfile, config: ImitatorConfig) -> Result<Self, ImitationError> {
         config.validate()?;
         profile.validate()?;
-        Ok(Imitator(match config.method {
-            ImitationMethod::Poubel => {
-                Method::Poubel(Box::new(PoubelImitator::new(profile, config)?))
+        // The shared settings' defaults depend on the method (the legs' velocity fraction):
+        // `config` keeps it while each method takes its own settings.
+        Ok(Imitator(match config.method.clone() {
+            ImitationMethod::Poubel(method) => {
+                Method::Poubel(Box::new(PoubelImitator::new(profile, &config, method)?))
             }
             ImitationMethod::Koenemann(method) => {
                 Method::Koenemann(Box::new(KoenemannImitator::new(profile, &config, method)?))
@@ -61,7 +63,7 @@ impl Imitator {
     }
 
     /// Imitates one human frame: returns the robot's posture for it. With hand supports
-    /// ([`ImitatorConfig::hand_supports`]), feed the same frame again while the output's
+    /// ([`PoubelConfig::hand_supports`](crate::imitation::poubel::PoubelConfig::hand_supports)), feed the same frame again while the output's
     /// [`RobotFrame::awaiting_contact`] is set: the human's clock pauses while a hand is placed.
     ///
     /// # Errors

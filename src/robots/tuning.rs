@@ -103,7 +103,7 @@ pub struct MotionTuning {
     /// instead of at the sole's centre (the paper). Not a size: the scaling keeps it.
     pub offset_to_stance_point: bool,
     /// The hands' speeds in every phase of Poubel et al.'s method when its ZMP level holds the
-    /// balance (`ImitatorConfig::zmp_balance`: a level that sees the arms' acceleration and
+    /// balance (`PoubelConfig::zmp_balance`: a level that sees the arms' acceleration and
     /// bounds their vertical moment on the feet), instead of `tracking_speed`,
     /// `stance_tracking_speed` and `tracking_acceleration`; `None`: the level keeps those.
     /// Koenemann et al.'s method (no ZMP level) and the dynamic walk always use them.

@@ -288,8 +288,9 @@ fn a_dynamic_walk_finishes_within_the_automatic_hold() {
         ),
         ..ImitatorConfig::default()
     };
-    config.footsteps.follow = true;
-    config.footsteps.dynamic = true;
+    let poubel = config.poubel_mut().unwrap();
+    poubel.footsteps.follow = true;
+    poubel.footsteps.dynamic = true;
     let mut imitator = Imitator::new(nao::profile(), config).unwrap();
     let mut pending = Vec::new();
     let metrics = imitate_clip(&path, source, &mut imitator, Hold::UntilFinished, |r| {
@@ -374,7 +375,7 @@ fn the_hands_follow_the_kinect_gestures_on_time() {
     use taskstack::imitation::config::ImitationMethod;
     use taskstack::imitation::koenemann::KoenemannConfig;
     let methods = [
-        (ImitationMethod::Poubel, 0.045),
+        (ImitationMethod::default(), 0.045),
         (
             ImitationMethod::Koenemann(KoenemannConfig::default()),
             0.045,
@@ -382,7 +383,7 @@ fn the_hands_follow_the_kinect_gestures_on_time() {
     ];
     for ((method, bound), name) in methods
         .into_iter()
-        .flat_map(|m| [(m, SHORT[0]), (m, SHORT[2])])
+        .flat_map(|m| [(m.clone(), SHORT[0]), (m, SHORT[2])])
     {
         let (m, _) = nao_clip_metrics_with(name, method);
         let hands = m.effectors_clip.iter().filter(|e| e.name.ends_with("hand"));

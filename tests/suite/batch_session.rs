@@ -4,6 +4,9 @@
 
 use taskstack::batch::{BatchError, ClipSession, ClipSetup, LookAheadLeads, imitate_clip};
 use taskstack::human::{CaptureSystem, HumanFrame};
+use taskstack::imitation::ImitationMethod;
+use taskstack::imitation::koenemann::KoenemannConfig;
+use taskstack::imitation::poubel::PoubelConfig;
 use taskstack::imitation::poubel::hand_support::{HandContactPlan, HandSupportConfig};
 use taskstack::imitation::reference::contact_events::ContactConfig;
 use taskstack::imitation::reference::support::SupportConfig;
@@ -48,12 +51,13 @@ fn an_online_session_streams_and_sets_the_capture_systems_support() {
     };
     let session = ClipSession::open(WALK.as_ref(), &ClipSetup::default()).unwrap();
     assert!(session.clip().frames_ahead().is_none(), "read as it goes");
-    let config = session.config(&base);
+    let config = session.config(&base).unwrap();
     assert_eq!(
         config.support,
         SupportConfig::for_capture(CaptureSystem::Optical)
     );
-    assert!(config.look_ahead.is_none() && config.hand_supports.is_none());
+    let poubel = config.poubel().unwrap();
+    assert!(poubel.look_ahead.is_none() && poubel.hand_supports.is_none());
 }
 
 #[test]
@@ -67,7 +71,7 @@ fn an_offline_session_knows_the_foot_lifts_and_runs_as_built_by_hand() {
         ..ClipSetup::default()
     };
     let session = ClipSession::open(WALK.as_ref(), &setup).unwrap();
-    let config = session.config(&ImitatorConfig::default());
+    let config = session.config(&ImitatorConfig::default()).unwrap();
     let frames = streamed(WALK);
     let support = SupportConfig::for_capture(CaptureSystem::Optical);
     let by_hand = FootLookAhead {
@@ -75,7 +79,8 @@ fn an_offline_session_knows_the_foot_lifts_and_runs_as_built_by_hand() {
         lift_lead: 1.2,
         landing_lead: 0.6,
     };
-    assert_eq!(config.look_ahead.as_ref(), Some(&by_hand));
+    let poubel = config.poubel().unwrap();
+    assert_eq!(poubel.look_ahead.as_ref(), Some(&by_hand));
     assert!(!by_hand.schedule.lifts(taskstack::Side::Left).is_empty());
 
     // The session's run and the run of the look-ahead built by hand give the same targets.
@@ -90,7 +95,10 @@ fn an_offline_session_knows_the_foot_lifts_and_runs_as_built_by_hand() {
     };
     let hand_config = ImitatorConfig {
         support,
-        look_ahead: Some(by_hand),
+        method: ImitationMethod::Poubel(PoubelConfig {
+            look_ahead: Some(by_hand),
+            ..PoubelConfig::default()
+        }),
         ..ImitatorConfig::default()
     };
     assert_eq!(
@@ -111,9 +119,10 @@ fn a_session_with_a_scene_plans_the_hand_contacts() {
     let frames = streamed(&clip);
     let contacts = ContactConfig::for_capture(CaptureSystem::Optical);
     let plan = HandContactPlan::of_clip(&frames, &scene, &contacts).unwrap();
-    let config = session.config(&ImitatorConfig::default());
-    assert_eq!(config.hand_supports, Some(HandSupportConfig::new(plan)));
-    assert!(config.look_ahead.is_none());
+    let config = session.config(&ImitatorConfig::default()).unwrap();
+    let poubel = config.poubel().unwrap();
+    assert_eq!(poubel.hand_supports, Some(HandSupportConfig::new(plan)));
+    assert!(poubel.look_ahead.is_none());
     assert_eq!(session.clip().frames_ahead().unwrap(), &frames[..]);
 }
 
@@ -126,4 +135,23 @@ fn a_session_on_a_missing_clip_is_an_error_naming_it() {
     let err = ClipSession::open("nowhere/missing.bvh".as_ref(), &setup).unwrap_err();
     assert!(matches!(err, BatchError::Clip { .. }), "{err:?}");
     assert!(err.to_string().contains("missing.bvh"), "{err}");
+}
+
+#[test]
+fn an_offline_session_refuses_koenemanns_method_naming_the_clip() {
+    let setup = ClipSetup {
+        look_ahead: Some(LookAheadLeads::default()),
+        ..ClipSetup::default()
+    };
+    let session = ClipSession::open(WALK.as_ref(), &setup).unwrap();
+    let koenemann = ImitatorConfig {
+        method: ImitationMethod::Koenemann(KoenemannConfig::default()),
+        ..ImitatorConfig::default()
+    };
+    let err = session.config(&koenemann).unwrap_err();
+    assert!(
+        matches!(err, BatchError::NeedsPoubel { what, .. } if what.contains("look-ahead")),
+        "{err:?}"
+    );
+    assert!(err.to_string().contains("cmu_07_04_slow_walk.bvh"), "{err}");
 }

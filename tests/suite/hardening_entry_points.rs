@@ -4,9 +4,11 @@
 //! behaviour, and that a refused call changed nothing.
 
 use taskstack::human::{HumanFrame, HumanJoint};
+use taskstack::imitation::koenemann::KoenemannConfig;
+use taskstack::imitation::poubel::PoubelConfig;
 use taskstack::imitation::reference::scaler::ScaleError;
 use taskstack::imitation::shaping::MotionLimits;
-use taskstack::imitation::{ImitationError, Imitator, ImitatorConfig, RobotFrame};
+use taskstack::imitation::{ImitationError, ImitationMethod, Imitator, ImitatorConfig, RobotFrame};
 use taskstack::io::clip::Clip;
 use taskstack::model::ModelError;
 use taskstack::robots::nao;
@@ -342,8 +344,6 @@ fn run(imitator: &mut Imitator, frames: &[HumanFrame]) -> Vec<RobotFrame> {
 /// Koenemann et al.'s settings out of range are refused by name, before any frame.
 #[test]
 fn koenemann_config_out_of_range_is_refused_by_name() {
-    use taskstack::imitation::config::ImitationMethod;
-    use taskstack::imitation::koenemann::KoenemannConfig;
     type Set = fn(&mut KoenemannConfig, f64);
     let fields: [(&str, Set, &[f64]); 6] = [
         (
@@ -409,10 +409,19 @@ fn koenemann_config_out_of_range_is_refused_by_name() {
 #[test]
 fn imitator_config_out_of_range_is_refused_by_name() {
     type Set = fn(&mut ImitatorConfig, f64);
-    let fields: [(&str, Set); 10] = [
+    let fields: [(&str, Set); 12] = [
         ("velocity_fraction", |c, v| c.velocity_fraction = Some(v)),
         ("nominal_dt", |c, v| c.nominal_dt = v),
-        ("max_task_speed", |c, v| c.max_task_speed = Some(v)),
+        ("poubel.max_task_speed", |c, v| {
+            poubel(c).max_task_speed = Some(v)
+        }),
+        ("poubel.damping", |c, v| poubel(c).damping = Some(v)),
+        ("koenemann.swing_speed", |c, v| {
+            c.method = ImitationMethod::Koenemann(KoenemannConfig {
+                swing_speed: Some(v),
+                ..KoenemannConfig::default()
+            })
+        }),
         ("max_tracking_speed", |c, v| c.max_tracking_speed = Some(v)),
         ("upper_body_velocity_fraction", |c, v| {
             c.upper_body_velocity_fraction = Some(v)
@@ -440,26 +449,28 @@ fn imitator_config_out_of_range_is_refused_by_name() {
     }
     // Footstep thresholds may be 0 (step at once) but not negative or NaN.
     let steps: [(&str, Set); 6] = [
-        ("footsteps.distance", |c, v| c.footsteps.distance = v),
-        ("footsteps.heading", |c, v| c.footsteps.heading = v),
-        ("footsteps.pivot", |c, v| c.footsteps.pivot = v),
-        ("footsteps.slide", |c, v| c.footsteps.slide = v),
-        ("footsteps.stance_time", |c, v| c.footsteps.stance_time = v),
+        ("footsteps.distance", |c, v| {
+            poubel(c).footsteps.distance = v
+        }),
+        ("footsteps.heading", |c, v| poubel(c).footsteps.heading = v),
+        ("footsteps.pivot", |c, v| poubel(c).footsteps.pivot = v),
+        ("footsteps.slide", |c, v| poubel(c).footsteps.slide = v),
+        ("footsteps.stance_time", |c, v| {
+            poubel(c).footsteps.stance_time = v
+        }),
         ("footsteps.swing_timeout", |c, v| {
-            c.footsteps.swing_timeout = v
+            poubel(c).footsteps.swing_timeout = v
         }),
     ];
     for (name, set) in steps {
         refused(name, set, &[f64::NAN, -1.0]);
     }
-    let c = ImitatorConfig {
-        iterations_per_frame: 0,
-        ..ImitatorConfig::default()
-    };
+    let mut c = ImitatorConfig::default();
+    poubel(&mut c).iterations_per_frame = 0;
     assert!(matches!(
         Imitator::new(nao::profile(), c),
         Err(ImitationError::InvalidParameter {
-            name: "iterations_per_frame",
+            name: "poubel.iterations_per_frame",
             ..
         })
     ));
@@ -557,6 +568,11 @@ fn imitator_treats_non_finite_joint_positions_as_missing() {
 }
 
 /// The config's motion limits, the defaults put in first when it has none.
+fn poubel(c: &mut ImitatorConfig) -> &mut PoubelConfig {
+    c.poubel_mut()
+        .expect("the default method is Poubel et al.'s")
+}
+
 fn motion(c: &mut ImitatorConfig) -> &mut MotionLimits {
     c.motion.get_or_insert_with(MotionLimits::default)
 }

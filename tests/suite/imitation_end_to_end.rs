@@ -12,10 +12,11 @@
 use crate::common;
 
 use taskstack::human::{HumanFrame, HumanJoint, Side};
-use taskstack::imitation::config::ImitationMethod;
+use taskstack::imitation::ImitationMethod;
 use taskstack::imitation::koenemann::KoenemannConfig;
 use taskstack::imitation::metrics::{ImitationMetrics, MetricsRecorder};
 use taskstack::imitation::phase::SupportPhase;
+use taskstack::imitation::poubel::PoubelConfig;
 use taskstack::imitation::reference::support::SupportConfig;
 use taskstack::imitation::shaping::MotionLimits;
 use taskstack::imitation::walking::footsteps::FootstepConfig;
@@ -309,7 +310,7 @@ fn walking_arms_follow_the_human_hands() {
     };
     let (held, _) = run_held(name, dynamic(), WALKING_FOOT_TOLERANCE, 60.0);
     let mut config = dynamic();
-    config.footsteps.walking_arms = true;
+    config.poubel_mut().unwrap().footsteps.walking_arms = true;
     let (following, _) = run_held(name, config, WALKING_FOOT_TOLERANCE, 60.0);
     let (held, following) = (single_support(&held), single_support(&following));
     eprintln!("{name}: hands in single support {held:.4} → {following:.4} m");
@@ -321,24 +322,24 @@ fn walking_arms_follow_the_human_hands() {
 
 /// Walking step by step (`--walk`).
 fn step_by_step() -> ImitatorConfig {
-    ImitatorConfig {
+    ImitatorConfig::from(PoubelConfig {
         footsteps: FootstepConfig {
             follow: true,
             ..FootstepConfig::default()
         },
-        ..ImitatorConfig::default()
-    }
+        ..PoubelConfig::default()
+    })
 }
 
 fn dynamic() -> ImitatorConfig {
-    ImitatorConfig {
+    ImitatorConfig::from(PoubelConfig {
         footsteps: FootstepConfig {
             follow: true,
             dynamic: true,
             ..FootstepConfig::default()
         },
-        ..ImitatorConfig::default()
-    }
+        ..PoubelConfig::default()
+    })
 }
 
 /// The offline mode ([`FootLookAhead`]) on the clips with one-leg stances it can follow: the
@@ -355,10 +356,10 @@ fn offline_mode_lifts_with_the_human() {
         let support = SupportConfig::for_capture(clip.capture());
         let frames: Vec<HumanFrame> = clip.collect::<Result<_, _>>().unwrap();
         let schedule = FootSchedule::of_clip(&frames, support).unwrap();
-        let offline = ImitatorConfig {
+        let offline = ImitatorConfig::from(PoubelConfig {
             look_ahead: Some(FootLookAhead::new(schedule)),
-            ..ImitatorConfig::default()
-        };
+            ..PoubelConfig::default()
+        });
         let (ahead, _) = run_with(name, offline, HELD_FOOT_TOLERANCE);
         let (online, _) = run(name);
         let (a, o) = (ahead.lift_lag, online.lift_lag);
@@ -377,19 +378,16 @@ fn offline_mode_lifts_with_the_human() {
 #[test]
 fn offline_mode_settings_are_checked() {
     let ahead = FootLookAhead::new(FootSchedule::default());
-    let build = |look_ahead: FootLookAhead, method| {
-        let config = ImitatorConfig {
+    let build = |look_ahead: FootLookAhead| {
+        let config = ImitatorConfig::from(PoubelConfig {
             look_ahead: Some(look_ahead),
-            method,
-            ..ImitatorConfig::default()
-        };
+            ..PoubelConfig::default()
+        });
         Imitator::new(nao::profile(), config)
             .err()
             .map(|e| e.to_string())
     };
-    assert_eq!(build(ahead.clone(), ImitationMethod::Poubel), None);
-    let koenemann = ImitationMethod::Koenemann(KoenemannConfig::default());
-    assert!(build(ahead.clone(), koenemann).is_some_and(|e| e.contains("look_ahead")));
+    assert_eq!(build(ahead.clone()), None);
     for (lift_lead, landing_lead, name) in [
         (-0.1, 0.8, "look_ahead.lift_lead"),
         (1.5, f64::NAN, "look_ahead.landing_lead"),
@@ -400,7 +398,7 @@ fn offline_mode_settings_are_checked() {
             landing_lead,
             ..ahead.clone()
         };
-        let error = build(bad, ImitationMethod::Poubel);
+        let error = build(bad);
         assert!(
             error.as_ref().is_some_and(|e| e.contains(name)),
             "{error:?}"
@@ -426,10 +424,13 @@ fn other_clips_keep_the_invariants() {
 #[test]
 fn a_walk_at_full_speed_keeps_the_invariants() {
     let config = ImitatorConfig {
+        method: ImitationMethod::Poubel(PoubelConfig {
+            max_task_speed: Some(1.0),
+            iterations_per_frame: 2,
+            ..PoubelConfig::default()
+        }),
         velocity_fraction: Some(1.0),
         upper_body_velocity_fraction: Some(1.0),
-        max_task_speed: Some(1.0),
-        iterations_per_frame: 2,
         motion: Some(MotionLimits {
             com_speed: 0.1,
             com_acceleration: 0.6,
@@ -489,10 +490,10 @@ fn overridden_tables_are_solved_and_reported_whole() {
         }
         tables.set(table).unwrap();
     }
-    let config = ImitatorConfig {
+    let config = ImitatorConfig::from(PoubelConfig {
         tables: Some(tables.clone()),
-        ..ImitatorConfig::default()
-    };
+        ..PoubelConfig::default()
+    });
     // Double support (17 tasks) and a walk's single supports and transitions (14 and 15 tasks).
     for name in [
         "cmu_02_10_wash_self_standing_arm_gestures.bvh",
@@ -526,10 +527,7 @@ fn overridden_tables_are_solved_and_reported_whole() {
 /// the left lifts, and the left comes back down).
 #[test]
 fn koenemann_keeps_the_invariants_on_every_clip() {
-    let config = ImitatorConfig {
-        method: ImitationMethod::Koenemann(KoenemannConfig::default()),
-        ..ImitatorConfig::default()
-    };
+    let config = ImitatorConfig::from(KoenemannConfig::default());
     let mut names: Vec<String> = std::fs::read_dir(clip_path(""))
         .unwrap()
         .map(|e| e.unwrap().file_name().into_string().unwrap())
@@ -556,10 +554,7 @@ fn koenemann_keeps_the_invariants_on_every_clip() {
 /// them the right wrist's yaw; `ImitationMetrics::joint_reversal_frames`).
 #[test]
 fn koenemann_arms_do_not_chatter_on_a_tightly_folded_arm() {
-    let config = ImitatorConfig {
-        method: ImitationMethod::Koenemann(KoenemannConfig::default()),
-        ..ImitatorConfig::default()
-    };
+    let config = ImitatorConfig::from(KoenemannConfig::default());
     let name = "cmu_02_10_wash_self_standing_arm_gestures.bvh";
     let (m, _) = run_with(name, config, KOENEMANN_FOOT_TOLERANCE);
     assert!(
@@ -570,7 +565,7 @@ fn koenemann_arms_do_not_chatter_on_a_tightly_folded_arm() {
     );
 }
 
-/// Damping toward the last step ([`ImitatorConfig::damping_momentum`]). With fast hands and
+/// Damping toward the last step ([`PoubelConfig::damping_momentum`]). With fast hands and
 /// the ZMP level, CMU 05_02's arms reverse at speed on 90 of 1 123 frames at the textbook
 /// damping (0.02 toward rest); a damping of 0.1 toward rest stops that but leaves the hands
 /// 9.8 cm from the human on average, 0.1 toward 0.8 of the last step 8.1 cm (measured by
@@ -583,11 +578,14 @@ fn damping_toward_the_last_step_stops_the_chatter_and_keeps_the_hands() {
     let name = "cmu_05_02_stand_arm_gestures_turn_single_leg.bvh";
     let run = |momentum: f64| {
         let config = ImitatorConfig {
-            zmp_balance: true,
+            method: ImitationMethod::Poubel(PoubelConfig {
+                zmp_balance: true,
+                damping_momentum: momentum,
+                damping: Some(0.1),
+                ..PoubelConfig::default()
+            }),
             max_tracking_speed: Some(1.0),
             max_tracking_acceleration: Some(10.0),
-            damping_momentum: momentum,
-            damping: Some(0.1),
             ..ImitatorConfig::default()
         };
         let (m, _) = run_with(name, config, HELD_FOOT_TOLERANCE);
@@ -597,23 +595,18 @@ fn damping_toward_the_last_step_stops_the_chatter_and_keeps_the_hands() {
             .collect();
         (hands.iter().sum::<f64>() / hands.len() as f64, m)
     };
-    // Out of range, or with Koenemann's method (no task levels, its own damping): refused by
-    // name, not ignored.
-    let koenemann = || ImitationMethod::Koenemann(KoenemannConfig::default());
-    for (method, momentum, damping, name) in [
-        (ImitationMethod::Poubel, 1.5, None, "damping_momentum"),
-        (ImitationMethod::Poubel, f64::NAN, None, "damping_momentum"),
-        (koenemann(), 0.5, None, "damping_momentum"),
-        (ImitationMethod::Poubel, 0.0, Some(0.0), "damping"),
-        (ImitationMethod::Poubel, 0.0, Some(f64::INFINITY), "damping"),
-        (koenemann(), 0.0, Some(0.05), "damping"),
+    // Out of range: refused by name, not ignored (Koenemann's method has neither setting).
+    for (momentum, damping, name) in [
+        (1.5, None, "poubel.damping_momentum"),
+        (f64::NAN, None, "poubel.damping_momentum"),
+        (0.0, Some(0.0), "poubel.damping"),
+        (0.0, Some(f64::INFINITY), "poubel.damping"),
     ] {
-        let config = ImitatorConfig {
-            method,
+        let config = ImitatorConfig::from(PoubelConfig {
             damping_momentum: momentum,
             damping,
-            ..ImitatorConfig::default()
-        };
+            ..PoubelConfig::default()
+        });
         let refused = Imitator::new(nao::profile(), config).err();
         assert!(
             refused.is_some_and(|e| e.to_string().contains(name)),
@@ -786,7 +779,7 @@ fn each_frame_solves_within_its_pass_budget() {
     let name = "cmu_131_01_start_walk_stop_maxskel.bvh";
     for budget in [8, 3] {
         let mut config = ImitatorConfig::default();
-        config.solver.max_passes = Some(budget);
+        config.poubel_mut().unwrap().solver.max_passes = Some(budget);
         run_held(name, config.clone(), HELD_FOOT_TOLERANCE, 1.0);
         let (mut clip, _) = nao_on(name);
         config.support = SupportConfig::for_capture(clip.capture());
@@ -872,10 +865,10 @@ fn zmp_balance_moves_the_hands_at_the_profiles_balanced_speeds() {
         }
         out
     };
-    let balanced = ImitatorConfig {
+    let balanced = ImitatorConfig::from(PoubelConfig {
         zmp_balance: true,
-        ..ImitatorConfig::default()
-    };
+        ..PoubelConfig::default()
+    });
     let asked = ImitatorConfig {
         max_tracking_speed: Some(1.0),
         max_tracking_acceleration: Some(10.0),
@@ -899,18 +892,14 @@ fn zmp_balance_moves_the_hands_at_the_profiles_balanced_speeds() {
 fn zmp_balance_bounds_the_arms_moment_on_the_floor() {
     let name = "kinect2_labanotation_ges02_balancinghands.csv";
     let fast = |zmp_balance| ImitatorConfig {
+        method: ImitationMethod::Poubel(PoubelConfig {
+            zmp_balance,
+            ..PoubelConfig::default()
+        }),
         max_tracking_speed: Some(1.0),
         max_tracking_acceleration: Some(10.0),
-        zmp_balance,
         ..ImitatorConfig::default()
     };
-    // Koenemann's method has no task tables to put the level in: refused, not ignored.
-    let koenemann = ImitatorConfig {
-        method: ImitationMethod::Koenemann(KoenemannConfig::default()),
-        ..fast(true)
-    };
-    let refused = Imitator::new(nao::profile(), koenemann).err();
-    assert!(refused.is_some_and(|e| e.to_string().contains("zmp_balance")));
     let bound = nao::profile().max_floor_yaw_moment();
     let (free, free_metrics) = arms_yaw_moment(name, fast(false));
     let (balanced, balanced_metrics) = arms_yaw_moment(name, fast(true));

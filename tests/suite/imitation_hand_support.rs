@@ -11,6 +11,7 @@
 
 use taskstack::human::{HumanFrame, Side};
 use taskstack::imitation::metrics::MetricsRecorder;
+use taskstack::imitation::poubel::PoubelConfig;
 use taskstack::imitation::poubel::hand_support::{HandContactPlan, HandSupportConfig};
 use taskstack::imitation::reference::contact_events::ContactConfig;
 use taskstack::io::clip::Clip;
@@ -35,10 +36,10 @@ fn plan(frames: &[HumanFrame]) -> HandContactPlan {
 /// Imitates `frames` with hand supports, feeding a frame again while the imitator asks for it,
 /// then holds the last pose for 1 s; every robot frame.
 fn imitate(frames: &[HumanFrame], config: HandSupportConfig) -> Vec<RobotFrame> {
-    let imitator_config = ImitatorConfig {
+    let imitator_config = ImitatorConfig::from(PoubelConfig {
         hand_supports: Some(config),
-        ..ImitatorConfig::default()
-    };
+        ..PoubelConfig::default()
+    });
     let mut imitator = Imitator::new(nao::profile(), imitator_config).unwrap();
     let mut out = Vec::new();
     let last = *frames.last().unwrap();
@@ -291,10 +292,10 @@ fn without_a_pause_budget_the_contact_starts_where_the_hand_is() {
 fn bad_settings_are_refused_by_name() {
     let frames = clip();
     let bad = |config: HandSupportConfig| {
-        let imitator_config = ImitatorConfig {
+        let imitator_config = ImitatorConfig::from(PoubelConfig {
             hand_supports: Some(config),
-            ..ImitatorConfig::default()
-        };
+            ..PoubelConfig::default()
+        });
         Imitator::new(nao::profile(), imitator_config)
             .unwrap_err()
             .to_string()

@@ -108,7 +108,7 @@ fn largest(frames: &[[f64; 3]], k: usize) -> f64 {
 
 #[test]
 fn poubels_tables_turn_the_g1s_upper_body_at_its_waist_only() {
-    let held = waist_motion(g1::profile(), ImitationMethod::Poubel);
+    let held = waist_motion(g1::profile(), ImitationMethod::default());
     let (tilt, turn) = (largest(&held, 0), largest(&held, 1));
     // The upright task trails the waist's fast yaw by a few frames (its step is bounded).
     assert!(tilt < 0.08, "the chest leaned {tilt} rad off the hips");
@@ -124,7 +124,7 @@ fn poubels_tables_turn_the_g1s_upper_body_at_its_waist_only() {
         chest: None,
         ..g1::profile()
     };
-    let swung = waist_motion(free, ImitationMethod::Poubel);
+    let swung = waist_motion(free, ImitationMethod::default());
     assert!(largest(&swung, 0) > 0.2, "{}", largest(&swung, 0));
     assert!(largest(&swung, 1) > 0.1, "{}", largest(&swung, 1));
 }

@@ -174,7 +174,7 @@ fn slow_dance(settle_time: Option<f64>) -> (Clip, ImitatorConfig) {
         support: SupportConfig::for_capture(clip.capture()),
         ..ImitatorConfig::default()
     };
-    config.phase.settle_time = settle_time;
+    config.poubel_mut().unwrap().phase.settle_time = settle_time;
     (clip, config)
 }
 

@@ -32,10 +32,11 @@ use std::path::Path;
 use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 use taskstack::human::HumanFrame;
 use taskstack::human::Side;
-use taskstack::imitation::config::ImitationMethod;
+use taskstack::imitation::ImitationMethod;
 use taskstack::imitation::koenemann::KoenemannConfig;
 use taskstack::imitation::metrics::{MetricsRecorder, convex_margin};
 use taskstack::imitation::output::CONTACT_HEIGHT;
+use taskstack::imitation::poubel::PoubelConfig;
 use taskstack::imitation::poubel::hand_support::{HandContactPlan, HandSupportConfig};
 use taskstack::imitation::reference::contact_events::ContactConfig;
 use taskstack::imitation::reference::support::SupportConfig;
@@ -314,42 +315,42 @@ fn g1_step_does_not_allocate_after_warm_up() {
 #[test]
 fn dynamic_walk_step_does_not_allocate_after_warm_up() {
     for walking_arms in [false, true] {
-        let config = ImitatorConfig {
+        let config = ImitatorConfig::from(PoubelConfig {
             footsteps: FootstepConfig {
                 follow: true,
                 dynamic: true,
                 walking_arms,
                 ..FootstepConfig::default()
             },
-            ..ImitatorConfig::default()
-        };
+            ..PoubelConfig::default()
+        });
         let imitator = Imitator::new(nao::profile(), config).unwrap();
         let walking = assert_no_allocation_after_warm_up(imitator, &WALKS);
         assert!(walking > 100, "{walking} walking frames after the warm-up");
     }
 }
 
-/// Nor does the ZMP balance ([`ImitatorConfig::zmp_balance`]): its polygons, rows and the
+/// Nor does the ZMP balance ([`PoubelConfig::zmp_balance`]): its polygons, rows and the
 /// joints' velocity are sized in `new`.
 #[test]
 fn zmp_balance_step_does_not_allocate_after_warm_up() {
-    let config = ImitatorConfig {
+    let config = ImitatorConfig::from(PoubelConfig {
         zmp_balance: true,
-        ..ImitatorConfig::default()
-    };
+        ..PoubelConfig::default()
+    });
     assert_no_allocation_after_warm_up(Imitator::new(nao::profile(), config).unwrap(), &SHORT);
 }
 
-/// Nor does damping toward the last step ([`ImitatorConfig::damping_momentum`]): the step
+/// Nor does damping toward the last step ([`PoubelConfig::damping_momentum`]): the step
 /// reference and the solver's reference coordinates are sized in `new`.
 #[test]
 fn damping_momentum_step_does_not_allocate_after_warm_up() {
-    let config = ImitatorConfig {
+    let config = ImitatorConfig::from(PoubelConfig {
         zmp_balance: true,
         damping_momentum: 0.8,
         damping: Some(0.1),
-        ..ImitatorConfig::default()
-    };
+        ..PoubelConfig::default()
+    });
     assert_no_allocation_after_warm_up(Imitator::new(nao::profile(), config).unwrap(), &SHORT);
 }
 
@@ -372,10 +373,10 @@ fn hand_support_step_does_not_allocate_after_warm_up() {
     let frames: Vec<HumanFrame> = clip.collect::<Result<_, _>>().unwrap();
     let scene = Scene::from_toml_file(dir.join("stool_23_19.toml")).unwrap();
     let plan = HandContactPlan::of_clip(&frames, &scene, &ContactConfig::default()).unwrap();
-    let config = ImitatorConfig {
+    let config = ImitatorConfig::from(PoubelConfig {
         hand_supports: Some(HandSupportConfig::new(plan)),
-        ..ImitatorConfig::default()
-    };
+        ..PoubelConfig::default()
+    });
     let mut imitator = Imitator::new(nao::profile(), config).unwrap();
     let (mut after_warm_up, mut steps, mut held) = (0, 0, 0);
     for (i, human) in frames.iter().enumerate() {
@@ -416,10 +417,10 @@ fn look_ahead_step_does_not_allocate_after_warm_up() {
     .unwrap();
     let frames: Vec<HumanFrame> = clip.collect::<Result<_, _>>().unwrap();
     let schedule = FootSchedule::of_clip(&frames, SupportConfig::optical()).unwrap();
-    let config = ImitatorConfig {
+    let config = ImitatorConfig::from(PoubelConfig {
         look_ahead: Some(FootLookAhead::new(schedule)),
-        ..ImitatorConfig::default()
-    };
+        ..PoubelConfig::default()
+    });
     let mut imitator = Imitator::new(nao::profile(), config).unwrap();
     let (mut after_warm_up, mut single) = (0, 0);
     for (i, human) in frames.iter().enumerate() {

@@ -120,7 +120,7 @@ impl KoenemannImitator {
             hand_speed: config.hand_speed_for(&tuning, false),
             hand_rates: HandRates::default(),
             human_double_time: 0.0,
-            foot_speed: config.max_task_speed.unwrap_or(tuning.task_speed),
+            foot_speed: method.swing_speed.unwrap_or(tuning.task_speed),
             motion: config.motion_for(&tuning),
             step_envelope: config.step_envelope.unwrap_or(profile.step_envelope),
             q_start: shared.q.clone(),

@@ -96,6 +96,10 @@ pub struct KoenemannConfig {
     /// medians no higher, and the same runs stand in the physics judge (the closing note of
     /// issue 32).
     pub max_leg_iterations: usize,
+    /// Largest speed of the swing foot's target toward the human's foot (m/s, > 0). `None`
+    /// (default): the profile's [`MotionTuning::task_speed`](crate::robots::MotionTuning::task_speed)
+    /// (NAO 0.15 m/s), the speed Poubel et al.'s method gives its tasks.
+    pub swing_speed: Option<f64>,
     /// Tolerance of the legs' IK (m; a normal's error counts 0.033 rad as 1 mm). Default 1e-3.
     pub tolerance: f64,
     /// Share of the way toward the profile's standing posture
@@ -172,6 +176,7 @@ impl Default for KoenemannConfig {
             damping: 0.01,
             arm_iterations: 4,
             max_leg_iterations: 4,
+            swing_speed: None,
             tolerance: 1e-3,
             arm_posture_gain: 0.01,
             settle_time: None,
@@ -195,6 +200,7 @@ impl KoenemannConfig {
         let positive = [
             ("koenemann.damping", self.damping),
             ("koenemann.tolerance", self.tolerance),
+            ("koenemann.swing_speed", self.swing_speed.unwrap_or(1.0)),
         ];
         if let Some((name, v)) = positive
             .into_iter()

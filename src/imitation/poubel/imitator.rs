@@ -57,6 +57,7 @@ use crate::imitation::config::ImitatorConfig;
 use crate::imitation::error::ImitationError;
 use crate::imitation::output::{EFFECTORS, RobotFrame, effector_frames};
 use crate::imitation::phase::zmp_balance::JointVelocity;
+use crate::imitation::poubel::PoubelConfig;
 
 /// Poubel et al.'s imitator.
 pub(crate) struct PoubelImitator {
@@ -124,11 +125,12 @@ impl PoubelImitator {
     /// An imitator for `profile` (validated by the caller with `config`).
     pub(crate) fn new(
         profile: BipedProfile,
-        mut config: ImitatorConfig,
+        config: &ImitatorConfig,
+        mut method: PoubelConfig,
     ) -> Result<Self, ImitationError> {
-        let (tables, hands) = tables_and_hands(&mut config, &profile);
+        let (tables, hands) = tables_and_hands(&mut method, &profile);
         // Position limits only matter to the limit-avoidance gradient and the start clamp.
-        let (mut shared, position_bounds) = Shared::new(profile, &config)?;
+        let (mut shared, position_bounds) = Shared::new(profile, config)?;
         let (profile, q) = (&shared.profile, &shared.q);
         let model = profile.model(Side::Right);
         // The legs are pulled toward the standing posture, not the human's leg angles: those
@@ -140,8 +142,8 @@ impl PoubelImitator {
             .zip(q)
             .map(|(&l, &v)| l.then_some(v))
             .collect();
-        let solver = config.solver_for(&profile.tuning);
-        let phases = phase_solvers(&tables, profile, q, solver, config.damping_momentum)?;
+        let solver = method.solver_for(&profile.tuning);
+        let phases = phase_solvers(&tables, profile, q, solver, method.damping_momentum)?;
         let angles = profile.joint_angles.map(|build| build(model)).transpose()?;
         let effectors = effector_ids(profile)?;
         let tuning = profile.tuning;
@@ -156,11 +158,19 @@ impl PoubelImitator {
         let arms = Side::BOTH
             .map(|root| Side::BOTH.map(|side| Arm::of(profile, profile.model(root), side)));
         shared.bounds = elbows_kept_bent(&shared.bounds, &arms[Side::Right.index()], &shared.q)?;
-        let footsteps = match config.look_ahead.take() {
-            Some(ahead) => FootstepPlanner::new(config.footsteps, area).with_look_ahead(ahead),
-            None => FootstepPlanner::new(config.footsteps, area),
+        let footsteps = match method.look_ahead.take() {
+            Some(ahead) => FootstepPlanner::new(method.footsteps, area).with_look_ahead(ahead),
+            None => FootstepPlanner::new(method.footsteps, area),
         };
-        let walk = walk_follower(&config, &shared, &position_bounds, &arms, solver, area)?;
+        let walk = walk_follower(
+            config,
+            &method,
+            &shared,
+            &position_bounds,
+            &arms,
+            solver,
+            area,
+        )?;
         let tracking = JointTracking::new(q)?;
         let (human_q, joint_velocity) = (q.clone(), JointVelocity::new(q.len()));
         shared.reserve_output(phases_sizes(&phases));
@@ -169,17 +179,17 @@ impl PoubelImitator {
             scaler,
             angles,
             machine: PhaseMachine::new(PhaseConfig {
-                settle_time: (config.phase.settle_time).or(sway_period),
-                ..config.phase
+                settle_time: (method.phase.settle_time).or(sway_period),
+                ..method.phase
             })?,
             limits: JointLimitAvoidance::new(&position_bounds),
             tracking,
             stance,
             human_q,
-            iterations: config.iterations_per_frame,
-            max_task_speed: config.max_task_speed.unwrap_or(tuning.task_speed),
-            walking_arms: config.footsteps.walking_arms,
-            hand_speed: hand_speed(&config, &tuning, walk.is_some()),
+            iterations: method.iterations_per_frame,
+            max_task_speed: method.max_task_speed.unwrap_or(tuning.task_speed),
+            walking_arms: method.footsteps.walking_arms,
+            hand_speed: hand_speed(config, &method, &tuning, walk.is_some()),
             hand_rates: HandRates::default(),
             arms,
             phases,

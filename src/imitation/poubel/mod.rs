@@ -3,9 +3,11 @@
 //! the hands may rest on the scene ([`hand_support`]); the scaled arms hang from the robot's own
 //! shoulders, not the scaled human's.
 
+mod config;
 pub mod hand_support;
 mod imitator;
 mod setup;
 mod shoulder_anchor;
 
+pub use config::PoubelConfig;
 pub(crate) use imitator::PoubelImitator;

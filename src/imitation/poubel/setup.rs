@@ -8,6 +8,7 @@ use crate::imitation::error::ImitationError;
 use crate::imitation::phase::SupportPhase;
 use crate::imitation::phase::solver::PhaseSolver;
 use crate::imitation::phase::tables::TaskTables;
+use crate::imitation::poubel::PoubelConfig;
 use crate::imitation::poubel::hand_support::HandSupports;
 use crate::imitation::reach::Arm;
 use crate::imitation::shaping::HandSpeed;
@@ -65,7 +66,7 @@ pub(super) fn elbows_kept_bent(
 /// the stances centred for walking when the robot follows the human's steps) and the hand
 /// supports; the tables gain the rows the hand supports and the ZMP balance need.
 pub(super) fn tables_and_hands(
-    config: &mut ImitatorConfig,
+    config: &mut PoubelConfig,
     profile: &BipedProfile,
 ) -> (TaskTables, Option<HandSupports>) {
     let mut tables = match config.tables.take() {
@@ -93,13 +94,14 @@ pub(super) fn tables_and_hands(
 /// keep them when the arms move while walking.
 pub(super) fn walk_follower(
     config: &ImitatorConfig,
+    method: &PoubelConfig,
     shared: &Shared,
     position_bounds: &JointBounds,
     arms: &[[Option<Arm>; 2]; 2],
     solver: Settings,
     area: FootArea,
 ) -> Result<Option<WalkFollower>, ImitationError> {
-    if !(config.footsteps.follow && config.footsteps.dynamic) {
+    if !(method.footsteps.follow && method.footsteps.dynamic) {
         return Ok(None);
     }
     let (profile, q) = (&shared.profile, &shared.q);
@@ -111,15 +113,15 @@ pub(super) fn walk_follower(
         model,
         position_bounds,
         &shared.legs,
-        config.walking_velocity_fraction,
+        method.walking_velocity_fraction,
         upper_body,
     )?;
     // The walk's arm step keeps the elbows bent as the support phases do.
-    let bounds = match config.footsteps.walking_arms {
+    let bounds = match method.footsteps.walking_arms {
         true => elbows_kept_bent(&bounds, &arms[Side::Right.index()], q)?,
         false => bounds,
     };
-    let footsteps = &config.footsteps;
+    let footsteps = &method.footsteps;
     Ok(Some(WalkFollower::new(
         profile, q, solver, area, footsteps, bounds,
     )?))
@@ -131,6 +133,7 @@ pub(super) fn walk_follower(
 /// have no ZMP level, so its hands keep the ordinary speeds.
 pub(super) fn hand_speed(
     config: &ImitatorConfig,
+    method: &PoubelConfig,
     tuning: &MotionTuning,
     walking: bool,
 ) -> HandSpeed {
@@ -142,7 +145,7 @@ pub(super) fn hand_speed(
                 ..speed
             }
         }
-        false => config.hand_speed_for(tuning, config.zmp_balance),
+        false => config.hand_speed_for(tuning, method.zmp_balance),
     }
 }
 

@@ -299,7 +299,7 @@ pub fn self_collision() -> SelfCollision {
 ///   is what limits them: faster or unshaped hands turned loaded feet by more than 2° and let
 ///   the weak model's stance foot roll onto an edge, on one foot most of all; slower ones left
 ///   the hands tenths of a second late.
-/// * With the ZMP level (`ImitatorConfig::zmp_balance`) the hands at 1 m/s and 10 m/s² in every
+/// * With the ZMP level (`PoubelConfig::zmp_balance`) the hands at 1 m/s and 10 m/s² in every
 ///   phase (`balanced_hands`): the level keeps the arms' reaction inside the support, which the
 ///   fixed caps above do without it; faster still (1.5 m/s, 20 m/s²), loaded feet turned.
 /// * The torso 0.02 m low: with 0.1 m shanks both knees end up straight at the standing height.

@@ -66,7 +66,7 @@ pub(crate) struct PhaseSolver {
     other_sole: FrameId,
     /// The joints the solve may move ([`PhaseSolver::restricted`]); `None`: all.
     joints: Option<Vec<bool>>,
-    /// [`ImitatorConfig::damping_momentum`](super::ImitatorConfig::damping_momentum), and the
+    /// [`PoubelConfig::damping_momentum`](crate::imitation::poubel::PoubelConfig::damping_momentum), and the
     /// frame's step reference it gives (rad).
     damping_momentum: f64,
     momentum_step: Vec<f64>,
@@ -167,7 +167,7 @@ impl PhaseSolver {
     }
 
     /// Damped levels keep `share` of the last frame's step ([`PhaseSolver::run`]'s step
-    /// reference, [`ImitatorConfig::damping_momentum`](super::ImitatorConfig::damping_momentum)).
+    /// reference, [`PoubelConfig::damping_momentum`](crate::imitation::poubel::PoubelConfig::damping_momentum)).
     pub(crate) fn with_damping_momentum(mut self, share: f64) -> Self {
         self.damping_momentum = share;
         self
