@@ -9,6 +9,9 @@ use crate::imitation::shaping::{HandSpeed, MotionLimits};
 use crate::robots::{FootArea, MotionTuning};
 
 /// Which method imitates, with its own settings; what both use is in [`ImitatorConfig`].
+// Boxing Poubel's settings (about 450 bytes) would save nothing that matters: a config is
+// built once per imitator, and `ImitationMethod::Poubel(PoubelConfig { .. })` reads as written.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone)]
 pub enum ImitationMethod {
     /// Poubel et al.'s support phases and task tables, one prioritized IK step per frame

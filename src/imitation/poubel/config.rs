@@ -56,9 +56,9 @@ pub struct PoubelConfig {
     /// budget by default. Its [`Settings::damping_threshold`] and [`Settings::max_damping`]
     /// are replaced by [`PoubelConfig::damping`].
     pub solver: Settings,
-    /// The solver's damping of near-singular levels (task units per rad, m/rad for the hands,
-    /// > 0): the damping threshold and the largest damping of `solver`. `None` (default): the
-    /// profile's [`MotionTuning::damping`] (NAO 0.02, G1 0.039: it scales with the arm).
+    /// The solver's damping of near-singular levels (> 0; task units per rad, m/rad for the
+    /// hands): the damping threshold and the largest damping of `solver`. `None` (default):
+    /// the profile's [`MotionTuning::damping`] (NAO 0.02, G1 0.039: it scales with the arm).
     pub damping: Option<f64>,
     /// The share (0–1) of the last frame's joint step that a damped level keeps (the support
     /// phases). A level whose smallest singular value falls below the damping

@@ -122,7 +122,10 @@ impl std::fmt::Debug for PoubelImitator {
 }
 
 impl PoubelImitator {
-    /// An imitator for `profile` (validated by the caller with `config`).
+    /// An imitator for `profile` (validated by the caller with `config`) by `method`'s settings.
+    // One function on purpose (~85 lines): the imitator's state built in the order each part
+    // needs the last (tables, shared state, phases, scaler, arms, steps), one field a line;
+    // split up, a reader would hunt for where a field comes from.
     pub(crate) fn new(
         profile: BipedProfile,
         config: &ImitatorConfig,

@@ -24,7 +24,7 @@
 //!
 //! Cost: one `m × m` Cholesky factorization per pass, `m` the stack's total rows.
 
-use super::Solver;
+use super::solver::Solver;
 use crate::solver::JointBounds;
 
 /// Chan & Dubey's `∂H/∂q_i` for a joint at `q` in `[lower, upper]` (1/rad): 0 at the middle of
