@@ -263,8 +263,14 @@ fn print_locomotion(text: &mut String, m: &ImitationMetrics) {
     let t = &m.travel;
     let _ = writeln!(
         text,
-        "travel: scaled human {:.3} m, robot {:.3} m; steps: human {}, robot {}",
-        t.scaled_human_m, t.robot_m, m.human_steps, m.robot_steps
+        "travel: scaled human {:.3} m, robot {:.3} m, ending {:.3} m and {:.1}° from where the \
+         scaled human stands; steps: human {}, robot {}",
+        t.scaled_human_m,
+        t.robot_m,
+        t.error_m,
+        t.heading_error_rad.to_degrees(),
+        m.human_steps,
+        m.robot_steps
     );
     if let Some(w) = &m.walking {
         let duration = w
@@ -279,11 +285,12 @@ fn print_locomotion(text: &mut String, m: &ImitationMetrics) {
             w.zmp_margin_min_m * 1e3
         );
     }
-    if m.human_lifts > 0 {
+    if let Some(f) = &m.following {
+        let catch_up = (f.catch_up_s).map_or("never".to_owned(), |s| format!("{s:.2} s after"));
         let _ = writeln!(
             text,
-            "feet: robot lifted {} of the human's {} foot lifts, median {:.2} s after (landed {:.2} s after)",
-            m.lift_lag.count, m.human_lifts, m.lift_lag.median, m.landing_lag.median
+            "feet: robot lifted {} of the human's {} foot lifts, median {:.2} s after (landed {:.2} s after); its last landing {catch_up} the human's",
+            f.matched_steps, f.human_steps, m.lift_lag.median, m.landing_lag.median
         );
     }
 }

@@ -26,6 +26,7 @@ use serde_json::{Value, json};
 use thiserror::Error;
 
 use crate::human::HumanFrame;
+use crate::imitation::metrics::travel::StepFollowing;
 use crate::imitation::metrics::{
     EffectorError, ImitationMetrics, MeanMax, MetricsRecorder, Spread,
 };
@@ -673,6 +674,7 @@ pub fn metrics_value(m: &ImitationMetrics, clip: &Path) -> Value {
             "scaled_human_m": m.travel.scaled_human_m,
             "robot_m": m.travel.robot_m,
             "heading_error_rad": m.travel.heading_error_rad,
+            "error_m": m.travel.error_m,
         },
         "steps": {
             "human": m.human_steps,
@@ -685,12 +687,30 @@ pub fn metrics_value(m: &ImitationMetrics, clip: &Path) -> Value {
             "landing": spread(&m.landing_lag),
             "human_lifts": m.human_lifts,
         },
-        "walking": m.walking.map(|w| json!({
-            "steps": w.steps,
-            "mean_speed_m_s": w.mean_speed_m_s,
-            "step_duration_s": w.step_duration_s,
-            "zmp_margin_min_m": w.zmp_margin_min_m,
-            "walking_s": w.walking_s,
-        })),
+        "walking": walking_value(m),
+    })
+}
+
+/// `metrics.json`'s `walking`: how the robot followed the human's steps (when the human
+/// stepped) and what its walks did (when it walked with the pattern generator; `null` fields
+/// otherwise); `null` when neither.
+fn walking_value(m: &ImitationMetrics) -> Value {
+    if m.walking.is_none() && m.following.is_none() {
+        return Value::Null;
+    }
+    let w = m.walking.as_ref();
+    let f = m.following.as_ref();
+    json!({
+        "steps": w.map(|w| w.steps),
+        "mean_speed_m_s": w.map(|w| w.mean_speed_m_s),
+        "step_duration_s": w.and_then(|w| w.step_duration_s),
+        "zmp_margin_min_m": w.map(|w| w.zmp_margin_min_m),
+        "walking_s": w.map(|w| w.walking_s),
+        "human_steps": f.map(|f| f.human_steps),
+        "matched_steps": f.map(|f| f.matched_steps),
+        "matched_share": f.map(StepFollowing::matched_share),
+        "catch_up_s": f.and_then(|f| f.catch_up_s),
+        "travel_error_m": m.travel.error_m,
+        "heading_error_deg": m.travel.heading_error_rad.to_degrees(),
     })
 }

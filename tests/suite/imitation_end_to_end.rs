@@ -261,6 +261,11 @@ fn dynamic_walks_are_walked() {
             (t.robot_m - t.scaled_human_m).abs() <= 0.25 * t.scaled_human_m,
             "{name}: {t:?}"
         );
+        // It follows the human's steps, and goes on stepping after the human's last.
+        let f = m.following.unwrap_or_else(|| panic!("{name}: the human stepped"));
+        assert!(f.matched_steps >= 1, "{name}: {f:?}");
+        assert!(f.catch_up_s.is_some_and(|s| s > 0.0), "{name}: {f:?}");
+        assert!(t.error_m < 0.25 * t.scaled_human_m, "{name}: {t:?}");
     }
 }
 

@@ -50,7 +50,8 @@ use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 use crate::imitation::imitator::Imitator;
 use crate::imitation::metrics::clearance::{ClearanceMeter, SelfClearance};
 use crate::imitation::metrics::travel::{
-    FootTiming, HandTrace, Stance, StepCounter, Travel, TravelRecorder, robot_stance,
+    FootTiming, HandTrace, Stance, StepCounter, StepFollowing, Travel, TravelRecorder,
+    robot_stance,
 };
 use crate::imitation::output::RobotFrame;
 use crate::imitation::phase::{SupportKind, SupportPhase};
@@ -225,6 +226,8 @@ pub struct ImitationMetrics {
     pub finished: bool,
     /// The robot's walks ([`crate::imitation::walking`]); `None` when it never walked.
     pub walking: Option<WalkingSummary>,
+    /// How the robot followed the human's steps; `None` when the human never stepped.
+    pub following: Option<StepFollowing>,
 }
 
 /// Accumulates [`ImitationMetrics`] frame by frame.
@@ -625,6 +628,7 @@ impl MetricsRecorder {
                 .then(|| self.held.each_ref().map(HeldHandTally::summary)),
             finished: self.finished,
             walking: self.walking.finish(),
+            following: self.feet.following(),
             lift_lag: Spread::of(&mut lift_lag),
             landing_lag: Spread::of(&mut landing_lag),
             human_lifts,

@@ -4,10 +4,13 @@
 //! * **Travel**: start-to-end displacement of the scaled human's stance (the ankles' midpoint
 //!   times the leg ratio) and of the robot's mid-feet point, and the difference of their heading
 //!   changes (rad, wrapped to ±π).
+//!   At the end, the robot's **travel error**: its distance from where the scaled human stands
+//!   (the human's displacement, scaled, turned into the robot's world by the initial heading
+//!   difference).
 //! * **Catch-up**: after the clip's last frame, the time until the robot stands in double
 //!   support where the scaled human stands (within [`CATCH_UP_DISTANCE`] and
-//!   [`CATCH_UP_HEADING`], the human's displacement turned into the robot's world by the initial
-//!   heading difference) and stays there.
+//!   [`CATCH_UP_HEADING`]) and stays there. The **step catch-up** ([`StepFollowing`]) is
+//!   simpler: from the human's last landing of a foot to the robot's.
 //! * **Steps**: episodes of at least [`MIN_STEP_TIME`] with a foot off the floor, for the human
 //!   (single-support episodes) and for the robot (a swing foot, from the plan's phases).
 //! * **Foot lag**: each human lift-off (landing) of a foot lifted at least [`MIN_STEP_TIME`] is
@@ -45,6 +48,32 @@ pub struct Travel {
     pub robot_m: f64,
     /// Robot heading change minus human heading change at the end (rad, ±π).
     pub heading_error_rad: f64,
+    /// The robot's distance from where the scaled human stands at the end (m): the robot's
+    /// displacement minus the scaled human's, turned into the robot's world by the initial
+    /// heading difference.
+    pub error_m: f64,
+}
+
+/// How the robot followed the human's steps (present when the human lifted a foot for at
+/// least [`MIN_STEP_TIME`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepFollowing {
+    /// The human's lifts of a foot (the steps).
+    pub human_steps: usize,
+    /// Those the robot matched: a lift of the same foot paired with it (see the foot lag).
+    pub matched_steps: usize,
+    /// From the human's last landing of a foot to the robot's last landing (s): how long the
+    /// robot went on stepping after the human stopped. Negative when the robot's last step
+    /// ended first (it left the human's last steps out: see `matched_steps` and
+    /// [`Travel::error_m`]); `None` when the robot never put a foot down.
+    pub catch_up_s: Option<f64>,
+}
+
+impl StepFollowing {
+    /// The share of the human's steps the robot matched (0–1).
+    pub fn matched_share(&self) -> f64 {
+        self.matched_steps as f64 / self.human_steps as f64
+    }
 }
 
 /// Where someone stands: ground point (m) and heading (rad).
@@ -120,10 +149,12 @@ impl TravelRecorder {
         let (Some((h0, r0)), Some((h, r, ratio))) = (self.start, self.last) else {
             return Travel::default();
         };
+        let (error_m, heading_error_rad) = self.errors(h0, r0, h, r, ratio);
         Travel {
             scaled_human_m: ((h.point - h0.point) * ratio).norm(),
             robot_m: (r.point - r0.point).norm(),
-            heading_error_rad: self.errors(h0, r0, h, r, ratio).1,
+            heading_error_rad,
+            error_m,
         }
     }
 
@@ -205,6 +236,22 @@ impl FootTiming {
     pub(crate) fn record(&mut self, human_up: [bool; 2], robot_up: [bool; 2], time: f64) {
         self.human.record(human_up, time, MIN_STEP_TIME);
         self.robot.record(robot_up, time, 0.0);
+    }
+
+    /// The human's steps, those the robot matched, and the step catch-up; `None` when the
+    /// human never stepped.
+    pub(crate) fn following(&self) -> Option<StepFollowing> {
+        let last = |events: &FootEvents| {
+            let landings = events.landings.iter().filter_map(|l| l.last().copied());
+            landings.reduce(f64::max)
+        };
+        let human_last = last(&self.human)?;
+        let (matched, human_steps) = pair(&self.human.lifts, &self.robot.lifts);
+        Some(StepFollowing {
+            human_steps,
+            matched_steps: matched.len(),
+            catch_up_s: last(&self.robot).map(|robot| robot - human_last),
+        })
     }
 
     /// Lags of the lift-offs and of the landings.
@@ -362,7 +409,53 @@ mod tests {
         assert!((travel.scaled_human_m - 1.0).abs() < 1e-12);
         assert!((travel.robot_m - 0.2).abs() < 1e-12);
         assert!((travel.heading_error_rad + FRAC_PI_2).abs() < 1e-12);
+        // Both started facing +x: the scaled human ends 1 m ahead, the robot 0.2 m.
+        assert!((travel.error_m - 0.8).abs() < 1e-12);
         assert_eq!(t.catch_up(), None);
+    }
+
+    /// The travel error turns the human's displacement into the robot's world: the human
+    /// faces +y at the start and walks 2 m along it (1 m scaled), the robot faces +x, so it
+    /// should end 1 m along +x; it ends at (0.6, 0.3): √(0.4² + 0.3²) = 0.5 m off.
+    #[test]
+    fn travel_error_is_measured_in_the_robots_world() {
+        let mut t = TravelRecorder::default();
+        let human = [stance(5.0, 1.0, FRAC_PI_2), stance(5.0, 3.0, FRAC_PI_2)];
+        let robot = [stance(0.0, 0.0, 0.0), stance(0.6, 0.3, 0.0)];
+        for (i, time) in [0.0, 1.0].into_iter().enumerate() {
+            t.record(Some(human[i]), 0.5, robot[i], true, time);
+        }
+        let travel = t.travel();
+        assert!((travel.error_m - 0.5).abs() < 1e-12, "{travel:?}");
+        assert!(travel.heading_error_rad.abs() < 1e-12);
+    }
+
+    /// The human steps with the left foot (lift 1.0, land 1.5) and the right (2.0–2.5); the
+    /// robot follows the left (1.3–2.1) and never the right, then steps with the left again
+    /// (3.0–3.6): one of two steps matched, its last landing 3.6 − 2.5 = 1.1 s after the
+    /// human's.
+    #[test]
+    fn step_following_counts_matched_steps_and_the_last_landings_apart() {
+        let mut timing = FootTiming::default();
+        assert_eq!(timing.following(), None, "no human step yet");
+        let (l, r, none) = ([true, false], [false, true], [false, false]);
+        for (human, robot, time) in [
+            (none, none, 0.0),
+            (l, none, 1.0),
+            (l, l, 1.3),
+            (none, l, 1.5),
+            (r, l, 2.0),
+            (r, none, 2.1),
+            (none, none, 2.5),
+            (none, l, 3.0),
+            (none, none, 3.6),
+        ] {
+            timing.record(human, robot, time);
+        }
+        let following = timing.following().unwrap();
+        assert_eq!((following.human_steps, following.matched_steps), (2, 1));
+        assert!((following.catch_up_s.unwrap() - 1.1).abs() < 1e-12);
+        assert_eq!(following.matched_share(), 0.5);
     }
 
     #[test]
