@@ -15,8 +15,8 @@ use taskstack::imitation::phase::SupportPhase;
 use taskstack::imitation::reference::support::HumanSupport;
 use taskstack::locomotion::footstep::wrap_angle;
 use taskstack::locomotion::{
-    Footstep, GroundPose, Support, SupportPolygon, WalkParams, WalkerFrame, WholeBodyWalker,
-    goal_feet, plan_steps,
+    Footstep, GroundPose, StepTiming, Support, SupportPolygon, WalkParams, WalkerFrame,
+    WholeBodyWalker, goal_feet, plan_steps,
 };
 use taskstack::nalgebra::Translation3;
 use taskstack::robots::BipedProfile;
@@ -64,6 +64,15 @@ pub(crate) struct WalkArgs {
     /// (NAO 0.05, G1 0.15).
     #[arg(long, value_parser = crate::options::positive)]
     step_length: Option<f64>,
+    /// Double support of every step (s, > 0): both feet on the floor while the ZMP moves onto
+    /// the next stance sole. Default: the robot's derived timing
+    /// (`taskstack::locomotion::params`; NAO 0.50 s).
+    #[arg(long, value_name = "SECONDS", value_parser = crate::options::positive)]
+    double_support: Option<f64>,
+    /// Single support of every step (s, > 0): the swing foot in the air. Default: the robot's
+    /// derived timing (NAO 0.58 s).
+    #[arg(long, value_name = "SECONDS", value_parser = crate::options::positive)]
+    single_support: Option<f64>,
     /// Seconds to stand still after the robot has stopped.
     #[arg(long, default_value_t = 1.0, value_parser = non_negative)]
     hold: f64,
@@ -80,7 +89,14 @@ pub(crate) fn run(args: WalkArgs, report: Report) -> Result<ExitCode> {
         bail!("--forward, --left and --turn must be finite numbers");
     }
     let profile = robot_profile(&args.robot)?;
-    let params = WalkParams::for_profile(&profile).context("deriving the walk settings")?;
+    let mut params = WalkParams::for_profile(&profile).context("deriving the walk settings")?;
+    if args.double_support.is_some() || args.single_support.is_some() {
+        let timing = StepTiming {
+            double_support: args.double_support.unwrap_or(params.timing.double_support),
+            single_support: args.single_support.unwrap_or(params.timing.single_support),
+        };
+        params = params.with_timing(timing);
+    }
     let timing = params.timing;
     let mut walker = WholeBodyWalker::new(&profile, params, GroundPose::new(0.0, 0.0, 0.0))?;
     let start = *walker.generator().standing_feet();

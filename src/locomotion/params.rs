@@ -156,6 +156,14 @@ impl WalkParams {
         }
     }
 
+    /// These parameters with every step timed by `timing` (s), the start and the stop one
+    /// step time each (the rule of the module docs), for a walk faster or slower than the
+    /// derived one.
+    pub fn with_timing(mut self, timing: StepTiming) -> Self {
+        self.timing = timing;
+        self.with_start_and_stop()
+    }
+
     /// Start and stop times of one step each.
     fn with_start_and_stop(mut self) -> Self {
         let step_time = self.timing.duration();

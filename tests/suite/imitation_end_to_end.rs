@@ -262,7 +262,9 @@ fn dynamic_walks_are_walked() {
             "{name}: {t:?}"
         );
         // It follows the human's steps, and goes on stepping after the human's last.
-        let f = m.following.unwrap_or_else(|| panic!("{name}: the human stepped"));
+        let f = m
+            .following
+            .unwrap_or_else(|| panic!("{name}: the human stepped"));
         assert!(f.matched_steps >= 1, "{name}: {f:?}");
         assert!(f.catch_up_s.is_some_and(|s| s > 0.0), "{name}: {f:?}");
         assert!(t.error_m < 0.25 * t.scaled_human_m, "{name}: {t:?}");

@@ -50,8 +50,7 @@ use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 use crate::imitation::imitator::Imitator;
 use crate::imitation::metrics::clearance::{ClearanceMeter, SelfClearance};
 use crate::imitation::metrics::travel::{
-    FootTiming, HandTrace, Stance, StepCounter, StepFollowing, Travel, TravelRecorder,
-    robot_stance,
+    FootTiming, HandTrace, Stance, StepCounter, StepFollowing, Travel, TravelRecorder, robot_stance,
 };
 use crate::imitation::output::RobotFrame;
 use crate::imitation::phase::{SupportKind, SupportPhase};
