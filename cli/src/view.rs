@@ -14,6 +14,7 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use serde_json::json;
 use taskstack::human::{HumanJoint, Side};
+use taskstack::imitation::EFFECTORS;
 use taskstack::imitation::output::CONTACT_HEIGHT;
 use taskstack::imitation::output::HandPlacement;
 use taskstack::imitation::phase::SupportPhase;
@@ -79,6 +80,8 @@ impl<W: Write> ViewWriter<W> {
             "human_joints": HumanJoint::ALL.iter().map(|j| j.name()).collect::<Vec<_>>(),
             "rate_hz": VIEW_RATE,
             "phases": SupportPhase::ALL.iter().map(ToString::to_string).collect::<Vec<_>>(),
+            // The human joints of the hands' targets ([`EFFECTORS`]' hands), in the human points.
+            "hand_joints": EFFECTORS[..2].iter().map(|(_, joint)| joint.index()).collect::<Vec<_>>(),
         });
         let (head, _) = split_template()?;
         write!(out, "{head}const RUN = {run};\nconst FRAMES = [\n")?;
@@ -98,7 +101,8 @@ impl<W: Write> ViewWriter<W> {
 
     /// Adds robot frame `r` if it is due at [`VIEW_RATE`]. Each frame is
     /// `[time ms, phase, human support, robot points, human points, left sole, right sole,
-    /// CoM xy, grounded bits, planned ZMP xy or null, footsteps, hand supports]`, lengths in mm in the world
+    /// CoM xy, grounded bits, planned ZMP xy or null, footsteps, hand supports, robot hands
+    /// (left xyz, right xyz) or null]`, lengths in mm in the world
     /// frame; each footstep is `[side (0 left, 1 right), corner x, y, …]`, its sole outline
     /// where it lands; then the hands placed on or held at a surface (see
     /// `push_hand_supports`).
@@ -115,6 +119,11 @@ impl<W: Write> ViewWriter<W> {
             zmp: r.walk.map(|w| w.zmp),
             footsteps: &r.footsteps,
             hand_supports: r.hand_supports,
+            hands: Some([0, 1].map(|k| {
+                r.world_t_root
+                    .transform_point(&r.effectors[k].into())
+                    .coords
+            })),
         };
         self.frame_of(&frame, reference)
     }
@@ -192,7 +201,18 @@ impl<W: Write> ViewWriter<W> {
         }
         line.push_str("],[");
         push_hand_supports(line, &r.hand_supports);
-        line.push_str("]],\n");
+        line.push_str("],");
+        match r.hands {
+            Some(hands) => {
+                line.push('[');
+                push_xyz(line, &hands[0]);
+                line.push(',');
+                push_xyz(line, &hands[1]);
+                line.push(']');
+            }
+            None => line.push_str("null"),
+        }
+        line.push_str("],\n");
         self.out.write_all(line.as_bytes())?;
         self.written += 1;
         Ok(())
@@ -235,6 +255,9 @@ pub(crate) struct ViewFrame<'a> {
     pub(crate) footsteps: &'a [Footstep],
     /// The hands placed on or held at a surface (world), `[left, right]`.
     pub(crate) hand_supports: [Option<HandPlacement>; 2],
+    /// The robot's hands (m, world), `[left, right]`, drawn with their targets (the scaled
+    /// human's hands as the robot is asked to reach them); `None` for a run with no human.
+    pub(crate) hands: Option<[Vector3<f64>; 2]>,
 }
 
 /// What is drawn of the robot: the link origins and named frames whose world positions each

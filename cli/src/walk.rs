@@ -240,6 +240,7 @@ impl Recorder {
             zmp: Some(w.zmp),
             footsteps,
             hand_supports: [None; 2],
+            hands: None,
         };
         self.view
             .frame_of(&view, std::iter::repeat_n(None, HumanJoint::COUNT))

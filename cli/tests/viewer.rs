@@ -104,15 +104,17 @@ fn the_viewer_draws_the_walk_plan() {
     assert_eq!(run.code, Some(0), "{}", run.stderr);
     let page = out.join("view.html").canonicalize().unwrap();
     let text = std::fs::read_to_string(&page).unwrap();
-    // A frame with a step queued ends `…,grounded,[zmp x,zmp y],[[side,x,y,…]],[]],` (no hand
-    // supports).
-    let planned = text.lines().filter(|l| l.ends_with("]],[]],")).count();
+    // A frame with a step queued: `[…, grounded, [zmp x, zmp y], [[side, x, y, …]], [], null]`
+    // (no hand supports, no robot hands: a walk has no human).
+    let planned = (text.lines().filter_map(frame))
+        .filter(|f| f[9].is_array() && f[10].as_array().is_some_and(|s| !s.is_empty()))
+        .count();
     assert!(planned > 50, "{planned} frames with a footstep");
     // The same frames without the plan (every frame's ZMP and footsteps emptied).
     draws_more_than_stripped(&browser, &page, 0, |l| {
-        let cut = l.rfind("],[[")?;
-        let zmp = l[..cut].rfind(",[")?;
-        Some(format!("{},null,[],[]],", &l[..zmp]))
+        let mut f = frame(l)?;
+        (f[9], f[10]) = (Value::Null, Value::Array(vec![]));
+        Some(format!("{f},"))
     });
 }
 
@@ -136,13 +138,62 @@ fn the_viewer_draws_the_surfaces_the_hands_rest_on() {
     assert_eq!(run.code, Some(0), "{}", run.stderr);
     let page = out.join("view.html").canonicalize().unwrap();
     let text = std::fs::read_to_string(&page).unwrap();
-    // A frame with a hand support ends `…,[footsteps],[[side,holding,x,y,z,height,corners…]]],`.
-    let held = text.lines().filter(|l| l.ends_with("]]],")).count();
+    // A frame with a hand support: `[…, [footsteps], [[side, holding, x, y, z, height,
+    // corners…]], [robot hands]]`.
+    let supported = |f: &Value| f[11].as_array().is_some_and(|h| !h.is_empty());
+    let held = text.lines().filter_map(frame).filter(supported).count();
     assert!(held > 20, "{held} frames with a hand support");
     draws_more_than_stripped(&browser, &page, 3, |l| {
-        let cut = l.rfind(",[[").filter(|_| l.ends_with("]]],"))?;
-        Some(format!("{},[]],", &l[..cut]))
+        let mut f = frame(l).filter(supported)?;
+        f[11] = Value::Array(vec![]);
+        Some(format!("{f},"))
     });
+}
+
+/// An imitation's page draws each hand's target (the scaled human's hand as the robot is asked
+/// to reach it) and the hand's error to it: its frames carry the robot's hands, 0.5–50 cm from
+/// the targets in the human points at `RUN.hand_joints`, and the page draws more than with the
+/// hands taken out.
+#[test]
+fn the_viewer_draws_the_hand_targets() {
+    let Some(browser) = browser() else {
+        assert!(std::env::var_os("TASKSTACK_REQUIRE_BROWSER").is_none());
+        eprintln!("viewer test skipped: no browser");
+        return;
+    };
+    let dir = temp_dir("viewer-hands");
+    let out = imitated_kinect(&dir, "1");
+    let page = out.join("view.html").canonicalize().unwrap();
+    let text = std::fs::read_to_string(&page).unwrap();
+    let joints = ["LHand", "RHand"].map(|name| {
+        let names = text.split("\"human_joints\":[").nth(1).unwrap().split(']').next().unwrap();
+        (names.split(',')).position(|n| n == format!("\"{name}\"")).unwrap()
+    });
+    let frames: Vec<Value> = text.lines().filter_map(frame).collect();
+    let errors: Vec<f64> = (frames.iter())
+        .flat_map(|f| {
+            (0..2).map(move |s| {
+                let at = |v: &Value, k: usize| v[k].as_f64().unwrap();
+                let (hand, human) = (&f[12], &f[4]);
+                let d = (0..3).map(|a| at(hand, 3 * s + a) - at(human, 3 * joints[s] + a));
+                d.map(|x| x * x).sum::<f64>().sqrt()
+            })
+        })
+        .collect();
+    assert_eq!(errors.len(), 2 * frames.len());
+    assert!(errors.iter().all(|&e| e < 500.0), "{errors:?} mm");
+    assert!(errors.iter().any(|&e| e > 5.0), "{errors:?} mm");
+    draws_more_than_stripped(&browser, &page, 1, |l| {
+        let mut f = frame(l)?;
+        f[12] = Value::Null;
+        Some(format!("{f},"))
+    });
+}
+
+/// A frame line of a page (`[…],`) as JSON; `None` for any other line.
+fn frame(line: &str) -> Option<Value> {
+    let json = line.strip_prefix('[')?.strip_suffix("],")?;
+    serde_json::from_str(&format!("[{json}]")).ok()
 }
 
 /// The page runs clean, runs clean again with `strip` applied to its frame lines (`None` keeps
