@@ -11,6 +11,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
 use taskstack::batch::{HOLD_CAP, Hold};
 use taskstack::imitation::metrics::ImitationMetrics;
+use taskstack::imitation::metrics::travel::LATE_LAG;
 use taskstack::imitation::reach::POSTURE_UNREACHABLE;
 
 use crate::Report;
@@ -342,6 +343,30 @@ fn print_tracking(text: &mut String, m: &ImitationMetrics) {
         );
     }
     print_reach(text, m);
+    print_hand_timing(text, m);
+}
+
+/// Whether the hands are late: the best time shift, and how much of their error it removes.
+fn print_hand_timing(text: &mut String, m: &ImitationMetrics) {
+    let Some(t) = m.hand_timing() else {
+        return;
+    };
+    let verdict = match t.late() {
+        true => "late",
+        false if t.lag_s < LATE_LAG => "on time",
+        false => {
+            "not late: the hands are off more in where than in when (slowed down cutting \
+             corners, out of reach or at a limit, a robot not where the human is)"
+        }
+    };
+    let _ = writeln!(
+        text,
+        "hands' timing: best aligned {:.2} s later, which takes their mean error from {:.1} to {:.1} cm ({:.0} %): {verdict}",
+        t.lag_s,
+        t.error_m * 100.0,
+        t.lag_removed_error_m * 100.0,
+        t.removed_share() * 100.0
+    );
 }
 
 /// Per hand, the clip frames whose reference lay out of the arm's reach from the robot's

@@ -151,6 +151,19 @@ fn imitate_writes_every_output_and_reports_clip_and_hold_apart() {
         );
         assert!(run.stdout.contains(&told), "{told}\n{}", run.stdout);
     }
+    // The hands' timing: metrics.json's lag, the errors without and with it removed (the
+    // pooled clip errors of `tracking_error_clip` can only be larger), told in the summary.
+    let timing = &metrics["hand_timing"];
+    assert_eq!(timing["lag_s"], metrics["hand_lag_s"]);
+    let (error, removed) = (&timing["error_m"], &timing["lag_removed_error_m"]);
+    assert!(removed.as_f64().unwrap() <= error.as_f64().unwrap(), "{timing}");
+    let told = format!(
+        "best aligned {:.2} s later, which takes their mean error from {} to {} cm",
+        timing["lag_s"].as_f64().unwrap(),
+        cm(error),
+        cm(removed)
+    );
+    assert!(run.stdout.contains(&told), "{told}\n{}", run.stdout);
 }
 
 #[test]

@@ -166,8 +166,16 @@ fn the_viewer_draws_the_hand_targets() {
     let page = out.join("view.html").canonicalize().unwrap();
     let text = std::fs::read_to_string(&page).unwrap();
     let joints = ["LHand", "RHand"].map(|name| {
-        let names = text.split("\"human_joints\":[").nth(1).unwrap().split(']').next().unwrap();
-        (names.split(',')).position(|n| n == format!("\"{name}\"")).unwrap()
+        let names = text
+            .split("\"human_joints\":[")
+            .nth(1)
+            .unwrap()
+            .split(']')
+            .next()
+            .unwrap();
+        (names.split(','))
+            .position(|n| n == format!("\"{name}\""))
+            .unwrap()
     });
     let frames: Vec<Value> = text.lines().filter_map(frame).collect();
     let errors: Vec<f64> = (frames.iter())

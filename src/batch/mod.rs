@@ -657,6 +657,13 @@ pub fn metrics_value(m: &ImitationMetrics, clip: &Path) -> Value {
         },
         "tracking_error_clip_lag_removed": effector_map(&m.hands_clip_lag_removed),
         "hand_lag_s": m.hand_lag_s,
+        "hand_timing": m.hand_timing().map(|t| json!({
+            "lag_s": t.lag_s,
+            "error_m": t.error_m,
+            "lag_removed_error_m": t.lag_removed_error_m,
+            "removed_share": t.removed_share(),
+            "late": t.late(),
+        })),
         "hand_reach": m.hand_reach.map(|arms| {
             let arm = |r: &crate::imitation::reach::HandReach| json!({
                 "reach_m": r.reach_m,

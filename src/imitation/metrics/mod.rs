@@ -50,7 +50,8 @@ use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 use crate::imitation::imitator::Imitator;
 use crate::imitation::metrics::clearance::{ClearanceMeter, SelfClearance};
 use crate::imitation::metrics::travel::{
-    FootTiming, HandTrace, Stance, StepCounter, StepFollowing, Travel, TravelRecorder, robot_stance,
+    FootTiming, HandTiming, HandTrace, Stance, StepCounter, StepFollowing, Travel, TravelRecorder,
+    robot_stance,
 };
 use crate::imitation::output::RobotFrame;
 use crate::imitation::phase::{SupportKind, SupportPhase};
@@ -188,7 +189,8 @@ pub struct ImitationMetrics {
     /// Hand errors over the clip's frames once the best time shift is removed (`l_hand`,
     /// `r_hand`).
     pub hands_clip_lag_removed: Vec<EffectorError>,
-    /// The time shift (s) that best aligns the robot's hands with the scaled reference.
+    /// The time shift (s) that best aligns the robot's hands with the scaled reference; see
+    /// [`ImitationMetrics::hand_timing`] for whether it means the robot is late.
     pub hand_lag_s: f64,
     /// Over the clip's frames, how far the hand references lay beyond the arms' reach from the
     /// robot's shoulders (`[left, right]`; [`crate::imitation::reach`]); `None` when the profile maps no
@@ -227,6 +229,27 @@ pub struct ImitationMetrics {
     pub walking: Option<WalkingSummary>,
     /// How the robot followed the human's steps; `None` when the human never stepped.
     pub following: Option<StepFollowing>,
+}
+
+impl ImitationMetrics {
+    /// The hand lag with the hands' mean error over the clip without and with it removed (both
+    /// hands, every phase that tracks them): whether the robot is late
+    /// ([`HandTiming::late`]); `None` when no hand was tracked.
+    pub fn hand_timing(&self) -> Option<HandTiming> {
+        let pooled = |errors: &[EffectorError]| {
+            let hands = errors.iter().filter(|e| e.name.ends_with("hand"));
+            let cells = hands.flat_map(|e| [e.single_support, e.double_support, e.transitions]);
+            let (sum, count) = cells.fold((0.0, 0), |(s, n), c| {
+                (s + c.mean * c.count as f64, n + c.count)
+            });
+            (count > 0).then(|| sum / count as f64)
+        };
+        Some(HandTiming {
+            lag_s: self.hand_lag_s,
+            error_m: pooled(&self.effectors_clip)?,
+            lag_removed_error_m: pooled(&self.hands_clip_lag_removed)?,
+        })
+    }
 }
 
 /// Accumulates [`ImitationMetrics`] frame by frame.

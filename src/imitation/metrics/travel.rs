@@ -280,6 +280,42 @@ fn pair(human: &[Vec<f64>; 2], robot: &[Vec<f64>; 2]) -> Lags {
     (lags, human.iter().map(Vec::len).sum())
 }
 
+/// The shortest shift (s) [`HandTiming`] calls late.
+pub const LATE_LAG: f64 = 0.1;
+/// The least share of the hands' error a shift must remove for [`HandTiming`] to call the
+/// robot late: below it the error barely depends on timing, and the best shift is whichever
+/// small wobble the search found.
+pub const LATE_SHARE: f64 = 0.25;
+
+/// What the hand lag means: whether the robot's hands follow the human's path late, or are
+/// off for another reason (out of reach, at a joint limit, a robot standing where the human
+/// no longer is), for which no time shift helps and the best shift says nothing.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HandTiming {
+    /// The best time shift (s, 0 … [`MAX_LAG`]).
+    pub lag_s: f64,
+    /// The hands' mean error over the clip without a shift (m).
+    pub error_m: f64,
+    /// ... and with the best shift removed (m).
+    pub lag_removed_error_m: f64,
+}
+
+impl HandTiming {
+    /// The share of the error the shift removes (0–1; 0 when there is no error).
+    pub fn removed_share(&self) -> f64 {
+        match self.error_m > 0.0 {
+            true => (1.0 - self.lag_removed_error_m / self.error_m).clamp(0.0, 1.0),
+            false => 0.0,
+        }
+    }
+
+    /// Whether the robot is late: the shift is at least [`LATE_LAG`] and removes at least
+    /// [`LATE_SHARE`] of the error.
+    pub fn late(&self) -> bool {
+        self.lag_s >= LATE_LAG && self.removed_share() >= LATE_SHARE
+    }
+}
+
 /// Most lags (frames) the hand-lag search tries: [`MAX_LAG`] at up to 500 frames per second.
 const LAG_CAPACITY: usize = 1024;
 
@@ -496,6 +532,26 @@ mod tests {
             s.record(off, t);
         }
         assert_eq!(s.steps(), 1);
+    }
+
+    /// A shift that removes 3 of 4 cm is lateness; one that removes 0.5 of 4 cm (12.5 %) is
+    /// not, however long; a short one never is.
+    #[test]
+    fn hand_timing_calls_late_only_a_shift_that_removes_the_error() {
+        let timing = |lag_s, lag_removed_error_m| HandTiming {
+            lag_s,
+            error_m: 0.04,
+            lag_removed_error_m,
+        };
+        assert!((timing(0.5, 0.01).removed_share() - 0.75).abs() < 1e-12);
+        assert!(timing(0.5, 0.01).late());
+        assert!(!timing(1.5, 0.035).late());
+        assert!(!timing(0.05, 0.01).late());
+        let none = HandTiming {
+            error_m: 0.0,
+            ..timing(0.3, 0.0)
+        };
+        assert_eq!(none.removed_share(), 0.0);
     }
 
     #[test]
