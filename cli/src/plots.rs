@@ -2,7 +2,8 @@
 //! two whenever [`MAX_SAMPLES`] is reached) and written as SVG at the end:
 //!
 //! * `effectors.svg`: each hand's and ankle's distance to the scaled human (cm) over time, the
-//!   robot's phases shaded;
+//!   robot's phases shaded; beside each hand's, dashed, the part no arm posture within the
+//!   joint limits removes (the reach report's least error, over the clip's frames);
 //! * `com.svg`: the CoM ground path seen from above inside the footprints (each placement once);
 //! * `phases.svg`: the human's support and the robot's phase over time;
 //! * `joints.svg`: the right arm's joint angles against their limits.
@@ -38,6 +39,8 @@ type SupportOf = fn(&Sample) -> Option<usize>;
 struct Sample {
     time: f64,
     errors: [Option<f64>; 4],
+    /// The part of each hand's error no arm posture removes (m, `[left, right]`).
+    least: [Option<f64>; 2],
     phase: SupportPhase,
     human: HumanSupport,
     com: [f64; 2],
@@ -82,7 +85,9 @@ impl PlotRecorder {
         }
     }
 
-    pub(crate) fn record(&mut self, r: &RobotFrame) {
+    /// Records `r`, with `least` the part of each hand's error no arm posture removes (m,
+    /// `[left, right]`; `None` where unknown).
+    pub(crate) fn record(&mut self, r: &RobotFrame, least: [Option<f64>; 2]) {
         self.record_footprints(r);
         self.seen += 1;
         if !(self.seen - 1).is_multiple_of(self.stride) {
@@ -95,6 +100,7 @@ impl PlotRecorder {
         self.samples.push(Sample {
             time: r.time,
             errors,
+            least,
             phase: r.phase,
             human: r.human_support,
             com: [r.com.x, r.com.y],
@@ -184,6 +190,7 @@ impl PlotRecorder {
                 ("CoM step", COM_STEP_COLOR, false),
                 ("lift / lower", FOOT_STEP_COLOR, false),
                 ("distance", TRACE_COLOR, false),
+                ("no arm posture removes", TRACE_COLOR, true),
             ],
         );
         let x = self.time_range();
@@ -208,6 +215,12 @@ impl PlotRecorder {
                 .map(|s| s.errors[e].map(|v| axes.point(s.time, v * 100.0)))
                 .collect();
             svg.path(&points, TRACE_COLOR, 1.5, false);
+            if let Some(hand) = (e < 2).then_some(e) {
+                let least: Vec<_> = (self.samples.iter())
+                    .map(|s| s.least[hand].map(|v| axes.point(s.time, v * 100.0)))
+                    .collect();
+                svg.path(&least, TRACE_COLOR, 1.0, true);
+            }
         }
         svg.finish()
     }

@@ -11,10 +11,10 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use serde_json::json;
-use taskstack::batch::{ClipSession, ClipSetup, Hold, imitate_clip, metrics_json};
+use taskstack::batch::{ClipSession, ClipSetup, Hold, imitate_clip_measured, metrics_json};
 use taskstack::export::JointsWriter;
 use taskstack::export::{MotionRecorder, MotionTrack, write_motion_npz, write_unitree_csv};
-use taskstack::imitation::metrics::ImitationMetrics;
+use taskstack::imitation::metrics::{ImitationMetrics, MetricsRecorder};
 use taskstack::robots::BipedProfile;
 use taskstack::{Imitator, ImitatorConfig, RobotFrame};
 
@@ -116,7 +116,7 @@ fn run_staged(
     let mut written: Result<()> = Ok(());
     let mut done = 0u64;
     let mut first_time = None;
-    let each = |frame: &RobotFrame| {
+    let each = |frame: &RobotFrame, measured: &MetricsRecorder| {
         first_time.get_or_insert(frame.time);
         if written.is_ok() {
             written = joints
@@ -125,13 +125,13 @@ fn run_staged(
                 .and_then(|()| view.frame(frame))
                 .and_then(|()| Ok(motion.record(frame)?));
         }
-        plots.record(frame);
+        plots.record(frame, measured.last_least_hand_errors());
         done += 1;
         if done.is_multiple_of(32) {
             progress(Progress::Frames(done));
         }
     };
-    let metrics = imitate_clip(
+    let metrics = imitate_clip_measured(
         clip,
         session.into_clip(),
         &mut imitator,

@@ -156,7 +156,10 @@ fn imitate_writes_every_output_and_reports_clip_and_hold_apart() {
     let timing = &metrics["hand_timing"];
     assert_eq!(timing["lag_s"], metrics["hand_lag_s"]);
     let (error, removed) = (&timing["error_m"], &timing["lag_removed_error_m"]);
-    assert!(removed.as_f64().unwrap() <= error.as_f64().unwrap(), "{timing}");
+    assert!(
+        removed.as_f64().unwrap() <= error.as_f64().unwrap(),
+        "{timing}"
+    );
     let told = format!(
         "best aligned {:.2} s later, which takes their mean error from {} to {} cm",
         timing["lag_s"].as_f64().unwrap(),
@@ -164,6 +167,12 @@ fn imitate_writes_every_output_and_reports_clip_and_hold_apart() {
         cm(removed)
     );
     assert!(run.stdout.contains(&told), "{told}\n{}", run.stdout);
+    // effectors.svg draws, beside each hand's distance, the part no arm posture removes: one
+    // dashed path per hand besides the legend's swatch.
+    let plot = std::fs::read_to_string(out.join("effectors.svg")).unwrap();
+    assert!(plot.contains("no arm posture removes"));
+    let dashed = plot.matches("stroke-dasharray").count();
+    assert_eq!(dashed, 3, "legend swatch and two hands");
 }
 
 #[test]

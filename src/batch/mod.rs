@@ -422,10 +422,27 @@ pub fn hold_frames(hold: f64) -> u64 {
 /// naming the frame.
 pub fn imitate_clip(
     path: &Path,
-    mut source: Clip,
+    source: Clip,
     imitator: &mut Imitator,
     hold: impl Into<Hold>,
     mut each: impl FnMut(&RobotFrame),
+) -> Result<ImitationMetrics, BatchError> {
+    imitate_clip_measured(path, source, imitator, hold, |frame, _| each(frame))
+}
+
+/// [`imitate_clip`], calling `each` with every robot frame and the metrics recorded so far
+/// (that frame's included): for outputs that show a frame's metrics as the run goes, such as
+/// the part of each hand's error no arm posture removes
+/// ([`MetricsRecorder::last_least_hand_errors`]).
+///
+/// # Errors
+/// As [`imitate_clip`].
+pub fn imitate_clip_measured(
+    path: &Path,
+    mut source: Clip,
+    imitator: &mut Imitator,
+    hold: impl Into<Hold>,
+    mut each: impl FnMut(&RobotFrame, &MetricsRecorder),
 ) -> Result<ImitationMetrics, BatchError> {
     let hold = hold.into().validated()?;
     let settle = SETTLE_TIME + imitator.profile().sway_period.unwrap_or(0.0);
@@ -477,7 +494,7 @@ pub fn imitate_clip(
             0
         };
         recorder.record(robot);
-        each(robot);
+        each(robot, &recorder);
     }
     Ok(recorder.finish())
 }

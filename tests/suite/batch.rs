@@ -563,3 +563,37 @@ fn nao_clip_metrics_with(
     let json = metrics_value(&m, &path);
     (m, json)
 }
+
+/// `imitate_clip_measured` shows each frame the metrics so far: the part of each hand's error
+/// no arm posture removes is known on the clip's frames, never above the hand's own error that
+/// frame (the search only lowers it), and unknown during the hold.
+#[test]
+fn each_clip_frame_knows_the_hands_least_error() {
+    use taskstack::batch::{Hold, imitate_clip_measured};
+    use taskstack::imitation::{EFFECTORS, Imitator, ImitatorConfig};
+    use taskstack::io::clip::Clip;
+
+    let path = mocap(SHORT[0]);
+    let mut imitator = Imitator::new(nao::profile(), ImitatorConfig::default()).unwrap();
+    let (mut known, mut searched, mut holding_known) = (0, 0, 0);
+    let clip = Clip::open(&path).unwrap();
+    let metrics = imitate_clip_measured(&path, clip, &mut imitator, Hold::Fixed(0.5), |f, m| {
+        let least = m.last_least_hand_errors();
+        if f.time > m.finish().clip_duration + 1e-9 {
+            holding_known += least.iter().flatten().count();
+            return;
+        }
+        for (k, least) in least.iter().enumerate() {
+            let Some(least) = *least else { continue };
+            let joint = EFFECTORS[k].1;
+            let error = (f.effectors[k] - f.reference[joint.index()].unwrap()).norm();
+            assert!(least <= error + 1e-9, "t = {}: {least} > {error}", f.time);
+            known += 1;
+            searched += usize::from(least < error - 1e-3);
+        }
+    })
+    .unwrap();
+    assert!(known >= metrics.clip_frames, "{known} of {}", metrics.clip_frames);
+    assert!(searched > 0, "some frame's error is partly removable");
+    assert_eq!(holding_known, 0);
+}

@@ -412,6 +412,16 @@ impl MetricsRecorder {
         self.travel.mark_clip_end(self.last_time);
     }
 
+    /// The last recorded clip frame's least hand errors (`[left, right]`, m; see
+    /// [`ReachMeter::last_least_errors`]); `None` for a hand without a reference, for every hand
+    /// after the clip's end and on a profile that maps no hands.
+    pub fn last_least_hand_errors(&self) -> [Option<f64>; 2] {
+        match (&self.reach, self.travel.clip_ended()) {
+            (Some(reach), false) => reach.last_least_errors(),
+            _ => [None; 2],
+        }
+    }
+
     /// Records one frame, as returned by [`Imitator::step`].
     pub fn record(&mut self, frame: &RobotFrame) {
         self.record_tracking(frame);

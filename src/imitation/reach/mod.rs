@@ -344,6 +344,8 @@ pub struct ReachMeter {
     postures: [ArmPostures; 2],
     apart: KeptApart,
     tallies: [Tally; 2],
+    /// The last recorded frame's least error per hand (m; `None` without a reference).
+    last_least: [Option<f64>; 2],
 }
 
 /// The profile's self-collision pairs, and the distance each must keep in a searched posture:
@@ -420,6 +422,7 @@ impl ReachMeter {
             },
             model,
             tallies: [Tally::default(); 2],
+            last_least: [None; 2],
         })
     }
 
@@ -433,7 +436,9 @@ impl ReachMeter {
             postures,
             apart,
             tallies,
+            last_least,
         } = self;
+        *last_least = [None; 2];
         if model.forward_kinematics(data, &frame.q).is_err() {
             return;
         }
@@ -474,12 +479,20 @@ impl ReachMeter {
                     .map_or(error, |found| found.min(error)),
                 false => error,
             };
+            last_least[k] = Some(least);
             let tally = &mut tallies[k];
             tally.error_sum += error;
             tally.least_sum += least;
             tally.least_max = tally.least_max.max(least);
             tally.posture_unreachable += usize::from(least > POSTURE_UNREACHABLE);
         }
+    }
+
+    /// The last recorded frame's least hand errors (`[left, right]`, m): the part of each
+    /// hand's error no arm posture within the limits removes (its error itself when below
+    /// the search's threshold); `None` for a hand without a reference.
+    pub fn last_least_errors(&self) -> [Option<f64>; 2] {
+        self.last_least
     }
 
     /// The reach of both hands (`[left, right]`) over the frames recorded.
