@@ -113,7 +113,7 @@ pub(crate) struct ImitationOptions {
     /// included) inside the support polygon and the floor's vertical moment on the feet below
     /// what friction holds, so faster hands are held back only when they would tip the robot
     /// or turn a foot. The hands then move at the robot profile's balanced speeds (NAO 1 m/s,
-    /// 10 m/s², in every phase; the G1 keeps its own) unless --tracking-speed and
+    /// 5 m/s², in every phase; the G1 keeps its own) unless --tracking-speed and
     /// --tracking-acceleration say otherwise.
     #[arg(long)]
     pub(crate) zmp_balance: bool,

@@ -137,7 +137,7 @@ def imitate_clip(
             ``--zmp-balance``): the ZMP of the CoM and the arms' acceleration stays in the
             support polygon and their vertical moment below what friction holds, so faster
             hands do not tip the robot or turn a loaded foot; the hands then move at the
-            robot's balanced speeds (NAO 1 m/s, 10 m/s²) unless ``tracking_speed`` and
+            robot's balanced speeds (NAO 1 m/s, 5 m/s²) unless ``tracking_speed`` and
             ``tracking_acceleration`` are given.
         damping: the solver's damping of near-singular levels (the CLI's ``--damping``;
             default: the robot's, NAO 0.02, G1 0.039).

@@ -593,7 +593,11 @@ fn each_clip_frame_knows_the_hands_least_error() {
         }
     })
     .unwrap();
-    assert!(known >= metrics.clip_frames, "{known} of {}", metrics.clip_frames);
+    assert!(
+        known >= metrics.clip_frames,
+        "{known} of {}",
+        metrics.clip_frames
+    );
     assert!(searched > 0, "some frame's error is partly removable");
     assert_eq!(holding_known, 0);
 }

@@ -107,11 +107,11 @@ fn the_scaling_rules_keep_the_invariants_they_state() {
         low.scaled(&from, &to).single_support_lowering / to.hip_height,
         0.01 / from.hip_height
     );
-    // The hands' speeds (under the ZMP level too: the NAO's 1 m/s and 10 m/s²) and the damping
+    // The hands' speeds (under the ZMP level too: the NAO's 1 m/s and 5 m/s²) and the damping
     // per arm length.
     let (ha, hb) = (a.balanced_hands.unwrap(), b.balanced_hands.unwrap());
     assert_relative_eq!(ha.tracking_speed, 1.0);
-    assert_relative_eq!(ha.tracking_acceleration, 10.0);
+    assert_relative_eq!(ha.tracking_acceleration, 5.0);
     for (v, w) in [
         (a.tracking_speed, b.tracking_speed),
         (a.stance_tracking_speed, b.stance_tracking_speed),

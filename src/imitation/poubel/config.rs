@@ -78,7 +78,7 @@ pub struct PoubelConfig {
     /// acceleration (from the model's masses and inertias) inside the support polygon and the
     /// arms' vertical moment on the feet below what friction holds; the hands then move at the
     /// profile's [`MotionTuning::balanced_hands`] speeds where it has them (the NAO: 1 m/s,
-    /// 10 m/s²; not in a dynamic walk) unless [`ImitatorConfig::max_tracking_speed`](crate::imitation::ImitatorConfig::max_tracking_speed) /
+    /// 5 m/s²; not in a dynamic walk) unless [`ImitatorConfig::max_tracking_speed`](crate::imitation::ImitatorConfig::max_tracking_speed) /
     /// [`ImitatorConfig::max_tracking_acceleration`](crate::imitation::ImitatorConfig::max_tracking_acceleration) say otherwise. Default `false`. With
     /// hands at 1 m/s (10 m/s²), the level is what keeps the arms' reaction from turning the
     /// NAO's loaded feet in the physics judge (CMU 131_01 without it: 2.3–2.8°); at 1.5 m/s
