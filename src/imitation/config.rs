@@ -182,13 +182,7 @@ impl ImitatorConfig {
                 "must be finite and > 0",
             ),
         ];
-        for (name, value, reason) in positive {
-            if let Some(v) = value
-                && !(v.is_finite() && v > 0.0)
-            {
-                return invalid(name, v, reason);
-            }
-        }
+        ImitationError::check_positive(&positive)?;
         if let Some((name, value)) = self.motion.and_then(|m| m.invalid_field()) {
             return invalid(name, value, "motion limits must be finite and > 0");
         }

@@ -68,3 +68,21 @@ pub enum ImitationError {
         previous: f64,
     },
 }
+
+impl ImitationError {
+    /// The first of `settings` (`(name, value, reason)`, in order) that is set and not finite
+    /// and > 0, as [`ImitationError::InvalidParameter`]; unset ones are the defaults.
+    pub(crate) fn check_positive(
+        settings: &[(&'static str, Option<f64>, &'static str)],
+    ) -> Result<(), Self> {
+        let bad = |&(name, value, reason): &(&'static str, Option<f64>, &'static str)| {
+            let value = value.filter(|v| !(v.is_finite() && *v > 0.0))?;
+            Some(ImitationError::InvalidParameter {
+                name,
+                value,
+                reason,
+            })
+        };
+        settings.iter().find_map(bad).map_or(Ok(()), Err)
+    }
+}

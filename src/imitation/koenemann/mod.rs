@@ -198,13 +198,12 @@ impl KoenemannConfig {
             ));
         }
         let positive = [
-            ("koenemann.damping", self.damping),
-            ("koenemann.tolerance", self.tolerance),
-            ("koenemann.swing_speed", self.swing_speed.unwrap_or(1.0)),
+            ("koenemann.damping", Some(self.damping)),
+            ("koenemann.tolerance", Some(self.tolerance)),
+            ("koenemann.swing_speed", self.swing_speed),
         ];
-        if let Some((name, v)) = positive
-            .into_iter()
-            .find(|(_, v)| !(v.is_finite() && *v > 0.0))
+        if let Some((name, v)) = (positive.into_iter())
+            .find_map(|(name, v)| Some((name, v.filter(|v| !(v.is_finite() && *v > 0.0))?)))
         {
             return Some((name, v, "must be finite and > 0"));
         }

@@ -150,13 +150,7 @@ impl PoubelConfig {
             ),
             ("poubel.damping", self.damping, "must be finite and > 0"),
         ];
-        for (name, value, reason) in positive {
-            if let Some(v) = value
-                && !(v.is_finite() && v > 0.0)
-            {
-                return invalid(name, v, reason);
-            }
-        }
+        ImitationError::check_positive(&positive)?;
         if let Some((name, value)) = self.footsteps.invalid_field() {
             return invalid(name, value, "must be >= 0");
         }
