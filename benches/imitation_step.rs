@@ -153,7 +153,7 @@ fn zmp_balance(c: &mut Criterion) {
     let frames = frames("cmu_05_02_stand_arm_gestures_turn_single_leg.bvh");
     let config = ImitatorConfig {
         method: ImitationMethod::Poubel(PoubelConfig {
-            zmp_balance: true,
+            zmp_balance: Some(true),
             ..PoubelConfig::default()
         }),
         max_tracking_speed: Some(1.0),

@@ -94,7 +94,7 @@ def imitate_clip(
     step_heading: Optional[float] = None,
     step_pivot: Optional[float] = None,
     step_slide: Optional[float] = None,
-    zmp_balance: bool = False,
+    zmp_balance: Optional[bool] = None,
     damping: Optional[float] = None,
     damping_momentum: float = 0.0,
     offline: bool = False,
@@ -133,12 +133,14 @@ def imitate_clip(
             0.05: a standing human's foot jitters by up to 12° and 3.2 cm in the bundled
             captures).
         step_slide: see ``step_pivot``.
-        zmp_balance: experimental, balance that sees the arms' dynamics (the CLI's
-            ``--zmp-balance``): the ZMP of the CoM and the arms' acceleration stays in the
-            support polygon and their vertical moment below what friction holds, so faster
+        zmp_balance: balance that sees the arms' dynamics (the CLI's ``--zmp-balance`` /
+            ``--no-zmp-balance``): the ZMP of the CoM and the arms' acceleration stays in the
+            support polygon and their vertical moment below what friction holds, so fast
             hands do not tip the robot or turn a loaded foot; the hands then move at the
             robot's balanced speeds (NAO 1 m/s, 5 m/s²) unless ``tracking_speed`` and
-            ``tracking_acceleration`` are given.
+            ``tracking_acceleration`` are given. ``None`` (default): on for a robot with
+            balanced hand speeds (the NAO) unless ``dynamic_walk``; ``False``: the old, slower
+            arms.
         damping: the solver's damping of near-singular levels (the CLI's ``--damping``;
             default: the robot's, NAO 0.02, G1 0.039).
         damping_momentum: share in [0, 1] of the last frame's joint step a damped level

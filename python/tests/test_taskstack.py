@@ -81,8 +81,8 @@ def cli_joints(clip: Path, out: Path, *args: str):
         (
             KINECT,
             "nao",
-            ["--hold", "0", "--zmp-balance", "--tracking-speed", "1.0"],
-            {"hold": 0, "zmp_balance": True, "tracking_speed": 1.0},
+            ["--hold", "0", "--no-zmp-balance", "--tracking-speed", "1.0"],
+            {"hold": 0, "zmp_balance": False, "tracking_speed": 1.0},
         ),
         (
             KINECT,

@@ -204,7 +204,7 @@ impl ImitatorConfig {
     }
 
     /// Poubel et al.'s settings, if that is the method: to change one in place
-    /// (`config.poubel_mut().map(|p| p.zmp_balance = true)`).
+    /// (`config.poubel_mut().map(|p| p.zmp_balance = Some(false))`).
     pub fn poubel_mut(&mut self) -> Option<&mut PoubelConfig> {
         match &mut self.method {
             ImitationMethod::Poubel(poubel) => Some(poubel),

@@ -335,7 +335,7 @@ fn dynamic_walk_step_does_not_allocate_after_warm_up() {
 #[test]
 fn zmp_balance_step_does_not_allocate_after_warm_up() {
     let config = ImitatorConfig::from(PoubelConfig {
-        zmp_balance: true,
+        zmp_balance: Some(true),
         ..PoubelConfig::default()
     });
     assert_no_allocation_after_warm_up(Imitator::new(nao::profile(), config).unwrap(), &SHORT);
@@ -346,7 +346,7 @@ fn zmp_balance_step_does_not_allocate_after_warm_up() {
 #[test]
 fn damping_momentum_step_does_not_allocate_after_warm_up() {
     let config = ImitatorConfig::from(PoubelConfig {
-        zmp_balance: true,
+        zmp_balance: Some(true),
         damping_momentum: 0.8,
         damping: Some(0.1),
         ..PoubelConfig::default()

@@ -79,12 +79,18 @@ pub struct PoubelConfig {
     /// arms' vertical moment on the feet below what friction holds; the hands then move at the
     /// profile's [`MotionTuning::balanced_hands`] speeds where it has them (the NAO: 1 m/s,
     /// 5 m/s²; not in a dynamic walk) unless [`ImitatorConfig::max_tracking_speed`](crate::imitation::ImitatorConfig::max_tracking_speed) /
-    /// [`ImitatorConfig::max_tracking_acceleration`](crate::imitation::ImitatorConfig::max_tracking_acceleration) say otherwise. Default `false`. With
-    /// hands at 1 m/s (10 m/s²), the level is what keeps the arms' reaction from turning the
-    /// NAO's loaded feet in the physics judge (CMU 131_01 without it: 2.3–2.8°); at 1.5 m/s
-    /// and 20 m/s² it no longer does. The price at 1 m/s: the arms turn back at speed on 4–86
-    /// frames a clip (0–14 at the default speeds) and the step is slower.
-    pub zmp_balance: bool,
+    /// [`ImitatorConfig::max_tracking_acceleration`](crate::imitation::ImitatorConfig::max_tracking_acceleration) say otherwise.
+    ///
+    /// `None` (default): on where [`PoubelConfig::zmp_balance_on`] says it is measured to help
+    /// (a profile with balanced hands, the robot not walking dynamically, no hand supports);
+    /// `Some(false)`: the old, slower arms (fixed caps chosen for the static check; the
+    /// hands 1–3 cm farther from the human on the clips where the arms move fast, a
+    /// tenth of a second or more late), for comparison or a robot whose masses are not known
+    /// well. With hands at 1 m/s (10 m/s²), the level is what keeps the arms' reaction from
+    /// turning the NAO's loaded feet in the physics judge (CMU 131_01 without it: 2.3–2.8°);
+    /// at 1.5 m/s and 20 m/s² it no longer does. The price at 1 m/s: the arms turn back at
+    /// speed on 4–86 frames a clip (0–14 at the default speeds) and the step is slower.
+    pub zmp_balance: Option<bool>,
     /// Hands as supports, from a recording's contact list (see
     /// [`crate::imitation::poubel::hand_support`]). `None` (default): the hands only follow
     /// the human.
@@ -107,7 +113,7 @@ impl Default for PoubelConfig {
             solver: Settings::default(),
             damping: None,
             damping_momentum: 0.0,
-            zmp_balance: false,
+            zmp_balance: None,
             hand_supports: None,
             look_ahead: None,
         }
@@ -115,6 +121,21 @@ impl Default for PoubelConfig {
 }
 
 impl PoubelConfig {
+    /// Whether the ZMP level is on for a robot of `tuning`: [`PoubelConfig::zmp_balance`], or
+    /// by default where the judge measured it to help: the profile has
+    /// [`MotionTuning::balanced_hands`] (their masses and speeds measured together: the NAO),
+    /// the robot does not follow the human's steps dynamically (the level models a robot
+    /// standing in place; in a dynamic walk it turned a loaded NAO foot 2.5–4.0° on CMU 09_12
+    /// and let the weak model's ZMP leave the soles on 05_12) and the hands are no supports
+    /// (its polygon is the feet's; with the hands on a stool the weak model's ZMP left it).
+    pub fn zmp_balance_on(&self, tuning: &MotionTuning) -> bool {
+        self.zmp_balance.unwrap_or_else(|| {
+            tuning.balanced_hands.is_some()
+                && !(self.footsteps.follow && self.footsteps.dynamic)
+                && self.hand_supports.is_none()
+        })
+    }
+
     /// `solver` with the damping of [`PoubelConfig::damping`], or `tuning`'s.
     pub(super) fn solver_for(&self, tuning: &MotionTuning) -> Settings {
         let damping = self.damping.unwrap_or(tuning.damping);

@@ -131,6 +131,7 @@ impl PoubelImitator {
         config: &ImitatorConfig,
         mut method: PoubelConfig,
     ) -> Result<Self, ImitationError> {
+        method.zmp_balance = Some(method.zmp_balance_on(&profile.tuning));
         let (tables, hands) = tables_and_hands(&mut method, &profile);
         // Position limits only matter to the limit-avoidance gradient and the start clamp.
         let (mut shared, position_bounds) = Shared::new(profile, config)?;

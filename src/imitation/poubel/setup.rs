@@ -83,7 +83,7 @@ pub(super) fn tables_and_hands(
     if hands.is_some() {
         tables.add_hand_supports(profile);
     }
-    if config.zmp_balance {
+    if config.zmp_balance_on(&profile.tuning) {
         tables.add_zmp_balance(profile);
     }
     (tables, hands)
@@ -145,7 +145,7 @@ pub(super) fn hand_speed(
                 ..speed
             }
         }
-        false => config.hand_speed_for(tuning, method.zmp_balance),
+        false => config.hand_speed_for(tuning, method.zmp_balance_on(tuning)),
     }
 }
 
