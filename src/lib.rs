@@ -110,6 +110,7 @@ pub mod export;
 pub mod human;
 pub mod imitation;
 pub mod io;
+pub mod live;
 pub mod locomotion;
 pub mod model;
 pub mod problem;

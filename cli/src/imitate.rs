@@ -141,7 +141,7 @@ pub(crate) fn run(args: ImitateArgs, report: Report) -> Result<ExitCode> {
 /// The run's summary for the terminal, one line per concern: the clip and the hold, the hand
 /// supports, the support changes, the tracking, the balance and limits, the travel and steps,
 /// the solve time, the files written.
-fn print_summary(
+pub(crate) fn print_summary(
     text: &mut String,
     m: &ImitationMetrics,
     clip: &Path,

@@ -8,10 +8,12 @@ mod check;
 mod contacts;
 mod fk;
 mod imitate;
+mod live;
 mod options;
 mod plots;
 mod run;
 mod solve;
+mod stream;
 mod svg;
 mod view;
 mod walk;
@@ -43,7 +45,9 @@ enum Command {
     Check(check::CheckArgs),
     Contacts(contacts::ContactsArgs),
     Fk(fk::FkArgs),
+    Live(live::LiveArgs),
     Solve(solve::SolveArgs),
+    Stream(stream::StreamArgs),
     View(view::ViewArgs),
     Walk(walk::WalkArgs),
 }
@@ -81,7 +85,9 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
         Command::Fk(args) => fk::run(args),
+        Command::Live(args) => live::run(args, report),
         Command::Solve(args) => solve::run(args, report),
+        Command::Stream(args) => stream::run(args, report),
         Command::View(args) => view::run(args, report),
         Command::Walk(args) => walk::run(args, report),
     };

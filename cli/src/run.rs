@@ -6,7 +6,7 @@
 //! folder holds either the complete outputs of one run or those of an earlier one.
 
 use std::fs::File;
-use std::io::BufWriter;
+use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
@@ -15,6 +15,7 @@ use taskstack::batch::{ClipSession, ClipSetup, Hold, imitate_clip_measured, metr
 use taskstack::export::JointsWriter;
 use taskstack::export::{MotionRecorder, MotionTrack, write_motion_npz, write_unitree_csv};
 use taskstack::imitation::metrics::{ImitationMetrics, MetricsRecorder};
+use taskstack::io::FrameSource;
 use taskstack::robots::BipedProfile;
 use taskstack::{Imitator, ImitatorConfig, RobotFrame};
 
@@ -78,10 +79,39 @@ pub(crate) fn imitate_into(
     progress(Progress::Start(
         session.clip().declared_frames().map(|n| n + hold_frames),
     ));
+    let config = session.config(&settings.config)?;
+    let mut run = Run {
+        name: clip,
+        config,
+        settings,
+        commands: None,
+    };
+    staged_run(out, |staged| {
+        let metrics = run.imitate(session.into_clip(), staged, progress)?;
+        staged.write("metrics.json", metrics_json(&metrics, clip))?;
+        Ok(metrics)
+    })
+}
+
+/// One run: its name (the clip's path; a live session's input), its imitator settings and a
+/// second `joints.csv` stream of the commands as they come (a live session's).
+pub(crate) struct Run<'a> {
+    pub(crate) name: &'a Path,
+    pub(crate) config: ImitatorConfig,
+    pub(crate) settings: &'a Settings,
+    pub(crate) commands: Option<&'a mut dyn Write>,
+}
+
+/// Runs `imitate` into the output folder `out` (created if needed) with its files staged:
+/// committed when it succeeds, discarded when it fails.
+pub(crate) fn staged_run(
+    out: &Path,
+    imitate: impl FnOnce(&mut Staged) -> Result<ImitationMetrics>,
+) -> Result<ImitationMetrics> {
     std::fs::create_dir_all(out)
         .with_context(|| format!("output folder {}: cannot create it", out.display()))?;
     let mut staged = Staged::new(out);
-    let result = run_staged(clip, session, &mut staged, settings, progress);
+    let result = imitate(&mut staged);
     match result {
         Ok(metrics) => staged.commit().map(|()| metrics),
         Err(err) => {
@@ -91,72 +121,73 @@ pub(crate) fn imitate_into(
     }
 }
 
-/// The run itself, every file written through `staged`.
-fn run_staged(
-    clip: &Path,
-    session: ClipSession,
-    staged: &mut Staged,
-    settings: &Settings,
-    progress: &mut dyn FnMut(Progress),
-) -> Result<ImitationMetrics> {
-    let mut joints = JointsWriter::new(staged.create("joints.csv")?);
-    let view_file = staged.create("view.html")?;
-    let config = session.config(&settings.config)?;
-    let mut imitator = Imitator::new(settings.profile.clone(), config)
-        .with_context(|| format!("robot {}", settings.profile.name))?;
-    let title = clip
-        .file_stem()
-        .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
-    let mut view = ViewWriter::new(view_file, imitator.profile(), &title)?;
-    let mut plots = PlotRecorder::new(&imitator);
-    let mut motion = MotionRecorder::new(&imitator)?;
-    joints.header(&imitator)?;
+impl Run<'_> {
+    /// The run itself, every file but `metrics.json` written through `staged`.
+    pub(crate) fn imitate(
+        &mut self,
+        source: impl FrameSource,
+        staged: &mut Staged,
+        progress: &mut dyn FnMut(Progress),
+    ) -> Result<ImitationMetrics> {
+        let settings = self.settings;
+        let mut joints = JointsWriter::new(staged.create("joints.csv")?);
+        let view_file = staged.create("view.html")?;
+        let mut imitator = Imitator::new(settings.profile.clone(), self.config.clone())
+            .with_context(|| format!("robot {}", settings.profile.name))?;
+        let title =
+            (self.name.file_stem()).map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+        let mut view = ViewWriter::new(view_file, imitator.profile(), &title)?;
+        let mut plots = PlotRecorder::new(&imitator);
+        let mut motion = MotionRecorder::new(&imitator)?;
+        joints.header(&imitator)?;
+        let mut commands = self.commands.as_mut().map(|w| JointsWriter::new(&mut **w));
+        if let Some(commands) = commands.as_mut() {
+            commands.header(&imitator).context("the commands' output")?;
+        }
 
-    // Writing errors stop the outputs, not the loop; they are reported after it.
-    let mut written: Result<()> = Ok(());
-    let mut done = 0u64;
-    let mut first_time = None;
-    let each = |frame: &RobotFrame, measured: &MetricsRecorder| {
-        first_time.get_or_insert(frame.time);
-        if written.is_ok() {
-            written = joints
-                .frame(frame)
-                .map_err(anyhow::Error::from)
-                .and_then(|()| view.frame(frame))
-                .and_then(|()| Ok(motion.record(frame)?));
+        // Writing errors stop the outputs, not the loop; they are reported after it.
+        let mut written: Result<()> = Ok(());
+        let mut done = 0u64;
+        let mut first_time = None;
+        let each = |frame: &RobotFrame, measured: &MetricsRecorder| {
+            first_time.get_or_insert(frame.time);
+            if written.is_ok() {
+                written = joints
+                    .frame(frame)
+                    .map_err(anyhow::Error::from)
+                    .and_then(|()| view.frame(frame))
+                    .and_then(|()| Ok(motion.record(frame)?));
+            }
+            // A live consumer that goes away does not stop the session.
+            if let Some(out) = commands.as_mut() {
+                let _ = out.frame(frame);
+            }
+            plots.record(frame, measured.last_least_hand_errors());
+            done += 1;
+            if done.is_multiple_of(32) {
+                progress(Progress::Frames(done));
+            }
+        };
+        let metrics = imitate_clip_measured(self.name, source, &mut imitator, settings.hold, each)?;
+        progress(Progress::Frames(done));
+        let in_folder = || format!("output folder {}", staged.out.display());
+        written.with_context(in_folder)?;
+        joints.finish().with_context(in_folder)?;
+        let clip_end = first_time.unwrap_or(0.0) + metrics.clip_duration;
+        let summary = json!({ "frames": metrics.frames, "clip_frames": metrics.clip_frames,
+                              "robot_support_sequence": metrics.robot_support_sequence });
+        view.finish(clip_end, summary).with_context(in_folder)?;
+        write_exports(
+            staged,
+            &motion.finish(),
+            metrics.clip_frames,
+            settings.exports,
+        )?;
+        for (name, svg) in plots.render(&title) {
+            staged.write(name, svg)?;
         }
-        plots.record(frame, measured.last_least_hand_errors());
-        done += 1;
-        if done.is_multiple_of(32) {
-            progress(Progress::Frames(done));
-        }
-    };
-    let metrics = imitate_clip_measured(
-        clip,
-        session.into_clip(),
-        &mut imitator,
-        settings.hold,
-        each,
-    )?;
-    progress(Progress::Frames(done));
-    let in_folder = || format!("output folder {}", staged.out.display());
-    written.with_context(in_folder)?;
-    joints.finish().with_context(in_folder)?;
-    let clip_end = first_time.unwrap_or(0.0) + metrics.clip_duration;
-    let summary = json!({ "frames": metrics.frames, "clip_frames": metrics.clip_frames,
-                          "robot_support_sequence": metrics.robot_support_sequence });
-    view.finish(clip_end, summary).with_context(in_folder)?;
-    write_exports(
-        staged,
-        &motion.finish(),
-        metrics.clip_frames,
-        settings.exports,
-    )?;
-    staged.write("metrics.json", metrics_json(&metrics, clip))?;
-    for (name, svg) in plots.render(&title) {
-        staged.write(name, svg)?;
+        Ok(metrics)
     }
-    Ok(metrics)
 }
 
 /// `motion.npz`, and the Unitree CSV when asked, of `track` (the clip its first
@@ -183,7 +214,7 @@ fn write_exports(
 }
 
 /// The files of one run, written as `NAME.partial` until [`Staged::commit`].
-struct Staged {
+pub(crate) struct Staged {
     out: PathBuf,
     names: Vec<String>,
 }
@@ -210,7 +241,7 @@ impl Staged {
     }
 
     /// A new staged file `name` holding `text`.
-    fn write(&mut self, name: &str, text: String) -> Result<()> {
+    pub(crate) fn write(&mut self, name: &str, text: String) -> Result<()> {
         std::fs::write(self.partial(name), text).with_context(|| {
             format!("output folder {}: cannot write {name}", self.out.display())
         })?;

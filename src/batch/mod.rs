@@ -33,7 +33,8 @@ use crate::imitation::metrics::{
 use crate::imitation::poubel::hand_support::HandSupportError;
 use crate::imitation::walking::look_ahead::LookAheadError;
 use crate::imitation::{ImitationError, Imitator, ImitatorConfig, RobotFrame};
-use crate::io::clip::{Clip, ClipError};
+use crate::io::FrameSource;
+use crate::io::clip::ClipError;
 use crate::robots::{BipedProfile, nao};
 
 mod session;
@@ -136,7 +137,7 @@ pub struct BatchOptions {
     /// Worker threads; 0 means one per core. Ignored (always 1) without the `parallel` feature.
     pub threads: usize,
     /// Imitator settings shared by every clip, except `support`, which each clip replaces by the
-    /// defaults of its kind of source ([`SupportConfig::for_capture`](crate::imitation::reference::support::SupportConfig::for_capture) of [`Clip::capture`]: optical mocap or Kinect).
+    /// defaults of its kind of source ([`SupportConfig::for_capture`](crate::imitation::reference::support::SupportConfig::for_capture) of [`Clip::capture`](crate::io::clip::Clip::capture): optical mocap or Kinect).
     pub imitator: ImitatorConfig,
     /// After each clip, the human's last pose is held (frames 1/120 s apart) so that the robot
     /// can finish the step it is taking; those frames are in the outputs too. Default: until
@@ -422,7 +423,7 @@ pub fn hold_frames(hold: f64) -> u64 {
 /// naming the frame.
 pub fn imitate_clip(
     path: &Path,
-    source: Clip,
+    source: impl FrameSource,
     imitator: &mut Imitator,
     hold: impl Into<Hold>,
     mut each: impl FnMut(&RobotFrame),
@@ -439,7 +440,7 @@ pub fn imitate_clip(
 /// As [`imitate_clip`].
 pub fn imitate_clip_measured(
     path: &Path,
-    mut source: Clip,
+    mut source: impl FrameSource,
     imitator: &mut Imitator,
     hold: impl Into<Hold>,
     mut each: impl FnMut(&RobotFrame, &MetricsRecorder),

@@ -11,7 +11,8 @@ use std::path::Path;
 
 use thiserror::Error;
 
-use super::bvh::{BvhConfig, BvhError, BvhReader, CMU_MB_NAMES};
+use super::FrameSource;
+use super::bvh::{BvhConfig, BvhError, BvhReader, BvhSkeleton, CMU_MB_NAMES};
 use super::kinect::{KinectConfig, KinectError, KinectReader};
 use super::skeleton_map::SkeletonMap;
 use crate::human::{CaptureSystem, HumanFrame};
@@ -25,6 +26,15 @@ pub enum ClipError {
     /// From the Kinect reader.
     #[error(transparent)]
     Kinect(#[from] KinectError),
+    /// A stream of frames could not be read (a socket or standard input failed).
+    #[error("{origin}: {source}")]
+    Stream {
+        /// The stream (`tcp://ADDR`, `udp://ADDR`, `stdin`).
+        origin: String,
+        /// The failure.
+        #[source]
+        source: std::io::Error,
+    },
 }
 
 #[derive(Debug)]
@@ -60,11 +70,7 @@ impl Clip {
             });
         }
         let mut reader = BvhReader::open(path, BvhConfig::cmu())?;
-        let skeleton = reader.skeleton();
-        let motion_builder = CMU_MB_NAMES
-            .iter()
-            .all(|(name, _)| skeleton.index_of(name).is_some());
-        if motion_builder {
+        if leads_with_t_pose(reader.skeleton()) {
             let mut t_pose = HumanFrame::new(0.0);
             reader.read_frame(&mut t_pose)?;
         }
@@ -148,6 +154,20 @@ impl Clip {
                 None => false,
             },
         })
+    }
+}
+
+/// Whether a BVH clip of `skeleton` begins with a synthetic T-pose frame: the CMU
+/// MotionBuilder-friendly release's skeletons (CMU-MB names) do (see the module docs).
+pub(crate) fn leads_with_t_pose(skeleton: &BvhSkeleton) -> bool {
+    CMU_MB_NAMES
+        .iter()
+        .all(|(name, _)| skeleton.index_of(name).is_some())
+}
+
+impl FrameSource for Clip {
+    fn read_frame(&mut self, out: &mut HumanFrame) -> Result<bool, ClipError> {
+        Clip::read_frame(self, out)
     }
 }
 

@@ -234,6 +234,33 @@ impl<R: BufRead> KinectReader<R> {
                 Some(false) => break,
             }
         }
+        self.decode_current(out).map(|()| true)
+    }
+
+    /// Decodes `line`, one frame line received from elsewhere (a stream of Kinect frames), into
+    /// `out` as the next frame: the reader's own source is not read. Unlike
+    /// [`KinectReader::read_frame`], an error leaves the reader usable: the line is skipped
+    /// and the next one must still not go back in time.
+    ///
+    /// # Errors
+    /// [`KinectError::FieldCount`], [`KinectError::Value`], [`KinectError::TimeGoesBack`] or
+    /// [`KinectError::LineTooLong`] for the line, numbered as the reader's lines.
+    pub fn decode_line(&mut self, line: &str, out: &mut HumanFrame) -> Result<(), KinectError> {
+        self.line_no += 1;
+        if line.len() > self.config.max_line_bytes {
+            return Err(KinectError::LineTooLong {
+                origin: self.origin.clone(),
+                line: self.line_no,
+                limit: self.config.max_line_bytes,
+            });
+        }
+        self.line.clear();
+        self.line.push_str(line);
+        self.decode_current(out)
+    }
+
+    /// Decodes the line in `self.line` into `out`.
+    fn decode_current(&mut self, out: &mut HumanFrame) -> Result<(), KinectError> {
         let line = self.line.trim();
         let line = line.strip_suffix(',').unwrap_or(line);
         let found = line.split(',').count();
@@ -283,7 +310,7 @@ impl<R: BufRead> KinectReader<R> {
         self.first_timestamp = Some(first);
         self.previous_timestamp = timestamp;
         out.derive_mid_hip();
-        Ok(true)
+        Ok(())
     }
 
     /// Parses the field `(index, text)` as a finite number; `what` describes it for errors.

@@ -13,6 +13,25 @@ use std::io::{self, BufRead, Read};
 
 use crate::human::HumanFrame;
 
+/// A source of human frames, one at a time, in time order: a clip file ([`clip::Clip`]) or a
+/// live stream ([`crate::live::LiveSource`]). The imitation's clip loop
+/// ([`crate::batch::imitate_clip`]) reads either.
+pub trait FrameSource {
+    /// Reads the next frame into `out`; `Ok(false)` at the end.
+    ///
+    /// # Errors
+    /// The source's read error, naming where.
+    fn read_frame(&mut self, out: &mut HumanFrame) -> Result<bool, clip::ClipError>;
+}
+
+/// A source lent to the clip loop stays the caller's, to be asked afterwards (a live
+/// session's counts).
+impl<S: FrameSource + ?Sized> FrameSource for &mut S {
+    fn read_frame(&mut self, out: &mut HumanFrame) -> Result<bool, clip::ClipError> {
+        (**self).read_frame(out)
+    }
+}
+
 /// The iterator item of a reader with `read_frame(&mut HumanFrame) -> Result<bool, E>`: the next
 /// frame, `None` at the end, or the error.
 fn next_frame<E>(
@@ -29,7 +48,7 @@ fn next_frame<E>(
 /// Reads one line (without its `\n` / `\r\n`) into `buf`, reading at most `max_bytes` bytes.
 /// Returns `Ok(None)` at end of input and `Ok(Some(true))` if the line was longer than
 /// `max_bytes` (the rest of it is left unread). Invalid UTF-8 is an `InvalidData` error.
-fn read_line_capped<R: BufRead>(
+pub(crate) fn read_line_capped<R: BufRead>(
     reader: &mut R,
     buf: &mut String,
     max_bytes: usize,

@@ -132,36 +132,56 @@ impl<R: BufRead> BvhReader<R> {
             self.done = true;
             return Ok(false);
         }
-        // Frame counts in real files are far below 2^53, so the conversion is exact.
-        let time = self.frames_read as f64 * self.frame_time;
-        let result = self
-            .read_values()
-            .and_then(|()| self.forward_kinematics())
-            .and_then(|()| {
-                if time.is_finite() {
-                    Ok(())
-                } else {
-                    Err(BvhError::Number {
-                        origin: self.origin.clone(),
-                        line: self.line_no,
-                        field: "frame time × frame index".to_owned(),
-                        text: time.to_string(),
-                    })
-                }
-            });
+        let result = self.read_values().and_then(|()| self.frame_of_values(out));
         if result.is_err() {
             self.done = true;
         }
-        result?;
+        result.map(|()| true)
+    }
+
+    /// Decodes `line`, one motion line received from elsewhere (a stream of the same
+    /// skeleton's frames), into `out` as the next frame: the reader's own source is not read.
+    /// Unlike [`BvhReader::read_frame`], an error leaves the reader usable (the line is
+    /// skipped: the next line gets its frame index) and the header's frame count is not a
+    /// limit.
+    ///
+    /// # Errors
+    /// [`BvhError::FrameValueCount`], [`BvhError::Number`], [`BvhError::NonFinitePosition`]
+    /// or [`BvhError::Limit`] for the line, numbered as the reader's lines.
+    pub fn decode_line(&mut self, line: &str, out: &mut HumanFrame) -> Result<(), BvhError> {
+        self.line_no += 1;
+        if line.len() > self.max_line_bytes {
+            return Err(self.limit("line length in bytes", self.max_line_bytes));
+        }
+        self.line.clear();
+        self.line.push_str(line);
+        self.parse_values()?;
+        self.frame_of_values(out)
+    }
+
+    /// The frame of the values parsed last, into `out`, at time `frame index × frame time`.
+    fn frame_of_values(&mut self, out: &mut HumanFrame) -> Result<(), BvhError> {
+        // Frame counts in real files are far below 2^53, so the conversion is exact.
+        let time = self.frames_read as f64 * self.frame_time;
+        self.forward_kinematics()?;
+        if !time.is_finite() {
+            return Err(BvhError::Number {
+                origin: self.origin.clone(),
+                line: self.line_no,
+                field: "frame time × frame index".to_owned(),
+                text: time.to_string(),
+            });
+        }
         out.clear(time);
         for joint in HumanJoint::ALL {
             out.set(joint, self.map[joint.index()].map(|j| self.positions[j]));
         }
         out.derive_mid_hip();
         self.frames_read += 1;
-        Ok(true)
+        Ok(())
     }
 
+    /// Reads the next motion line and parses it into `self.values`.
     fn read_values(&mut self) -> Result<(), BvhError> {
         loop {
             self.line_no += 1;
@@ -185,6 +205,11 @@ impl<R: BufRead> BvhReader<R> {
                 Some(false) => break,
             }
         }
+        self.parse_values()
+    }
+
+    /// Parses the motion line in `self.line` into `self.values`.
+    fn parse_values(&mut self) -> Result<(), BvhError> {
         let expected = self.values.len();
         let mut found = 0;
         for token in self.line.split_ascii_whitespace() {
