@@ -11,7 +11,7 @@ fn every_subcommand_explains_its_options_and_outputs() {
     let top = taskstack(&["--help"]);
     assert_eq!(top.code, Some(0), "{}", top.stderr);
     for command in [
-        "imitate", "batch", "check", "contacts", "fk", "solve", "view", "walk",
+        "imitate", "batch", "check", "contacts", "fk", "live", "solve", "stream", "view", "walk",
     ] {
         assert!(
             top.stdout.contains(command),
@@ -64,6 +64,22 @@ fn every_subcommand_explains_its_options_and_outputs() {
         ),
         ("view", &["OUT_DIR", "--no-open"][..]),
         ("contacts", &["--scene", "--knees", "seconds", "metres"][..]),
+        (
+            "live",
+            &[
+                "--listen",
+                "--connect",
+                "--udp",
+                "--bvh-header",
+                "--print",
+                "--send",
+                "Ctrl-C",
+            ][..],
+        ),
+        (
+            "stream",
+            &["--to", "--udp", "--speed", "--malformed", "--pause"][..],
+        ),
     ] {
         let help = taskstack(&[command, "--help"]);
         assert_eq!(help.code, Some(0), "{command} --help");

@@ -125,9 +125,8 @@ impl LineDecoder {
                     *in_header = true;
                 }
                 if !*in_header {
-                    let result = reader.decode_line(line, out);
+                    reader.decode_line(line, out)?;
                     let t_pose = std::mem::take(t_pose_next);
-                    result?;
                     return Ok(if t_pose {
                         Decoded::Skipped
                     } else {

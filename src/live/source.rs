@@ -136,12 +136,12 @@ impl LiveSource {
                 return false;
             }
         }
-        self.place_in_time(&mut frame);
+        let shifted = self.place_in_time(&mut frame);
         if self.is_late(frame.time, at) {
             self.counts.stale += 1;
             return false;
         }
-        if !self.in_range(&frame) {
+        if !self.in_range(&frame, shifted) {
             self.counts.out_of_range += 1;
             return false;
         }
@@ -173,8 +173,9 @@ impl LiveSource {
     }
 
     /// Whether every joint of `frame` is within [`LiveConfig::max_reach`] of its pelvis and
-    /// the pelvis moved no faster than [`LiveConfig::max_speed`] since the last frame.
-    fn in_range(&self, frame: &HumanFrame) -> bool {
+    /// the pelvis moved no faster than [`LiveConfig::max_speed`] since the last frame (unless
+    /// its time was `shifted`: a new stream may begin anywhere).
+    fn in_range(&self, frame: &HumanFrame, shifted: bool) -> bool {
         let Some(pelvis) = frame.get(HumanJoint::Pelvis) else {
             return true;
         };
@@ -182,11 +183,10 @@ impl LiveSource {
             .joints()
             .filter_map(|(_, p)| p)
             .all(|p| (p - pelvis).norm() <= self.config.max_reach);
-        let last = self
-            .last
+        let last = (self.last.filter(|_| !shifted))
             .and_then(|l| l.get(HumanJoint::Pelvis).map(|p| (l.time, p)));
         let slow = last.is_none_or(|(time, before)| {
-            let dt = (frame.time + self.offset - time).max(HOLD_STEP);
+            let dt = (frame.time - time).max(HOLD_STEP);
             (pelvis - before).norm() <= self.config.max_speed * dt
         });
         near && slow
@@ -194,16 +194,17 @@ impl LiveSource {
 
     /// Moves `frame`'s time after the last frame's: a stream's own time goes on unchanged,
     /// but one that restarts or stands still across a gap, or leaps more than
-    /// [`LiveConfig::max_time_step`] ahead, is shifted to one hold step after it.
-    fn place_in_time(&mut self, frame: &mut HumanFrame) {
-        if let Some(last) = self.last {
-            let time = frame.time + self.offset;
-            if time <= last.time || time > last.time + self.config.max_time_step {
-                self.offset = last.time + HOLD_STEP - frame.time;
-                self.counts.time_shifts += 1;
-            }
+    /// [`LiveConfig::max_time_step`] ahead, is shifted to one hold step after it (`true`).
+    fn place_in_time(&mut self, frame: &mut HumanFrame) -> bool {
+        let time = frame.time + self.offset;
+        let shift = (self.last)
+            .is_some_and(|last| time <= last.time || time > last.time + self.config.max_time_step);
+        if let (true, Some(last)) = (shift, self.last) {
+            self.offset = last.time + HOLD_STEP - frame.time;
+            self.counts.time_shifts += 1;
         }
         frame.time += self.offset;
+        shift
     }
 
     /// Gives `frame` out, remembering it (and whether the human stands on both feet in it).

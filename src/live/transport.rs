@@ -28,7 +28,7 @@ pub enum Received {
     /// The source went away; a TCP server waits for the next, a client reconnects.
     Disconnected,
     /// The session is over: standard input ended, the first source left a session that
-    /// serves one ([`Input::once`]), or the user stopped it.
+    /// serves one (`once` of [`Input::open`]), or the user stopped it.
     End,
     /// The input failed and cannot go on (a port that cannot be bound, standard input
     /// unreadable).

@@ -37,6 +37,7 @@ mod imitation_waist;
 mod io_bvh;
 mod io_kinect;
 mod io_skeleton_map;
+mod live;
 mod locomotion_alloc;
 mod locomotion_generator;
 mod locomotion_walker;
