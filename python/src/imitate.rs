@@ -64,7 +64,7 @@ pub(crate) struct Settings {
 impl Settings {
     /// The settings of the keyword arguments `kwargs` (the options of `taskstack imitate`,
     /// with its defaults); an unknown keyword is a `TypeError`, as Python's own are.
-    fn from_kwargs(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
+    pub(crate) fn from_kwargs(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
         let mut s = Settings {
             method: "poubel".into(),
             walk: false,
@@ -127,7 +127,7 @@ impl Settings {
 
     /// The robot named `robot` (see [`profile`]), its commands played through its sway
     /// shaper unless `sway_shaping` is off (the CLI's `--no-sway-shaping`).
-    fn profile(&self, robot: &str) -> PyResult<BipedProfile> {
+    pub(crate) fn profile(&self, robot: &str) -> PyResult<BipedProfile> {
         let mut profile = profile(robot)?;
         if !self.sway_shaping {
             profile.sway_period = None;
@@ -138,7 +138,7 @@ impl Settings {
     /// The imitator settings for a clip of `capture`: the shared ones here, the method's in
     /// [`Settings::poubel`] and [`Settings::koenemann`]; a keyword of the other method is a
     /// `ValueError`.
-    fn config(&self, capture: CaptureSystem) -> PyResult<ImitatorConfig> {
+    pub(crate) fn config(&self, capture: CaptureSystem) -> PyResult<ImitatorConfig> {
         let (method, others) = match self.method.as_str() {
             "poubel" => (
                 ImitationMethod::Poubel(self.poubel()?),
@@ -563,7 +563,7 @@ impl PyImitator {
 }
 
 /// A robot frame as a dict (see the Python docstring of `Imitator.step`).
-fn robot_frame_dict<'py>(
+pub(crate) fn robot_frame_dict<'py>(
     py: Python<'py>,
     frame: &RobotFrame,
     root_pos: [f64; 3],

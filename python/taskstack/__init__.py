@@ -27,12 +27,13 @@ from typing import Any, Dict, List, Optional, Union
 
 import numpy as np
 
-from ._taskstack import Imitator, Model, Task, TaskSet, __version__, read_clip
+from ._taskstack import Imitator, LiveSession, Model, Task, TaskSet, __version__, read_clip
 from ._taskstack import imitate_clip as _imitate_clip
 
 __all__ = [
     "ImitationResult",
     "Imitator",
+    "LiveSession",
     "Model",
     "Task",
     "TaskSet",

@@ -161,3 +161,41 @@ class TaskSet:
         ``q`` (rad). Returns ``q`` (nv), ``task_errors`` (per task, m or rad), ``iterations``,
         ``stop`` ("converged", "stalled" or "iteration_limit")."""
         ...
+
+class LiveSession:
+    """A live session (the CLI's ``taskstack live``): human frames streamed in, one frame a
+    line, imitated as each arrives; iterate it for the robot frames (the dicts of
+    ``Imitator.step``) until the stream ends (the thread that made it only)."""
+
+    def __init__(
+        self,
+        listen: Optional[str] = None,
+        connect: Optional[str] = None,
+        udp: Optional[str] = None,
+        robot: str = "nao",
+        bvh_header: Optional[str] = None,
+        once: bool = False,
+        end_after: Optional[float] = None,
+        **options: Any,
+    ) -> None:
+        """Exactly one input, ``"HOST:PORT"``: ``listen`` (a TCP server, one source at a time),
+        ``connect`` (a TCP client that reconnects) or ``udp``. The lines: a BVH header then
+        motion lines (or ``bvh_header``, a BVH file whose header the stream's lines follow), or
+        Kinect v2 CSV lines; the first line tells which. ``once``: end when the first TCP source
+        leaves; ``end_after``: end after this long without a frame (s). ``options``: those of
+        ``Imitator``. Waits for the stream's first line (Python threads run meanwhile). Faults
+        are counted (``counts``) and bridged as ``taskstack.live`` documents: malformed lines
+        skipped, a gap held, a long gap brings the robot back onto both feet. Raises ValueError
+        for bad options or a malformed header, OSError for an address that cannot be bound."""
+        ...
+    @property
+    def joint_names(self) -> List[str]:
+        """The robot's joint names, in the order of ``q``."""
+        ...
+    @property
+    def counts(self) -> Dict[str, int]:
+        """frames, malformed, out_of_range, stale, gaps, held_frames, stands, connections,
+        disconnects, time_shifts."""
+        ...
+    def __iter__(self) -> "LiveSession": ...
+    def __next__(self) -> Dict[str, Any]: ...

@@ -227,6 +227,37 @@ def test_a_live_imitator_fed_a_clip_frame_by_frame_gives_the_clips_run():
     assert np.array_equal(again.step(times[0], first)["q"], qs[0])
 
 
+def test_a_live_session_fed_over_tcp_gives_the_clips_run():
+    import socket
+    import threading
+
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    lines = KINECT.read_text().splitlines(keepends=True)
+
+    def source():
+        # The session binds when it is made; a refused connection is tried again.
+        for _ in range(200):
+            try:
+                with socket.create_connection(("127.0.0.1", port)) as s:
+                    s.sendall(b"not a frame\n" + "".join(lines).encode())
+                return
+            except ConnectionRefusedError:
+                threading.Event().wait(0.01)
+
+    sender = threading.Thread(target=source)
+    sender.start()
+    session = taskstack.LiveSession(listen=f"127.0.0.1:{port}", once=True)
+    qs = [frame["q"] for frame in session]
+    sender.join()
+    batch = taskstack.imitate_clip(KINECT, hold=0)
+    assert np.array_equal(np.array(qs), batch.q)
+    assert session.counts["frames"] == len(qs) and session.counts["malformed"] == 1
+    with pytest.raises(ValueError):
+        taskstack.LiveSession(listen="127.0.0.1:1", udp="127.0.0.1:2")
+
+
 def test_model_fk_gives_the_cli_fk_numbers():
     model = taskstack.Model.nao("r_sole")
     rng = np.random.default_rng(7)
