@@ -16,6 +16,7 @@ use taskstack::live::{LiveConfig, LiveCounts, LiveSource};
 
 use crate::Report;
 use crate::imitate::print_summary;
+use crate::live_view::LiveView;
 use crate::options::{ImitationOptions, UsageError};
 use crate::run::{Progress, Run, Settings, output_files, staged_run};
 
@@ -70,6 +71,11 @@ pub(crate) struct LiveArgs {
     /// Send each command line to udp:HOST:PORT (one datagram a line) or tcp:HOST:PORT.
     #[arg(long, value_name = "udp:HOST:PORT|tcp:HOST:PORT")]
     send: Option<String>,
+    /// Serve a live view at HOST:PORT: open http://HOST:PORT/ in a browser to watch the robot
+    /// and the human as the frames arrive (the view.html page, fed over a WebSocket; a page
+    /// opened late first gets the last 30 s).
+    #[arg(long, value_name = "HOST:PORT")]
+    view: Option<String>,
     /// Output folder (created if needed). Default: taskstack-out/live.
     #[arg(long, short, value_name = "DIR")]
     out: Option<PathBuf>,
@@ -99,6 +105,9 @@ pub(crate) fn run(args: LiveArgs, report: Report) -> Result<ExitCode> {
     };
     let mut commands = commands_output(args.print, args.send.as_deref())?;
     let origin = input.origin();
+    let mut view = (args.view.as_deref())
+        .map(|address| LiveView::serve(address, &settings.profile, &origin))
+        .transpose()?;
     let (arrivals, sender) = (input.open(args.once)).with_context(|| origin.clone())?;
     stop_on_ctrl_c(sender);
     let config = LiveConfig {
@@ -117,11 +126,18 @@ pub(crate) fn run(args: LiveArgs, report: Report) -> Result<ExitCode> {
             support: SupportConfig::for_capture(source.capture()),
             ..settings.config.clone()
         };
+        // A page that cannot be sent a frame does not stop the session.
+        let mut show = |frame: &taskstack::RobotFrame| {
+            if let Some(view) = view.as_mut() {
+                let _ = view.frame(frame);
+            }
+        };
         let mut run = Run {
             name: &name,
             config,
             settings: &settings,
             commands: commands.as_mut().map(|w| &mut **w as &mut dyn Write),
+            on_frame: Some(&mut show),
         };
         let metrics = run.imitate(&mut source, staged, &mut |_: Progress| {})?;
         counts = *source.counts();

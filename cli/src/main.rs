@@ -9,6 +9,7 @@ mod contacts;
 mod fk;
 mod imitate;
 mod live;
+mod live_view;
 mod options;
 mod plots;
 mod run;

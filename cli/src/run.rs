@@ -85,6 +85,7 @@ pub(crate) fn imitate_into(
         config,
         settings,
         commands: None,
+        on_frame: None,
     };
     staged_run(out, |staged| {
         let metrics = run.imitate(session.into_clip(), staged, progress)?;
@@ -93,13 +94,15 @@ pub(crate) fn imitate_into(
     })
 }
 
-/// One run: its name (the clip's path; a live session's input), its imitator settings and a
-/// second `joints.csv` stream of the commands as they come (a live session's).
+/// One run: its name (the clip's path; a live session's input), its imitator settings, a
+/// second `joints.csv` stream of the commands as they come and what else sees each frame (a
+/// live session's view).
 pub(crate) struct Run<'a> {
     pub(crate) name: &'a Path,
     pub(crate) config: ImitatorConfig,
     pub(crate) settings: &'a Settings,
     pub(crate) commands: Option<&'a mut dyn Write>,
+    pub(crate) on_frame: Option<&'a mut dyn FnMut(&RobotFrame)>,
 }
 
 /// Runs `imitate` into the output folder `out` (created if needed) with its files staged:
@@ -161,6 +164,9 @@ impl Run<'_> {
             // A live consumer that goes away does not stop the session.
             if let Some(out) = commands.as_mut() {
                 let _ = out.frame(frame);
+            }
+            if let Some(on_frame) = self.on_frame.as_mut() {
+                on_frame(frame);
             }
             plots.record(frame, measured.last_least_hand_errors());
             done += 1;

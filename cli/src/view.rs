@@ -235,6 +235,25 @@ impl<W: Write> ViewWriter<W> {
     }
 }
 
+impl ViewWriter<Vec<u8>> {
+    /// What was written since the last call: the page's head at first, then each frame's line
+    /// (empty when the frame was not due).
+    pub(crate) fn take_written(&mut self) -> Vec<u8> {
+        std::mem::take(&mut self.out)
+    }
+
+    /// The live page of a view whose head (the template up to the frames, the run's data
+    /// included) is `head`: no frames of its own, `LIVE` set, so that its script takes them
+    /// from the WebSocket it opens.
+    pub(crate) fn live_page(head: &str) -> Result<String> {
+        let (_, rest) = split_template()?;
+        let tail = json!({ "clip_end_ms": 1e12, "summary": null, "frames": 0 });
+        Ok(format!(
+            "{head}];\nconst TAIL = {tail};\nconst LIVE = true;\n{rest}"
+        ))
+    }
+}
+
 /// One frame of a run for the viewer: what [`ViewWriter::frame_of`] draws besides the human.
 pub(crate) struct ViewFrame<'a> {
     /// The run's clock (s).

@@ -33,6 +33,49 @@ fn browser() -> Option<PathBuf> {
     })
 }
 
+/// `taskstack live --view`: the page served over HTTP draws the frames the session pushes over
+/// its WebSocket (a page opened after the frames first gets the session's backlog).
+#[test]
+fn the_live_view_follows_a_session_in_a_headless_browser() {
+    let Some(browser) = browser() else {
+        assert!(std::env::var_os("TASKSTACK_REQUIRE_BROWSER").is_none());
+        eprintln!("live view test skipped: no chromium, chromium-browser or google-chrome on PATH");
+        return;
+    };
+    let dir = temp_dir("live-view");
+    let port = |_| {
+        let listener = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+        listener.local_addr().unwrap().to_string()
+    };
+    let (frames, view) = (port(0), port(1));
+    let out = dir.join("live");
+    let mut session = Command::new(env!("CARGO_BIN_EXE_taskstack"))
+        .args([
+            "-q",
+            "live",
+            "--listen",
+            &frames,
+            "--view",
+            &view,
+            "--end-after",
+            "4",
+        ])
+        .args(["--hold", "0", "--out", s(&out)])
+        .spawn()
+        .expect("taskstack live starts");
+    let clip = common::clip(common::KINECT);
+    let sent = taskstack(&["-q", "stream", s(&clip), "--to", &frames, "--speed", "0"]);
+    assert_eq!(sent.code, Some(0), "{}", sent.stderr);
+    let report = selftest_at(&browser, &format!("http://{view}/#selftest=30"));
+    assert!(session.wait().unwrap().success());
+    assert_eq!(report["errors"], Value::Array(vec![]), "{report}");
+    assert_eq!(report["frames"], 30, "{report}");
+    let pixels = report["pixels"].as_f64().unwrap();
+    for drawn in report["drawn"].as_array().unwrap() {
+        assert!(drawn.as_f64().unwrap() > 0.01 * pixels, "{report}");
+    }
+}
+
 #[test]
 fn the_viewer_draws_and_plays_in_a_headless_browser() {
     let Some(browser) = browser() else {
@@ -231,6 +274,11 @@ fn draws_more_than_stripped(
 /// Loads `page` with `#selftest` in the headless `browser` and returns the page's report; the
 /// browser's log must hold no uncaught error.
 fn selftest(browser: &PathBuf, page: &std::path::Path) -> Value {
+    selftest_at(browser, &format!("file://{}#selftest", s(page)))
+}
+
+/// [`selftest`] of the page at `url`.
+fn selftest_at(browser: &PathBuf, url: &str) -> Value {
     let profile = temp_dir("viewer-profile");
     let output = Command::new(browser)
         .args([
@@ -245,7 +293,7 @@ fn selftest(browser: &PathBuf, page: &std::path::Path) -> Value {
         ])
         .arg(format!("--user-data-dir={}", s(&profile)))
         .arg("--dump-dom")
-        .arg(format!("file://{}#selftest", s(page)))
+        .arg(url)
         .output()
         .expect("the browser runs");
     let dom = String::from_utf8_lossy(&output.stdout);
