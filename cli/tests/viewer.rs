@@ -57,8 +57,9 @@ fn the_live_view_follows_a_session_in_a_headless_browser() {
             &frames,
             "--view",
             &view,
+            // Long enough for a busy machine to start the browser after the frames.
             "--end-after",
-            "4",
+            "8",
         ])
         .args(["--hold", "0", "--out", s(&out)])
         .spawn()
