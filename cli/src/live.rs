@@ -7,9 +7,10 @@ use std::net::{TcpStream, UdpSocket};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use clap::Args;
 use serde_json::json;
+use taskstack::imitation::metrics::ImitationMetrics;
 use taskstack::imitation::reference::support::SupportConfig;
 use taskstack::live::transport::{Arrival, Input, Received};
 use taskstack::live::{LiveConfig, LiveCounts, LiveSource};
@@ -18,7 +19,7 @@ use crate::Report;
 use crate::imitate::print_summary;
 use crate::live_view::LiveView;
 use crate::options::{ImitationOptions, UsageError};
-use crate::run::{Progress, Run, Settings, output_files, staged_run};
+use crate::run::{Progress, Run, Settings, Staged, output_files, staged_run};
 
 /// Imitate a human streamed in as it moves: one frame a line, live.
 ///
@@ -84,15 +85,7 @@ pub(crate) struct LiveArgs {
 }
 
 pub(crate) fn run(args: LiveArgs, report: Report) -> Result<ExitCode> {
-    if args.options.skeleton.is_some() {
-        return Err(UsageError("--skeleton (a skeleton map) is not read by taskstack live: it reads CMU-named BVH skeletons and Kinect lines".to_owned()).into());
-    }
-    let input = match (&args.listen, &args.connect, &args.udp) {
-        (Some(a), _, _) => Input::TcpListen(a.clone()),
-        (_, Some(a), _) => Input::TcpConnect(a.clone()),
-        (_, _, Some(a)) => Input::Udp(a.clone()),
-        _ => Input::Stdin,
-    };
+    let input = input_of(&args)?;
     let header = (args.bvh_header.as_ref())
         .map(|path| bvh_header(path).with_context(|| format!("--bvh-header {}", path.display())))
         .transpose()?;
@@ -103,9 +96,12 @@ pub(crate) fn run(args: LiveArgs, report: Report) -> Result<ExitCode> {
         setup: Default::default(),
         exports: args.options.exports(),
     };
-    let mut commands = commands_output(args.print, args.send.as_deref())?;
+    let mut outputs = Outputs {
+        commands: commands_output(args.print, args.send.as_deref())?,
+        view: None,
+    };
     let origin = input.origin();
-    let mut view = (args.view.as_deref())
+    outputs.view = (args.view.as_deref())
         .map(|address| LiveView::serve(address, &settings.profile, &origin))
         .transpose()?;
     let (arrivals, sender) = (input.open(args.once)).with_context(|| origin.clone())?;
@@ -116,37 +112,11 @@ pub(crate) fn run(args: LiveArgs, report: Report) -> Result<ExitCode> {
     };
     let mut source = LiveSource::start(arrivals, header.as_deref(), &origin, config)?;
     let name = PathBuf::from(&origin);
-    let out = args
-        .out
-        .clone()
-        .unwrap_or_else(|| Path::new("taskstack-out").join("live"));
-    let mut counts = LiveCounts::default();
+    let out = (args.out.clone()).unwrap_or_else(|| Path::new("taskstack-out").join("live"));
     let metrics = staged_run(&out, |staged| {
-        let config = taskstack::ImitatorConfig {
-            support: SupportConfig::for_capture(source.capture()),
-            ..settings.config.clone()
-        };
-        // A page that cannot be sent a frame does not stop the session.
-        let mut show = |frame: &taskstack::RobotFrame| {
-            if let Some(view) = view.as_mut() {
-                let _ = view.frame(frame);
-            }
-        };
-        let mut run = Run {
-            name: &name,
-            config,
-            settings: &settings,
-            commands: commands.as_mut().map(|w| &mut **w as &mut dyn Write),
-            on_frame: Some(&mut show),
-        };
-        let metrics = run.imitate(&mut source, staged, &mut |_: Progress| {})?;
-        counts = *source.counts();
-        let mut value = taskstack::batch::metrics_value(&metrics, &name);
-        value["live"] = counts.to_json();
-        let text = serde_json::to_string_pretty(&value).unwrap_or_default() + "\n";
-        staged.write("metrics.json", text)?;
-        Ok(metrics)
+        imitate_session(&mut source, &name, &settings, &mut outputs, staged)
     })?;
+    let counts = *source.counts();
     let mut text = String::new();
     if report.json {
         let value = json!({
@@ -165,18 +135,67 @@ pub(crate) fn run(args: LiveArgs, report: Report) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// The header of the BVH file at `path`: its lines up to and including `Frame Time:`.
+/// The input of the options (standard input by default).
+fn input_of(args: &LiveArgs) -> Result<Input> {
+    if args.options.skeleton.is_some() {
+        let why = "it reads CMU-named BVH skeletons and Kinect lines";
+        return Err(UsageError(format!(
+            "--skeleton (a skeleton map) is not read by taskstack live: {why}"
+        ))
+        .into());
+    }
+    Ok(match (&args.listen, &args.connect, &args.udp) {
+        (Some(a), _, _) => Input::TcpListen(a.clone()),
+        (_, Some(a), _) => Input::TcpConnect(a.clone()),
+        (_, _, Some(a)) => Input::Udp(a.clone()),
+        _ => Input::Stdin,
+    })
+}
+
+/// Where a session's frames go as they come, besides its files.
+struct Outputs {
+    commands: Option<Box<dyn Write>>,
+    view: Option<LiveView>,
+}
+
+/// The session's run into `staged`, `metrics.json` with the stream's counts.
+fn imitate_session(
+    source: &mut LiveSource,
+    name: &Path,
+    settings: &Settings,
+    outputs: &mut Outputs,
+    staged: &mut Staged,
+) -> Result<ImitationMetrics> {
+    let config = taskstack::ImitatorConfig {
+        support: SupportConfig::for_capture(source.capture()),
+        ..settings.config.clone()
+    };
+    let view = &mut outputs.view;
+    // A page that cannot be sent a frame does not stop the session.
+    let mut show = |frame: &taskstack::RobotFrame| {
+        if let Some(view) = view.as_mut() {
+            let _ = view.frame(frame);
+        }
+    };
+    let mut run = Run {
+        name,
+        config,
+        settings,
+        commands: (outputs.commands.as_mut()).map(|w| &mut **w as &mut dyn Write),
+        on_frame: Some(&mut show),
+    };
+    let metrics = run.imitate(&mut *source, staged, &mut |_: Progress| {})?;
+    let mut value = taskstack::batch::metrics_value(&metrics, name);
+    value["live"] = source.counts().to_json();
+    let text = serde_json::to_string_pretty(&value).unwrap_or_default() + "\n";
+    staged.write("metrics.json", text)?;
+    Ok(metrics)
+}
+
+/// The header of the BVH file at `path`.
 fn bvh_header(path: &Path) -> Result<String> {
     let text = std::fs::read_to_string(path)?;
-    let mut header = String::new();
-    for line in text.lines() {
-        header.push_str(line);
-        header.push('\n');
-        if line.split_whitespace().next() == Some("Frame") {
-            return Ok(header);
-        }
-    }
-    bail!("no `Frame Time:` line: not a BVH file")
+    taskstack::live::bvh_header(&text).context("no `Frame Time:` line: not a BVH file")
 }
 
 /// Where the command lines go: standard output, a socket, both or neither.

@@ -52,7 +52,12 @@ impl PyLiveSession {
             _ => return Err(value_error("give exactly one of listen, connect, udp")),
         };
         let header = bvh_header
-            .map(|path| std::fs::read_to_string(Path::new(&path)).map(|text| header_of(&text)))
+            .map(|path| {
+                let text = std::fs::read_to_string(Path::new(&path))?;
+                taskstack::live::bvh_header(&text).ok_or_else(|| {
+                    value_error(format!("{path}: no `Frame Time:` line: not a BVH file"))
+                })
+            })
             .transpose()?;
         let settings = Settings::from_kwargs(options)?;
         let profile = settings.profile(robot)?;
@@ -124,17 +129,4 @@ impl PyLiveSession {
         let contacts = self.recorder.contacts(frame);
         robot_frame_dict(py, frame, root_pos, root_quat, contacts).map(Some)
     }
-}
-
-/// A BVH file's header: its lines up to and including `Frame Time:`.
-fn header_of(text: &str) -> String {
-    let mut header = String::new();
-    for line in text.lines() {
-        header.push_str(line);
-        header.push('\n');
-        if line.split_whitespace().next() == Some("Frame") {
-            break;
-        }
-    }
-    header
 }

@@ -144,6 +144,20 @@ impl LineDecoder {
     }
 }
 
+/// The header of the BVH text `text` (a file's, say): its lines up to and including the one
+/// that begins with `Frame` (`Frame Time:`); `None` without one.
+pub fn bvh_header(text: &str) -> Option<String> {
+    let mut header = String::new();
+    for line in text.lines() {
+        header.push_str(line);
+        header.push('\n');
+        if line.split_whitespace().next() == Some("Frame") {
+            return Some(header);
+        }
+    }
+    None
+}
+
 /// A BVH reader of the header text `header`, positioned at its end.
 fn bvh_reader(header: &str, origin: &str) -> Result<BvhReader<Cursor<Vec<u8>>>, ClipError> {
     let text = Cursor::new(header.as_bytes().to_vec());

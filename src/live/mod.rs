@@ -43,7 +43,7 @@ mod decoder;
 mod source;
 pub mod transport;
 
-pub use decoder::{Decoded, LineDecoder};
+pub use decoder::{Decoded, LineDecoder, bvh_header};
 pub use source::LiveSource;
 
 use serde_json::{Value, json};

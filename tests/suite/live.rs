@@ -31,6 +31,13 @@ fn lines(name: &str) -> Vec<String> {
         .collect()
 }
 
+/// The index of the first motion line of a BVH clip's `lines` (0 for a Kinect clip).
+fn header_end(lines: &[String]) -> usize {
+    (lines.iter())
+        .position(|l| l.starts_with("Frame Time"))
+        .map_or(0, |i| i + 1)
+}
+
 /// The clip file's frames, read by the clip reader.
 fn clip_frames(name: &str) -> Vec<HumanFrame> {
     Clip::open(format!("{DATA}{name}"))
@@ -87,10 +94,7 @@ fn a_streamed_clip_gives_the_files_frames() {
 fn malformed_lines_are_counted_and_skipped() {
     for name in [BVH, KINECT] {
         let lines = lines(name);
-        let header = lines
-            .iter()
-            .position(|l| l.starts_with("Frame Time"))
-            .map_or(0, |i| i + 1);
+        let header = header_end(&lines);
         let bad = ["garbage", "1 2 3", "NaN,1,2", "1e999 0 0", "\u{fffd}"];
         let mut mixed: Vec<String> = lines[..header].to_vec();
         let per_frame = 10_000 / (lines.len() - header) + 1;
@@ -145,11 +149,7 @@ fn a_gap_holds_the_last_frame_then_the_standing_pose() {
         ..LiveConfig::default()
     };
     let lines = lines(BVH);
-    let header = lines
-        .iter()
-        .position(|l| l.starts_with("Frame Time"))
-        .unwrap()
-        + 1;
+    let header = header_end(&lines);
     // The gap comes a quarter second into the human's stance on one leg.
     let mut detector =
         SupportDetector::new(SupportConfig::for_capture(CaptureSystem::Optical)).unwrap();
@@ -247,11 +247,7 @@ fn a_source_that_comes_back_goes_on_in_time() {
 #[test]
 fn a_burst_is_kept_and_late_frames_are_dropped() {
     let lines = lines(BVH);
-    let header = lines
-        .iter()
-        .position(|l| l.starts_with("Frame Time"))
-        .unwrap()
-        + 1;
+    let header = header_end(&lines);
     let (frames, source) = streamed(&lines[..header + 1001], LiveConfig::default());
     assert_eq!((frames.len(), source.counts().stale), (1000, 0));
 
@@ -304,11 +300,7 @@ fn a_stream_without_frames_or_with_a_bad_header_is_refused() {
 #[test]
 fn a_faulty_stream_is_imitated_within_the_limits() {
     let lines = lines(BVH);
-    let header = lines
-        .iter()
-        .position(|l| l.starts_with("Frame Time"))
-        .unwrap()
-        + 1;
+    let header = header_end(&lines);
     let (tx, rx) = channel();
     let sender = thread::spawn(move || {
         for (k, line) in lines.iter().enumerate() {
