@@ -92,21 +92,9 @@ impl PyLiveSession {
     /// What the session met so far (the CLI's `live` counts).
     #[getter]
     fn counts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let c = self.source.counts();
         let out = PyDict::new(py);
-        for (name, value) in [
-            ("frames", c.frames),
-            ("malformed", c.malformed),
-            ("out_of_range", c.out_of_range),
-            ("stale", c.stale),
-            ("gaps", c.gaps),
-            ("held_frames", c.held_frames),
-            ("stands", c.stands),
-            ("connections", c.connections),
-            ("disconnects", c.disconnects),
-            ("time_shifts", c.time_shifts),
-        ] {
-            out.set_item(name, value)?;
+        for (name, count) in self.source.counts().named() {
+            out.set_item(name, count)?;
         }
         Ok(out)
     }

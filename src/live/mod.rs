@@ -150,19 +150,27 @@ pub struct LiveCounts {
 }
 
 impl LiveCounts {
+    /// Each count with its name (as in `metrics.json`'s `live`), in the order of the fields.
+    pub fn named(&self) -> [(&'static str, u64); 10] {
+        [
+            ("frames", self.frames),
+            ("malformed", self.malformed),
+            ("out_of_range", self.out_of_range),
+            ("stale", self.stale),
+            ("gaps", self.gaps),
+            ("held_frames", self.held_frames),
+            ("stands", self.stands),
+            ("connections", self.connections),
+            ("disconnects", self.disconnects),
+            ("time_shifts", self.time_shifts),
+        ]
+    }
+
     /// The counts as JSON (`metrics.json`'s `live`).
     pub fn to_json(&self) -> Value {
-        json!({
-            "frames": self.frames,
-            "malformed": self.malformed,
-            "out_of_range": self.out_of_range,
-            "stale": self.stale,
-            "gaps": self.gaps,
-            "held_frames": self.held_frames,
-            "stands": self.stands,
-            "connections": self.connections,
-            "disconnects": self.disconnects,
-            "time_shifts": self.time_shifts,
-        })
+        let counts = self
+            .named()
+            .map(|(name, count)| (name.to_owned(), json!(count)));
+        Value::Object(counts.into_iter().collect())
     }
 }

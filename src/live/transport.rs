@@ -188,7 +188,10 @@ fn receive(socket: &UdpSocket, tx: &Sender<Arrival>) {
         let mut lines = BufReader::new(&buffer[..n]);
         let mut text = String::new();
         while let Ok(Some(_)) = read_line_capped(&mut lines, &mut text, MAX_LINE_BYTES) {
-            if tx.send(Arrival::now(Received::Line(text.clone()))).is_err() {
+            if tx
+                .send(Arrival::now(Received::Line(std::mem::take(&mut text))))
+                .is_err()
+            {
                 return;
             }
         }
