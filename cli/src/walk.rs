@@ -15,7 +15,7 @@ use taskstack::imitation::phase::SupportPhase;
 use taskstack::imitation::reference::support::HumanSupport;
 use taskstack::locomotion::footstep::wrap_angle;
 use taskstack::locomotion::{
-    Footstep, GroundPose, StepTiming, Support, SupportPolygon, WalkParams, WalkerFrame,
+    Footstep, GroundPose, StepTiming, Support, SupportPolygon, WalkParams, WalkState, WalkerFrame,
     WholeBodyWalker, goal_feet, plan_steps,
 };
 use taskstack::nalgebra::Translation3;
@@ -39,9 +39,11 @@ const MAX_STEPS: usize = 1000;
 /// --turn (rad), in the robot's starting frame (x forward, y left). Writes OUT/joints.csv (time
 /// in s, joint angles in rad, 100 Hz; the format of `imitate`, playable by the physics check:
 /// the angles plus their servos' static sag when the profile states the servos' stiffness),
-/// OUT/plan.csv (the plan's CoM, ZMP and sole heights, m), OUT/view.html (the 3D viewer) and
-/// OUT/walk.json (steps, duration, speed, the smallest margins of the plan's ZMP and CoM
-/// inside the support polygon, the solver's largest foot and CoM errors).
+/// OUT/plan.csv (the plan's CoM, cart-table ZMP and sole heights, and the whole body's ZMP of
+/// the solved joint angles: swing leg, arms and torso included; m), OUT/view.html (the 3D
+/// viewer) and OUT/walk.json (steps, duration, speed, the smallest margins of the plan's ZMP,
+/// the whole body's ZMP and the CoM inside the support polygon, the solver's largest foot and
+/// CoM errors).
 ///
 /// Played on the MuJoCo robots of CI's physics check, the NAO's walks stand on both of its
 /// models; the G1's fall a few seconds in (the README's "Physics check").
@@ -98,8 +100,9 @@ pub(crate) fn run(args: WalkArgs, report: Report) -> Result<ExitCode> {
         params = params.with_timing(timing);
     }
     let timing = params.timing;
-    let mut walker = WholeBodyWalker::new(&profile, params, GroundPose::new(0.0, 0.0, 0.0))?;
-    let start = *walker.generator().standing_feet();
+    let start = *WholeBodyWalker::new(&profile, params.clone(), GroundPose::new(0.0, 0.0, 0.0))?
+        .generator()
+        .standing_feet();
     let goal = goal_feet(&start, &GroundPose::new(args.forward, args.left, args.turn));
     let mut envelope = profile.step_envelope;
     if let Some(length) = args.step_length {
@@ -107,31 +110,7 @@ pub(crate) fn run(args: WalkArgs, report: Report) -> Result<ExitCode> {
         envelope.x_min = envelope.x_min.min(length);
     }
     let steps = plan_steps(&start, &goal, &envelope, timing, MAX_STEPS);
-    // The generator's queue is bounded: steps are fed as they land.
-    let capacity = walker.generator().settings().capacity;
-    let mut pending = steps.iter();
-    let mut recorder = Recorder::new(&profile, walker.servo_targets())?;
-    let mut stopped_at = None;
-    loop {
-        while walker.generator().queued() < capacity
-            && let Some(step) = pending.next()
-        {
-            walker.push(*step)?;
-        }
-        let frame = *walker.tick()?;
-        let footsteps: Vec<Footstep> = (walker.generator().queued_steps())
-            .map(|(_, _, step)| *step)
-            .collect();
-        recorder.record(&frame, walker.q(), walker.servo_targets(), &footsteps)?;
-        let time = frame.walk.time;
-        if walker.generator().is_stopped() && pending.len() == 0 && stopped_at.is_none() {
-            stopped_at = Some(time);
-        }
-        if stopped_at.is_some_and(|t| time >= t + args.hold) {
-            break;
-        }
-    }
-    let end = walker.generator().standing_feet();
+    let (recorder, stopped_at, end) = walk_steps(&profile, &params, &steps, args.hold)?;
     let travel = ((end[0].xy + end[1].xy) - (start[0].xy + start[1].xy)).norm() / 2.0;
     let walk_time = stopped_at.unwrap_or(0.0);
     let summary = json!({
@@ -143,10 +122,11 @@ pub(crate) fn run(args: WalkArgs, report: Report) -> Result<ExitCode> {
         "mean_speed_m_s": travel / walk_time.max(f64::MIN_POSITIVE),
         "heading_rad": wrap_angle(end[1].yaw - start[1].yaw),
         "zmp_margin_min_m": recorder.zmp_margin,
+        "body_zmp_margin_min_m": recorder.body_zmp_margin,
         "com_margin_min_m": recorder.com_margin,
         "foot_error_max": recorder.foot_error,
         "com_error_max_m": recorder.com_error,
-        "com_height_m": walker.params().settings.com_height,
+        "com_height_m": params.settings.com_height,
     });
     let zmp_margin = recorder.zmp_margin;
     recorder.write(&args.out, walk_time, &summary)?;
@@ -166,6 +146,42 @@ pub(crate) fn run(args: WalkArgs, report: Report) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// Walks `steps` from the standing posture and stands `hold` s after the robot stops: the
+/// outputs, when it stopped (s) and where the soles ended.
+fn walk_steps(
+    profile: &BipedProfile,
+    params: &WalkParams,
+    steps: &[Footstep],
+    hold: f64,
+) -> Result<(Recorder, Option<f64>, [GroundPose; 2])> {
+    let mut walker = WholeBodyWalker::new(profile, params.clone(), GroundPose::new(0.0, 0.0, 0.0))?;
+    // The generator's queue is bounded: steps are fed as they land.
+    let capacity = walker.generator().settings().capacity;
+    let mut pending = steps.iter();
+    let mut recorder = Recorder::new(profile, walker.servo_targets())?;
+    let mut stopped_at = None;
+    loop {
+        while walker.generator().queued() < capacity
+            && let Some(step) = pending.next()
+        {
+            walker.push(*step)?;
+        }
+        let frame = *walker.tick()?;
+        let footsteps: Vec<Footstep> = (walker.generator().queued_steps())
+            .map(|(_, _, step)| *step)
+            .collect();
+        recorder.record(&frame, walker.q(), walker.servo_targets(), &footsteps)?;
+        let time = frame.walk.time;
+        if walker.generator().is_stopped() && pending.len() == 0 && stopped_at.is_none() {
+            stopped_at = Some(time);
+        }
+        if stopped_at.is_some_and(|t| time >= t + hold) {
+            break;
+        }
+    }
+    Ok((recorder, stopped_at, *walker.generator().standing_feet()))
+}
+
 /// The outputs of a walk, built as the ticks come, and the plan's margins and solver errors.
 struct Recorder {
     polygon: SupportPolygon,
@@ -173,6 +189,10 @@ struct Recorder {
     plan: String,
     view: ViewWriter<Vec<u8>>,
     zmp_margin: f64,
+    /// The whole body's ZMP's least margin (it lags a tick: [`WalkerFrame::previous_zmp`]).
+    body_zmp_margin: f64,
+    /// The last tick's state and its `plan.csv` row, waiting for its whole-body ZMP.
+    pending: Option<(WalkState, String)>,
     com_margin: f64,
     foot_error: f64,
     com_error: f64,
@@ -190,9 +210,13 @@ impl Recorder {
         Ok(Self {
             polygon: SupportPolygon::new(outlines),
             joints,
-            plan: String::from("time,com_x,com_y,zmp_x,zmp_y,left_z,right_z\n"),
+            plan: String::from(
+                "time,com_x,com_y,zmp_x,zmp_y,left_z,right_z,body_zmp_x,body_zmp_y\n",
+            ),
             view: ViewWriter::new(Vec::new(), profile, &title)?,
             zmp_margin: f64::INFINITY,
+            body_zmp_margin: f64::INFINITY,
+            pending: None,
             com_margin: f64::INFINITY,
             foot_error: 0.0,
             com_error: 0.0,
@@ -210,11 +234,20 @@ impl Recorder {
     ) -> Result<()> {
         let w = &frame.walk;
         let [left, right] = w.feet.map(|f| f.position);
-        let _ = writeln!(
-            self.plan,
+        if let Some((state, row)) = self.pending.take() {
+            self.plan.push_str(&row);
+            if let Some(p) = frame.previous_zmp {
+                self.body_zmp_margin = self.body_zmp_margin.min(self.polygon.margin(&state, p));
+                let _ = writeln!(self.plan, ",{:.6},{:.6}", p.x, p.y);
+            } else {
+                self.plan.push_str(",,\n");
+            }
+        }
+        let row = format!(
             "{:.3},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6}",
             w.time, w.com.x, w.com.y, w.zmp.x, w.zmp.y, left[2], right[2]
         );
+        self.pending = Some((*w, row));
         self.zmp_margin = self.zmp_margin.min(self.polygon.margin(w, w.zmp));
         self.com_margin = self.com_margin.min(self.polygon.margin(w, w.com.xy()));
         self.foot_error = self.foot_error.max(frame.foot_error);
@@ -255,8 +288,13 @@ impl Recorder {
                 .with_context(|| format!("cannot write {}", out.join(name).display()))
         };
         let view = self.view.into_inner(walk_end, summary.clone())?;
+        let mut plan = self.plan;
+        if let Some((_, row)) = self.pending {
+            plan.push_str(&row);
+            plan.push_str(",,\n");
+        }
         write("joints.csv", &self.joints.into_inner())?;
-        write("plan.csv", self.plan.as_bytes())?;
+        write("plan.csv", plan.as_bytes())?;
         write("view.html", &view)?;
         write(
             "walk.json",

@@ -62,6 +62,7 @@
 pub mod footstep;
 pub mod generator;
 pub mod margin;
+pub mod multibody;
 pub mod params;
 pub mod planner;
 pub mod preview;
@@ -74,6 +75,7 @@ use thiserror::Error;
 pub use footstep::{Footstep, GroundPose, StepTiming};
 pub use generator::{PatternGenerator, WalkSettings, WalkState};
 pub use margin::SupportPolygon;
+pub use multibody::MultibodyZmp;
 pub use params::WalkParams;
 pub use planner::{StepPlan, goal_feet, plan_steps};
 pub use preview::{CartTable, PreviewGains, PreviewSettings};

@@ -20,6 +20,7 @@ use thiserror::Error;
 use super::LocomotionError;
 use super::footstep::{Footstep, GroundPose};
 use super::generator::{PatternGenerator, WalkState};
+use super::multibody::MultibodyZmp;
 use super::params::{WalkParams, standing_feet};
 use super::schedule::Support;
 use super::schedule::smooth;
@@ -79,6 +80,9 @@ pub struct WalkerFrame {
     pub foot_error: f64,
     /// Error norm of the CoM task after the solve (m).
     pub com_error: f64,
+    /// The whole body's ZMP (world, m; [`super::multibody`]) of the tick *before* this one: it
+    /// needs the posture after it. `None` on the first two ticks.
+    pub previous_zmp: Option<Vector2<f64>>,
 }
 
 /// A biped walking footsteps (see the module docs). Borrows its profile.
@@ -101,6 +105,7 @@ pub struct WholeBodyWalker<'p> {
     /// `[root sole, other sole]` of the model rooted at each side.
     soles: [[FrameId; 2]; 2],
     servo_targets: Vec<f64>,
+    zmp: MultibodyZmp,
 }
 
 impl<'p> WholeBodyWalker<'p> {
@@ -136,6 +141,7 @@ impl<'p> WholeBodyWalker<'p> {
                 sole(Side::Right, Side::Left)?,
             ],
         ];
+        let zmp = MultibodyZmp::new(profile.model(Side::Right), params.settings.dt)?;
         let mut walker = Self {
             profile,
             params,
@@ -149,12 +155,14 @@ impl<'p> WholeBodyWalker<'p> {
                 root: Side::Right,
                 foot_error: 0.0,
                 com_error: 0.0,
+                previous_zmp: None,
             },
             half_span,
             servo: ServoSag::new(profile),
             data: profile.models.each_ref().map(Model::new_data),
             soles,
             servo_targets: profile.stand.clone(),
+            zmp,
         };
         walker.update_servo_targets(LoadedSoles::Both)?;
         Ok(walker)
@@ -226,26 +234,39 @@ impl<'p> WholeBodyWalker<'p> {
             Support::Double => LoadedSoles::Both,
         };
         self.update_servo_targets(loaded)?;
+        let previous_zmp = self.push_zmp(&root_pose)?;
         self.frame = WalkerFrame {
             walk,
             root,
             foot_error,
             com_error,
+            previous_zmp,
         };
         Ok(&self.frame)
     }
 
-    /// The servo targets of `q` in the root's model with `loaded` soles.
+    /// The whole-body ZMP of the previous tick, `q` standing on the root sole at `root_pose`.
+    fn push_zmp(&mut self, root_pose: &GroundPose) -> Result<Option<Vector2<f64>>, WalkerError> {
+        let base = IsometryMatrix3::from_parts(
+            Translation3::new(root_pose.xy.x, root_pose.xy.y, 0.0),
+            Rotation3::from_axis_angle(&Vector3::z_axis(), root_pose.yaw),
+        );
+        let (model, data) = (self.profile.model(self.root), &self.data[self.root.index()]);
+        Ok(self.zmp.push(model, data, &base, &self.q)?)
+    }
+
+    /// The servo targets of `q` in the root's model with `loaded` soles (and that model's
+    /// forward kinematics at `q`).
     fn update_servo_targets(&mut self, loaded: LoadedSoles) -> Result<(), WalkerError> {
-        let Some(servo) = &mut self.servo else {
-            self.servo_targets.copy_from_slice(&self.q);
-            return Ok(());
-        };
         let (model, data) = (
             self.profile.model(self.root),
             &mut self.data[self.root.index()],
         );
         model.forward_kinematics(data, &self.q)?;
+        let Some(servo) = &mut self.servo else {
+            self.servo_targets.copy_from_slice(&self.q);
+            return Ok(());
+        };
         let load = other_sole_load(model, data, self.soles[self.root.index()], loaded)?;
         servo.targets(
             model,

@@ -40,6 +40,7 @@ mod io_skeleton_map;
 mod live;
 mod locomotion_alloc;
 mod locomotion_generator;
+mod locomotion_multibody;
 mod locomotion_walker;
 mod model_alloc;
 mod model_dh;
