@@ -128,18 +128,19 @@ pub(crate) fn run(args: WalkArgs, report: Report) -> Result<ExitCode> {
         "com_error_max_m": recorder.com_error,
         "com_height_m": params.settings.com_height,
     });
-    let zmp_margin = recorder.zmp_margin;
+    let (zmp_margin, body_zmp_margin) = (recorder.zmp_margin, recorder.body_zmp_margin);
     recorder.write(&args.out, walk_time, &summary)?;
     if report.json {
         crate::output(&format!("{summary}\n"))?;
     } else if report.human() {
         crate::output(&format!(
-            "{}: {} steps of {:.2} s, {travel:.3} m in {walk_time:.2} s ({:.3} m/s), ZMP >= {:.1} mm inside the support\nwrote {}\n",
+            "{}: {} steps of {:.2} s, {travel:.3} m in {walk_time:.2} s ({:.3} m/s), ZMP >= {:.1} mm inside the support (the whole body's: {:.1} mm)\nwrote {}\n",
             profile.name,
             steps.len(),
             timing.duration(),
             travel / walk_time.max(f64::MIN_POSITIVE),
             zmp_margin * 1e3,
+            body_zmp_margin * 1e3,
             args.out.display()
         ))?;
     }

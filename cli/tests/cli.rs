@@ -914,14 +914,19 @@ fn walk_writes_a_joint_trajectory_the_plan_and_a_summary() {
     let view = std::fs::read_to_string(out.join("view.html")).unwrap();
     assert!(view.contains("const FRAMES") && view.contains("nao walking"));
     let plan = std::fs::read_to_string(out.join("plan.csv")).unwrap();
-    assert!(plan.starts_with(
-        "time,com_x,com_y,zmp_x,zmp_y,left_z,right_z,body_zmp_x,body_zmp_y\n"
-    ));
+    assert!(
+        plan.starts_with("time,com_x,com_y,zmp_x,zmp_y,left_z,right_z,body_zmp_x,body_zmp_y\n")
+    );
     // The whole body's ZMP is known from the second tick to the one before the last.
     let rows: Vec<&str> = plan.lines().skip(1).collect();
     assert!(rows[0].ends_with(",,") && rows[rows.len() - 1].ends_with(",,"));
     assert!(rows[1..rows.len() - 1].iter().all(|r| !r.ends_with(',')));
-    assert!(summary["body_zmp_margin_min_m"].as_f64().unwrap().is_finite());
+    assert!(
+        summary["body_zmp_margin_min_m"]
+            .as_f64()
+            .unwrap()
+            .is_finite()
+    );
     assert!(
         std::fs::read_to_string(out.join("walk.json"))
             .unwrap()
