@@ -166,14 +166,15 @@ pub(crate) struct ImitationOptions {
     #[arg(long, value_name = "M_PER_S", value_parser = positive, allow_negative_numbers = true)]
     pub(crate) swing_speed: Option<f64>,
     /// Fastest speed of the hand targets toward the scaled human (m/s, > 0), in every phase.
-    /// Default: the profile's, once both feet have stood for a second / on one foot and while
-    /// the weight shifts (NAO 0.8 / 0.3, G1 1.2 / 0.6; both methods; --dynamic-walk the second
-    /// throughout).
+    /// Default: the profile's balanced speed where it has one and the ZMP level is on or the
+    /// method is Koenemann's (NAO 1, every phase); else the profile's once both feet have
+    /// stood for a second / on one foot and while the weight shifts (NAO 0.8 / 0.3, G1
+    /// 1.2 / 0.6; --dynamic-walk the second throughout).
     #[arg(long, value_name = "M_PER_S", value_parser = positive, allow_negative_numbers = true)]
     pub(crate) tracking_speed: Option<f64>,
     /// Largest change of the hand targets' speed (m/s², > 0), in every phase: the hands start
-    /// and brake instead of reaching their speed in one frame. Default: the profile's (NAO 2,
-    /// G1 5; both methods).
+    /// and brake instead of reaching their speed in one frame. Default: the profile's, chosen
+    /// as --tracking-speed's (NAO 5 balanced, else 2; G1 5).
     #[arg(long, value_name = "M_PER_S2", value_parser = positive, allow_negative_numbers = true)]
     pub(crate) tracking_acceleration: Option<f64>,
     /// Poubel's method: solver iterations per human frame (1–100).

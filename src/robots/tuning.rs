@@ -104,9 +104,10 @@ pub struct MotionTuning {
     pub offset_to_stance_point: bool,
     /// The hands' speeds in every phase of Poubel et al.'s method when its ZMP level holds the
     /// balance (`PoubelConfig::zmp_balance`: a level that sees the arms' acceleration and
-    /// bounds their vertical moment on the feet), instead of `tracking_speed`,
-    /// `stance_tracking_speed` and `tracking_acceleration`; `None`: the level keeps those.
-    /// Koenemann et al.'s method (no ZMP level) and the dynamic walk always use them.
+    /// bounds their vertical moment on the feet) and of Koenemann et al.'s method (whose CoM
+    /// offset control was measured to keep the NAO up under them), instead of
+    /// `tracking_speed`, `stance_tracking_speed` and `tracking_acceleration`; `None`: both
+    /// methods keep those. The dynamic walk always keeps those.
     pub balanced_hands: Option<BalancedHands>,
     /// The solver's damping of near-singular levels in Poubel et al.'s method (m/rad: the
     /// damping threshold and the largest damping of

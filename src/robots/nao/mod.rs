@@ -306,7 +306,10 @@ pub fn self_collision() -> SelfCollision {
 ///   ges01 weak: the measured ZMP within 2 mm of an edge 1.4 % of the time); at 5 m/s² all 16
 ///   pass, the hands 0.0–0.6 cm farther than at 10 m/s² (bar Kinect ges01, 0.9 cm) and still
 ///   1.0–3.1 cm nearer than without the level on the clips where the arms move fast; faster
-///   still (1.5 m/s, 20 m/s²), loaded feet turned.
+///   still (1.5 m/s, 20 m/s²), loaded feet turned. Koenemann et al.'s method moves the hands at
+///   these speeds too: its CoM offset control keeps the NAO up under them without a ZMP level
+///   (16 of 16 bundled runs pass at 1 m/s and 5 m/s², and at 2 m/s and 10 m/s² with less
+///   margin: Kinect ges01's ZMP inside 99.1 % of the time), the hands 0.5–4.5 cm nearer.
 /// * The torso 0.02 m low: with 0.1 m shanks both knees end up straight at the standing height.
 /// * A 0.25 rad lean over the stance foot: upright, the stance hip-roll servo holds the upper
 ///   body at 88 % of its rated torque (beyond a weak servo's limit); leaning 0.25 rad lowers the
