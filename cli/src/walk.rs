@@ -100,9 +100,9 @@ pub(crate) fn run(args: WalkArgs, report: Report) -> Result<ExitCode> {
         params = params.with_timing(timing);
     }
     let timing = params.timing;
-    let start = *WholeBodyWalker::new(&profile, params.clone(), GroundPose::new(0.0, 0.0, 0.0))?
-        .generator()
-        .standing_feet();
+    let com_height = params.settings.com_height;
+    let walker = WholeBodyWalker::new(&profile, params, GroundPose::new(0.0, 0.0, 0.0))?;
+    let start = *walker.generator().standing_feet();
     let goal = goal_feet(&start, &GroundPose::new(args.forward, args.left, args.turn));
     let mut envelope = profile.step_envelope;
     if let Some(length) = args.step_length {
@@ -110,7 +110,7 @@ pub(crate) fn run(args: WalkArgs, report: Report) -> Result<ExitCode> {
         envelope.x_min = envelope.x_min.min(length);
     }
     let steps = plan_steps(&start, &goal, &envelope, timing, MAX_STEPS);
-    let (recorder, stopped_at, end) = walk_steps(&profile, &params, &steps, args.hold)?;
+    let (recorder, stopped_at, end) = walk_steps(walker, &profile, &steps, args.hold)?;
     let travel = ((end[0].xy + end[1].xy) - (start[0].xy + start[1].xy)).norm() / 2.0;
     let walk_time = stopped_at.unwrap_or(0.0);
     let summary = json!({
@@ -126,7 +126,7 @@ pub(crate) fn run(args: WalkArgs, report: Report) -> Result<ExitCode> {
         "com_margin_min_m": recorder.com_margin,
         "foot_error_max": recorder.foot_error,
         "com_error_max_m": recorder.com_error,
-        "com_height_m": params.settings.com_height,
+        "com_height_m": com_height,
     });
     let (zmp_margin, body_zmp_margin) = (recorder.zmp_margin, recorder.body_zmp_margin);
     recorder.write(&args.out, walk_time, &summary)?;
@@ -147,15 +147,14 @@ pub(crate) fn run(args: WalkArgs, report: Report) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// Walks `steps` from the standing posture and stands `hold` s after the robot stops: the
+/// `walker` (standing, with `profile`) walks `steps` and stands `hold` s after it stops: the
 /// outputs, when it stopped (s) and where the soles ended.
 fn walk_steps(
+    mut walker: WholeBodyWalker<'_>,
     profile: &BipedProfile,
-    params: &WalkParams,
     steps: &[Footstep],
     hold: f64,
 ) -> Result<(Recorder, Option<f64>, [GroundPose; 2])> {
-    let mut walker = WholeBodyWalker::new(profile, params.clone(), GroundPose::new(0.0, 0.0, 0.0))?;
     // The generator's queue is bounded: steps are fed as they land.
     let capacity = walker.generator().settings().capacity;
     let mut pending = steps.iter();

@@ -11,6 +11,20 @@ use std::process::Command;
 use common::{imitated_kinect, s, taskstack, temp_dir};
 use serde_json::Value;
 
+/// [`browser`], or `None` after saying the test is skipped; with `TASKSTACK_REQUIRE_BROWSER`
+/// set (CI) a missing browser fails the test instead.
+fn browser_or_skip() -> Option<PathBuf> {
+    let found = browser();
+    if found.is_none() {
+        assert!(
+            std::env::var_os("TASKSTACK_REQUIRE_BROWSER").is_none(),
+            "TASKSTACK_REQUIRE_BROWSER is set but no Chromium or Chrome was found"
+        );
+        eprintln!("viewer test skipped: no chromium, chromium-browser or google-chrome on PATH");
+    }
+    found
+}
+
 /// The first browser found: `TASKSTACK_BROWSER`, else chromium, chromium-browser, google-chrome.
 fn browser() -> Option<PathBuf> {
     let candidates = std::env::var_os("TASKSTACK_BROWSER")
@@ -37,9 +51,7 @@ fn browser() -> Option<PathBuf> {
 /// its WebSocket (a page opened after the frames first gets the session's backlog).
 #[test]
 fn the_live_view_follows_a_session_in_a_headless_browser() {
-    let Some(browser) = browser() else {
-        assert!(std::env::var_os("TASKSTACK_REQUIRE_BROWSER").is_none());
-        eprintln!("live view test skipped: no chromium, chromium-browser or google-chrome on PATH");
+    let Some(browser) = browser_or_skip() else {
         return;
     };
     let dir = temp_dir("live-view");
@@ -81,12 +93,7 @@ fn the_live_view_follows_a_session_in_a_headless_browser() {
 
 #[test]
 fn the_viewer_draws_and_plays_in_a_headless_browser() {
-    let Some(browser) = browser() else {
-        assert!(
-            std::env::var_os("TASKSTACK_REQUIRE_BROWSER").is_none(),
-            "TASKSTACK_REQUIRE_BROWSER is set but no Chromium or Chrome was found"
-        );
-        eprintln!("viewer test skipped: no chromium, chromium-browser or google-chrome on PATH");
+    let Some(browser) = browser_or_skip() else {
         return;
     };
     let dir = temp_dir("viewer");
@@ -139,9 +146,7 @@ fn the_viewer_draws_and_plays_in_a_headless_browser() {
 /// out of its frames.
 #[test]
 fn the_viewer_draws_the_walk_plan() {
-    let Some(browser) = browser() else {
-        assert!(std::env::var_os("TASKSTACK_REQUIRE_BROWSER").is_none());
-        eprintln!("viewer test skipped: no browser");
+    let Some(browser) = browser_or_skip() else {
         return;
     };
     let dir = temp_dir("viewer-walk");
@@ -169,9 +174,7 @@ fn the_viewer_draws_the_walk_plan() {
 /// taken out.
 #[test]
 fn the_viewer_draws_the_surfaces_the_hands_rest_on() {
-    let Some(browser) = browser() else {
-        assert!(std::env::var_os("TASKSTACK_REQUIRE_BROWSER").is_none());
-        eprintln!("viewer test skipped: no browser");
+    let Some(browser) = browser_or_skip() else {
         return;
     };
     let dir = temp_dir("viewer-stool");
@@ -202,9 +205,7 @@ fn the_viewer_draws_the_surfaces_the_hands_rest_on() {
 /// hands taken out.
 #[test]
 fn the_viewer_draws_the_hand_targets() {
-    let Some(browser) = browser() else {
-        assert!(std::env::var_os("TASKSTACK_REQUIRE_BROWSER").is_none());
-        eprintln!("viewer test skipped: no browser");
+    let Some(browser) = browser_or_skip() else {
         return;
     };
     let dir = temp_dir("viewer-hands");
