@@ -31,7 +31,8 @@
 use faer::Mat;
 use nalgebra::{IsometryMatrix3, Vector2, Vector3};
 
-use super::preview::GRAVITY;
+use super::LocomotionError;
+use super::preview::{GRAVITY, positive};
 use crate::model::{Model, ModelData, ModelError};
 
 /// The whole-body ZMP of a motion fed one tick at a time (module docs). Allocates in
@@ -55,11 +56,11 @@ impl MultibodyZmp {
     /// sampled every `dt` s.
     ///
     /// # Errors
-    /// [`ModelError::NoMass`] for a massless model.
-    pub fn new(model: &Model, dt: f64) -> Result<Self, ModelError> {
-        if model.total_mass() <= 0.0 {
-            return Err(ModelError::NoMass);
-        }
+    /// [`LocomotionError::InvalidParameter`] for a `dt` that is not finite and > 0 or a
+    /// massless model.
+    pub fn new(model: &Model, dt: f64) -> Result<Self, LocomotionError> {
+        positive("dt", dt)?;
+        positive("model mass", model.total_mass())?;
         let n = model.nv();
         Ok(Self {
             dt,
@@ -71,11 +72,6 @@ impl MultibodyZmp {
             momentum_world: [Vector3::zeros(); 2],
             samples: 0,
         })
-    }
-
-    /// Forgets the motion so far (the next [`MultibodyZmp::push`] starts a new one).
-    pub fn reset(&mut self) {
-        self.samples = 0;
     }
 
     /// Adds tick `k`: the posture `q` (rad, model variable order) of `model`, whose forward
@@ -154,5 +150,18 @@ mod tests {
         let com = model.com(&data).unwrap();
         let p = last.unwrap();
         assert!((p.x - (com.x + 0.3)).abs() < 1e-12 && (p.y - (com.y - 0.1)).abs() < 1e-12);
+    }
+
+    /// A tick that is not a positive time is refused, not divided by.
+    #[test]
+    fn a_bad_tick_is_refused() {
+        let profile = nao::profile();
+        let model = profile.model(Side::Right);
+        for dt in [0.0, -0.01, f64::NAN, f64::INFINITY] {
+            assert!(matches!(
+                MultibodyZmp::new(model, dt),
+                Err(LocomotionError::InvalidParameter { name: "dt", .. })
+            ));
+        }
     }
 }
